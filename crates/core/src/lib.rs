@@ -1,0 +1,14 @@
+//! Kernel of gyroemu, kept apart from the runtime (in the spirit of FutureSDR's `futuredsp`):
+//! the numeric sample type every stage is generic over, the small interface every stage
+//! shares, the parameter error, and trigonometry that gives the same bits on every platform.
+
+pub mod detmath;
+pub mod error;
+pub mod sample;
+pub mod stage;
+
+pub use error::{ParamError, ParamResult};
+pub use num_complex::Complex64;
+pub use sample::Sample;
+pub use stage::{Response, Stage};
+pub use wide::f64x4;

@@ -1,0 +1,136 @@
+//! The numeric type that flows through the chain: `f64`, or `f64x4` to run four operating
+//! points in SIMD lanes through the very same stage code.
+
+use core::fmt::Debug;
+use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
+use wide::f64x4;
+
+/// A real sample, scalar or lane-parallel. All arithmetic is plain IEEE `+ - * /` (no fused
+/// multiply-add) so that every lane of `f64x4` gives the bits the scalar `f64` path gives.
+pub trait Sample:
+    Copy
+    + Default
+    + Debug
+    + Send
+    + Sync
+    + 'static
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+{
+    /// Number of independent lanes (1 for `f64`).
+    const LANES: usize;
+    /// The same value in every lane.
+    fn splat(v: f64) -> Self;
+    /// Lane `i` set to `f(i)`.
+    fn from_fn(f: impl FnMut(usize) -> f64) -> Self;
+    /// The value of lane `i` (`i < LANES`).
+    fn lane(self, i: usize) -> f64;
+    /// Lane-wise clamp into `[lo, hi]`.
+    fn clamp_to(self, lo: Self, hi: Self) -> Self;
+    /// Lane-wise round half away from zero.
+    fn round_away(self) -> Self;
+    /// True when every lane is finite.
+    fn all_finite(self) -> bool;
+}
+
+impl Sample for f64 {
+    const LANES: usize = 1;
+    #[inline(always)]
+    fn splat(v: f64) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> f64) -> Self {
+        f(0)
+    }
+    #[inline(always)]
+    fn lane(self, _i: usize) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn clamp_to(self, lo: Self, hi: Self) -> Self {
+        // max/min rather than f64::clamp: no panic path, NaN propagates as a NaN.
+        if self < lo {
+            lo
+        } else if self > hi {
+            hi
+        } else {
+            self
+        }
+    }
+    #[inline(always)]
+    fn round_away(self) -> Self {
+        self.round()
+    }
+    #[inline(always)]
+    fn all_finite(self) -> bool {
+        self.is_finite()
+    }
+}
+
+impl Sample for f64x4 {
+    const LANES: usize = 4;
+    #[inline(always)]
+    fn splat(v: f64) -> Self {
+        f64x4::splat(v)
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> f64) -> Self {
+        f64x4::new([f(0), f(1), f(2), f(3)])
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> f64 {
+        self.to_array()[i]
+    }
+    #[inline(always)]
+    fn clamp_to(self, lo: Self, hi: Self) -> Self {
+        self.max(lo).min(hi)
+    }
+    #[inline(always)]
+    fn round_away(self) -> Self {
+        // f64x4::round rounds half to even; match f64::round (half away from zero).
+        let a = self.to_array();
+        Self::from_fn(|i| a[i].round())
+    }
+    #[inline(always)]
+    fn all_finite(self) -> bool {
+        self.is_finite().all()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lanes_match_scalar_arithmetic() {
+        let a = [1.25, -3.5, 1e-300, 7.0e12];
+        let b = [0.1, 2.0 / 3.0, -4.0, 1.0 / 7.0];
+        let va = f64x4::from_fn(|i| a[i]);
+        let vb = f64x4::from_fn(|i| b[i]);
+        let r = (va * vb + va - vb) / vb;
+        for i in 0..4 {
+            let s = (a[i] * b[i] + a[i] - b[i]) / b[i];
+            assert_eq!(r.lane(i).to_bits(), s.to_bits());
+        }
+    }
+
+    #[test]
+    fn round_and_clamp_match_scalar() {
+        let xs = [2.5, -2.5, 0.49999999999999994, -7.3];
+        let v = f64x4::from_fn(|i| xs[i]);
+        let r = v.round_away();
+        let c = v.clamp_to(f64x4::splat(-1.0), f64x4::splat(1.0));
+        for i in 0..4 {
+            assert_eq!(r.lane(i), xs[i].round());
+            assert_eq!(c.lane(i), xs[i].clamp_to(-1.0, 1.0));
+        }
+        assert!(!f64x4::from_fn(|i| if i == 2 { f64::NAN } else { 0.0 }).all_finite());
+    }
+}

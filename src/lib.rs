@@ -1,0 +1,2 @@
+//! facade (stages pending)
+pub use gyroemu_core as core;
