@@ -1,2 +1,14 @@
-//! facade (stages pending)
+//! gyroemu: a sample-level emulator of the mixed-signal readout board of a MEMS vibratory
+//! gyroscope and its electrostatic self-calibration (Casinovi et al., MEMS 2012).
+//!
+//! This facade re-exports the stage crates, one per stage of the board; see
+//! `docs/architecture.md` for the chain and the shared [`Stage`] interface.
+
+pub use gyroemu_am as am;
 pub use gyroemu_core as core;
+pub use gyroemu_core::{Complex64, ParamError, Response, Sample, Stage};
+pub use gyroemu_lpf as lpf;
+pub use gyroemu_mixer as mixer;
+pub use gyroemu_nco as nco;
+pub use gyroemu_resonator as resonator;
+pub use gyroemu_tia as tia;

@@ -78,7 +78,10 @@ pub fn below_nyquist(
             stage,
             param,
             f_hz,
-            format!("must be finite, > 0 and below Nyquist (fs/2 = {} Hz)", 0.5 * fs_hz),
+            format!(
+                "must be finite, > 0 and below Nyquist (fs/2 = {} Hz)",
+                0.5 * fs_hz
+            ),
         ))
     }
 }
@@ -91,7 +94,9 @@ mod tests {
     fn message_names_stage_param_value_rule() {
         let e = positive("resonator", "q", -3.0).unwrap_err();
         let m = e.to_string();
-        assert!(m.contains("resonator") && m.contains("`q`") && m.contains("-3") && m.contains("> 0"));
+        assert!(
+            m.contains("resonator") && m.contains("`q`") && m.contains("-3") && m.contains("> 0")
+        );
         assert!(finite("x", "y", f64::NAN).is_err());
         assert!(positive("x", "y", f64::INFINITY).is_err());
         assert!(non_negative("x", "y", 0.0).is_ok());

@@ -1,0 +1,1 @@
+//! AM modulator of the two drives and the DAC (hold, quantisation)

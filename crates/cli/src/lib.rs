@@ -1,0 +1,1 @@
+//! The gyroemu command-line program

@@ -1,0 +1,1 @@
+//! Outputs: atomic file writes, CSV, JSON, multichannel WAV and windowed signal dumps

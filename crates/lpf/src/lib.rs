@@ -1,0 +1,1 @@
+//! Low-pass decimator (Butterworth and lock-in biquad cascades) and compensated averager

@@ -1,0 +1,1 @@
+//! Paper-style PNG figures with a bundled font (no system fontconfig)

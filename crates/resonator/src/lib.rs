@@ -1,0 +1,1 @@
+//! 2-DOF vibratory gyroscope plant, exactly discretised with the matrix exponential

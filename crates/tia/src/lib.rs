@@ -1,0 +1,1 @@
+//! Transimpedance front end: gain, one pole, inversion, output rails
