@@ -1,1 +1,57 @@
-//! Two-stage mixer: carrier I/Q demodulation, single real mixer, demodulation at Omega and the sideband estimators
+//! Two-stage mixer of the gyroscope readout (THEORY sections 3, 4 and 6).
+//!
+//! * [`Stage1Mixer`]: complex demodulation by the carrier, `z = 2 y e^{-j(w0 t + phi)}`, to be
+//!   low-passed (the low-pass lives in `gyroemu-lpf`). For `y = A cos(w0 t - theta)` the DC of `z`
+//!   is `A e^{-j(theta + phi)}`: a lag `theta` shows as a *negative* phase of `z`.
+//! * [`SingleMixer`]: the paper's single real mixer `2 y r`, DC `A cos(theta - phi)`.
+//! * [`Stage2Mixer`]: demodulation of `z` at the modulation rate Omega, giving the C and S terms.
+//! * [`sideband_estimate`], [`paper_i_channel_psi_rad`], [`phase_lag_rad`]: the read-outs.
+
+mod estimate;
+mod iq;
+mod single;
+mod stage1;
+mod stage2;
+
+pub use estimate::{
+    paper_i_channel_psi_rad, phase_lag_rad, sideband_estimate, Mode, SidebandEstimate,
+};
+pub use iq::Iq;
+pub use single::SingleMixer;
+pub use stage1::Stage1Mixer;
+pub use stage2::{Stage2Mixer, Stage2Out};
+
+/// Wraps an angle into `(-pi, pi]` (the branch every read-out here uses).
+#[inline]
+pub fn wrap_pi(x: f64) -> f64 {
+    use core::f64::consts::{PI, TAU};
+    let mut w = x - TAU * (x / TAU).round();
+    // `round` leaves w in [-pi, pi]; move the lower end to the upper one.
+    if w <= -PI {
+        w += TAU;
+    }
+    if w > PI {
+        w -= TAU;
+    }
+    w
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wrap_pi;
+    use core::f64::consts::{PI, TAU};
+
+    #[test]
+    fn wrap_pi_is_half_open_and_preserves_angle() {
+        assert_eq!(wrap_pi(PI), PI);
+        assert_eq!(wrap_pi(-PI), PI);
+        assert_eq!(wrap_pi(3.0 * PI), PI);
+        for k in -50..50 {
+            let x = 0.37 * k as f64;
+            let w = wrap_pi(x);
+            assert!(w > -PI && w <= PI);
+            let turns = (x - w) / TAU;
+            assert!((turns - turns.round()).abs() < 1e-12);
+        }
+    }
+}

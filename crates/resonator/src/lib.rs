@@ -1,1 +1,25 @@
-//! 2-DOF vibratory gyroscope plant, exactly discretised with the matrix exponential
+//! 2-DOF vibratory gyroscope plant, exactly discretised with the matrix exponential.
+//!
+//! State `x = [q1, q2, v1, v2]` (m, m/s), force per unit mass `u = [f1, f2]` (m/s^2):
+//!
+//! ```text
+//! q1'' + (w1/Q1) q1' - 2 lambda Omega_z q2' + w1^2 q1 + k12 q2 = f1
+//! q2'' + (w2/Q2) q2' + 2 lambda Omega_z q1' + w2^2 q2 + k12 q1 = f2
+//! ```
+//!
+//! The DAC holds each drive sample for `Ts`, so the exact step is the zero-order-hold
+//! discretisation `x[n+1] = Phi x[n] + Gamma u[n]` (THEORY.md sections 2 and 6). A rate that
+//! varies in time uses a second-order expansion of the step about the design rate, so no
+//! exponential is taken per sample.
+
+mod discretise;
+mod params;
+mod plant;
+mod steady;
+
+pub use params::{ModeParams, ResonatorParams};
+pub use plant::{PlantOutput, Resonator};
+pub use steady::continuous_steady_state;
+
+/// Stage name used in every [`gyroemu_core::ParamError`] of this crate.
+pub const STAGE: &str = "resonator";
