@@ -1,1 +1,9 @@
-//! Transimpedance front end: gain, one pole, inversion, output rails
+//! Transimpedance front end: gain, one pole, inversion, output rails.
+//!
+//! The sensed electrode gives a motional *current* proportional to velocity (THEORY section 2);
+//! the TIA turns it into a voltage with gain `R` (ohm) and the pole of its feedback `R || C`.
+#![warn(missing_docs)]
+
+mod tia;
+
+pub use tia::{Tia, TiaParams};

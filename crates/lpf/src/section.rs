@@ -1,0 +1,118 @@
+//! One second-order section `(b0 + b1 z^-1 + b2 z^-2) / (1 + a1 z^-1 + a2 z^-2)`.
+
+use gyroemu_core::{Complex64, Sample};
+
+/// Coefficients of one section in f64 (`a0 = 1`); a first-order section has `b2 = a2 = 0`.
+///
+/// For the response each polynomial `p0 + p1 z^-1 + p2 z^-2` is also kept as
+/// `P(1) + (p1 + 2 p2) u + p2 u^2` with `u = z^-1 - 1`: near DC, where the poles of a
+/// narrow low-pass sit next to `z = 1`, this form has no cancellation, so the response and
+/// the group delay keep full relative precision.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Coefs {
+    pub b0: f64,
+    pub b1: f64,
+    pub b2: f64,
+    pub a1: f64,
+    pub a2: f64,
+    b_sum: f64,
+    b_slope: f64,
+    a_sum: f64,
+    a_slope: f64,
+}
+
+impl Coefs {
+    /// A direct-form section `(b0, b1, b2) / (1, a1, a2)`.
+    pub fn biquad(b0: f64, b1: f64, b2: f64, a1: f64, a2: f64) -> Self {
+        Self {
+            b0,
+            b1,
+            b2,
+            a1,
+            a2,
+            b_sum: b0 + b1 + b2,
+            b_slope: b1 + 2.0 * b2,
+            // For poles near z = 1 these sums are exact (Sterbenz: a1 ~ -2, a2 ~ 1).
+            a_sum: 1.0 + a1 + a2,
+            a_slope: a1 + 2.0 * a2,
+        }
+    }
+
+    /// The one-pole `y += k (x - y)`, i.e. `k / (1 - (1 - k) z^-1)`, with `A(1) = k` exactly.
+    pub fn one_pole(k: f64) -> Self {
+        Self {
+            b0: k,
+            b1: 0.0,
+            b2: 0.0,
+            a1: -(1.0 - k),
+            a2: 0.0,
+            b_sum: k,
+            b_slope: 0.0,
+            a_sum: k,
+            a_slope: -(1.0 - k),
+        }
+    }
+
+    /// Complex gain at `z^-1 = 1 + u`.
+    pub fn response(&self, u: Complex64) -> Complex64 {
+        let num = u * (u * self.b2 + self.b_slope) + self.b_sum;
+        let den = u * (u * self.a2 + self.a_slope) + self.a_sum;
+        num / den
+    }
+
+    /// DC group delay in samples: near DC `u = -j w`, so each polynomial's phase is
+    /// `-w slope / sum`, and the section's delay is numerator's minus denominator's.
+    pub fn dc_group_delay(&self) -> f64 {
+        self.b_slope / self.b_sum - self.a_slope / self.a_sum
+    }
+}
+
+/// A section's coefficients as samples and its two state variables.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Section<S> {
+    b0: S,
+    b1: S,
+    b2: S,
+    a1: S,
+    a2: S,
+    s1: S,
+    s2: S,
+}
+
+impl<S: Sample> Section<S> {
+    pub fn new(c: &Coefs) -> Self {
+        Self {
+            b0: S::splat(c.b0),
+            b1: S::splat(c.b1),
+            b2: S::splat(c.b2),
+            a1: S::splat(c.a1),
+            a2: S::splat(c.a2),
+            s1: S::default(),
+            s2: S::default(),
+        }
+    }
+
+    /// Transposed direct form II: fewest states, and each state is a sum of scaled signals
+    /// (no large internal gain for low-pass sections).
+    #[inline(always)]
+    pub fn tick_df2t(&mut self, x: S) -> S {
+        let y = self.b0 * x + self.s1;
+        self.s1 = self.b1 * x - self.a1 * y + self.s2;
+        self.s2 = self.b2 * x - self.a2 * y;
+        y
+    }
+
+    /// Lock-in RC one-pole `y += k (x - y)` with `k = b0` (state in `s1`): a held input is
+    /// reached exactly, whatever the rounding of `k`.
+    #[inline(always)]
+    pub fn tick_one_pole(&mut self, x: S) -> S {
+        let y = self.s1 + self.b0 * (x - self.s1);
+        self.s1 = y;
+        y
+    }
+
+    pub fn reset(&mut self) {
+        self.s1 = S::default();
+        self.s2 = S::default();
+    }
+}

@@ -1,0 +1,202 @@
+//! The compensated averager: long-sum accuracy, whole-period exactness, window leakage.
+
+mod common;
+
+use gyroemu_core::detmath::sin_cos_turns;
+use gyroemu_core::{f64x4, Complex64, Sample};
+use gyroemu_lpf::{whole_half_periods, Averager, KahanSum, Window};
+use std::f64::consts::{PI, TAU};
+use std::hint::black_box;
+
+#[test]
+fn mean_of_5e8_samples_of_0_1_is_exact_where_a_naive_sum_is_not() {
+    let n: u64 = 500_000_000;
+    let x = black_box(0.1);
+    let t0 = std::time::Instant::now();
+    let mut avg = Averager::<f64>::new(Window::Boxcar, n).unwrap();
+    for _ in 0..n {
+        avg.push(black_box(x));
+    }
+    let dt = t0.elapsed();
+    assert_eq!(avg.count(), n);
+    let rel = (avg.mean() - 0.1).abs() / 0.1;
+    let mut naive = 0.0;
+    for _ in 0..n {
+        naive += black_box(x);
+    }
+    let naive_rel = (naive / n as f64 - 0.1).abs() / 0.1;
+    eprintln!("5e8 x 0.1: Kahan rel err {rel:e} ({dt:?}), naive rel err {naive_rel:e}");
+    assert!(rel < 1e-12);
+    assert!(
+        naive_rel > 1e-10,
+        "the naive sum must fail this test ({naive_rel:e})"
+    );
+}
+
+/// Phase of `f n / fs` in turns, exact for integer `f`, `fs` (reduced before rounding).
+fn turns(f: f64, fs: f64, n: u64) -> f64 {
+    (f * n as f64) % fs / fs
+}
+
+#[test]
+fn boxcar_over_whole_half_periods_is_exact_for_the_stage_2_products() {
+    let (f, fs) = (125.0, 1e6); // half period 4000 samples
+    let n = whole_half_periods(f, fs, 0.1037);
+    assert_eq!(n, 100_000); // 25 half periods
+    let psi: f64 = 0.3;
+    let amp = 0.7;
+    let mut prod = Averager::<f64>::new(Window::Boxcar, n).unwrap();
+    let mut sq = Averager::<f64>::new(Window::Boxcar, n).unwrap();
+    let mut c = Averager::<f64>::new(Window::Boxcar, n).unwrap();
+    let mut s = Averager::<f64>::new(Window::Boxcar, n).unwrap();
+    for i in 0..n {
+        let (sn, cs) = sin_cos_turns(turns(f, fs, i));
+        let z = amp * (cs * psi.cos() + sn * psi.sin()); // A cos(W t - psi)
+        prod.push(sn * cs);
+        sq.push(cs * cs);
+        c.push(2.0 * z * cs);
+        s.push(2.0 * z * sn);
+    }
+    eprintln!(
+        "whole half periods: <sin cos> = {:e}, <cos^2> - 1/2 = {:e}",
+        prod.mean(),
+        sq.mean() - 0.5
+    );
+    assert!(prod.mean().abs() < 1e-12);
+    assert!((sq.mean() - 0.5).abs() < 1e-12);
+    // stage 2: C = A cos psi, S = A sin psi exactly, so atan2 gives psi back
+    assert!(
+        (c.mean() - amp * psi.cos()).abs() < 1e-12 && (s.mean() - amp * psi.sin()).abs() < 1e-12
+    );
+    assert!((s.mean().atan2(c.mean()) - psi).abs() < 1e-12);
+}
+
+/// `sum_{n<N} e^{j theta n}` in closed form (Dirichlet kernel).
+fn geometric(theta: f64, n: u64) -> Complex64 {
+    let e = |t: f64| Complex64::from_polar(1.0, t);
+    if (theta / TAU).fract().abs() < 1e-300 {
+        return Complex64::new(n as f64, 0.0);
+    }
+    (Complex64::new(1.0, 0.0) - e(theta * n as f64)) / (Complex64::new(1.0, 0.0) - e(theta))
+}
+
+/// Closed forms of the weighted mean of `sin(theta n + phi)` for the two windows:
+/// boxcar `sin(theta N/2)/(N sin(theta/2)) sin(phi + theta (N-1)/2)`; Hann from
+/// `w_n = 1/2 - (e^{j b (n+1/2)} + e^{-j b (n+1/2)})/4`, `b = 2 pi/N`, `sum w = N/2`.
+fn leak_closed_forms(theta: f64, phi: f64, n: u64) -> (f64, f64) {
+    let nf = n as f64;
+    let boxcar = (theta * nf / 2.0).sin() / (nf * (theta / 2.0).sin())
+        * (phi + theta * (nf - 1.0) / 2.0).sin();
+    let b = TAU / nf;
+    let sw = geometric(theta, n) * 0.5
+        - Complex64::from_polar(0.25, b / 2.0) * geometric(theta + b, n)
+        - Complex64::from_polar(0.25, -b / 2.0) * geometric(theta - b, n);
+    let hann = (Complex64::from_polar(1.0, phi) * sw).im / (nf / 2.0);
+    (boxcar, hann)
+}
+
+#[test]
+fn hann_over_10_3_modulation_periods_leaks_below_1e_4_and_less_than_boxcar() {
+    // Stage 2 leaves a 2 Omega term: over T = 10.3 modulation periods it spans 20.6 periods.
+    let (f_mod, fs) = (10.0, 1e5);
+    let n: u64 = 103_000; // 10.3 periods of 10 Hz at 100 kS/s
+    let f = 2.0 * f_mod;
+    let theta = TAU * f / fs;
+    let mut worst_hann: f64 = 0.0;
+    let mut worst_box: f64 = 0.0;
+    for phi in [0.0, 0.4, 1.1, 2.0, 2.9] {
+        let mut bx = Averager::<f64>::new(Window::Boxcar, n).unwrap();
+        let mut hn = Averager::<f64>::new(Window::Hann, n).unwrap();
+        let (sp, cp) = (f64::sin(phi), f64::cos(phi));
+        for i in 0..n {
+            let (s, c) = sin_cos_turns(turns(f, fs, i));
+            let x = s * cp + c * sp; // sin(theta i + phi)
+            bx.push(x);
+            hn.push(x);
+        }
+        let (box_cf, hann_cf) = leak_closed_forms(theta, phi, n);
+        assert!(
+            (bx.mean() - box_cf).abs() < 1e-12,
+            "boxcar {} vs closed form {box_cf}",
+            bx.mean()
+        );
+        assert!(
+            (hn.mean() - hann_cf).abs() < 1e-12,
+            "hann {} vs closed form {hann_cf}",
+            hn.mean()
+        );
+        worst_hann = worst_hann.max(hn.mean().abs());
+        worst_box = worst_box.max(bx.mean().abs());
+    }
+    // envelopes: boxcar |sin(pi m)|/(pi m), Hann |sin(pi m)| / (pi m (m^2 - 1)) at m = 20.6
+    let m = 20.6;
+    eprintln!(
+        "10.3 periods: boxcar leak {worst_box:e} (envelope {:e}), Hann leak {worst_hann:e} (envelope {:e})",
+        (PI * m).sin().abs() / (PI * m),
+        (PI * m).sin().abs() / (PI * m * (m * m - 1.0))
+    );
+    assert!(worst_hann < 1e-4);
+    assert!(worst_box > 10.0 * worst_hann);
+    assert!(worst_box <= (PI * m).sin().abs() / (PI * m) * 1.001);
+}
+
+#[test]
+fn hann_leak_of_a_tone_over_10_3_of_its_own_periods_follows_its_envelope() {
+    // For the tone itself (m = 10.3) the Hann leak is ~2.4e-4: the 1e-4 target needs the 2 Omega
+    // reading above. Check measured == discrete closed form ~ continuous envelope.
+    let (f, fs, n) = (10.0, 1e5, 103_000u64);
+    let theta = TAU * f / fs;
+    let mut worst: f64 = 0.0;
+    for k in 0..16 {
+        let phi = k as f64 * PI / 16.0;
+        let mut hn = Averager::<f64>::new(Window::Hann, n).unwrap();
+        for i in 0..n {
+            let (s, c) = sin_cos_turns(turns(f, fs, i));
+            hn.push(s * phi.cos() + c * phi.sin());
+        }
+        assert!((hn.mean() - leak_closed_forms(theta, phi, n).1).abs() < 1e-12);
+        worst = worst.max(hn.mean().abs());
+    }
+    let m = 10.3;
+    let envelope = (PI * m).sin().abs() / (PI * m * (m * m - 1.0));
+    eprintln!("tone over 10.3 periods: Hann leak {worst:e}, envelope {envelope:e}");
+    assert!((worst / envelope - 1.0).abs() < 0.02);
+}
+
+#[test]
+fn hann_mean_of_a_constant_is_the_constant_and_lanes_equal_scalar() {
+    let n = 12_345u64;
+    let xs: Vec<Vec<f64>> = (0..4)
+        .map(|l| common::noise(n as usize, 1.0 + l as f64, 40 + l as u64))
+        .collect();
+    for window in [Window::Boxcar, Window::Hann] {
+        let mut k = Averager::<f64>::new(window, n).unwrap();
+        for _ in 0..n {
+            k.push(0.3);
+        }
+        assert!((k.mean() - 0.3).abs() < 1e-15, "{window:?}: {}", k.mean());
+        let mut v = Averager::<f64x4>::new(window, n).unwrap();
+        (0..n as usize).for_each(|i| v.push(f64x4::from_fn(|l| xs[l][i])));
+        for (l, x) in xs.iter().enumerate() {
+            let mut s = Averager::<f64>::new(window, n).unwrap();
+            for &xi in x {
+                s.push(xi);
+            }
+            assert_eq!(s.mean().to_bits(), v.mean().lane(l).to_bits());
+            let m1 = s.mean();
+            s.reset();
+            assert_eq!(s.count(), 0);
+            for &xi in x {
+                s.push(xi);
+            }
+            assert_eq!(s.mean().to_bits(), m1.to_bits());
+        }
+    }
+    let mut ks = KahanSum::<f64x4>::new();
+    let mut k1 = KahanSum::<f64>::new();
+    for &x in &xs[2] {
+        ks.add(f64x4::splat(x));
+        k1.add(x);
+    }
+    assert_eq!(ks.value().lane(3).to_bits(), k1.value().to_bits());
+}

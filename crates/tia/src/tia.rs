@@ -1,0 +1,239 @@
+//! The TIA stage: `y[n] = a y[n-1] + (1 - a) G x[n]`, then clamped to the rails.
+
+use gyroemu_core::detmath::sin_cos_turns;
+use gyroemu_core::error::positive;
+use gyroemu_core::{Complex64, ParamError, ParamResult, Response, Sample, Stage};
+
+const STAGE: &str = "tia";
+
+/// Parameters of a transimpedance amplifier.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TiaParams {
+    /// Transimpedance `R` in ohm (V per A at DC), finite and > 0.
+    pub gain_ohm: f64,
+    /// Feedback pole `1 / (2 pi R C)` in Hz, `0 < pole < fs/2`; `None` for an ideal wide-band TIA.
+    pub pole_hz: Option<f64>,
+    /// True for the usual inverting topology (DC gain `-R`).
+    pub inverting: bool,
+    /// Output swing: the output saturates at `+-rail_v` volts; `None` for no rails.
+    pub rail_v: Option<f64>,
+    /// Sample rate in Hz.
+    pub fs_hz: f64,
+}
+
+/// A one-pole transimpedance amplifier with saturating output.
+///
+/// Discretisation: `y[n] = a y[n-1] + (1 - a) G x[n]` with `a = exp(-2 pi pole / fs)` and
+/// `G = -R` when inverting (`a = 0`, i.e. `y = G x`, without a pole). The pole matches the
+/// continuous one exactly (matched z); the current sample enters without delay, so the
+/// discrete response leads `G / (1 + j f/pole)` by about half a sample (`exp(j pi f/fs)`).
+///
+/// Rails: the output stage of a real TIA saturates, and the feedback capacitor, which sits
+/// between the output and the virtual ground, then holds the saturated output voltage. So the
+/// output *and* the state (the capacitor voltage, which is the same number here) are clamped
+/// to `+-rail`. Recovery after overload is therefore immediate (no integrator wind-up): once
+/// the input current returns in range the output decays from the rail with the pole's time
+/// constant.
+#[derive(Clone, Debug)]
+pub struct Tia<S> {
+    a: S,
+    b: S,
+    lo: S,
+    hi: S,
+    y: S,
+    a_f64: f64,
+    b_f64: f64,
+    g_f64: f64,
+    pole_hz: Option<f64>,
+    fs_hz: f64,
+}
+
+impl<S: Sample> Tia<S> {
+    /// Builds the TIA; every parameter is checked (stage `"tia"`).
+    pub fn new(p: &TiaParams) -> ParamResult<Self> {
+        let fs = positive(STAGE, "fs_hz", p.fs_hz)?;
+        let r = positive(STAGE, "gain_ohm", p.gain_ohm)?;
+        let a = match p.pole_hz {
+            None => 0.0,
+            Some(f) => {
+                if !(f.is_finite() && f > 0.0 && f < 0.5 * fs) {
+                    return Err(ParamError::new(
+                        STAGE,
+                        "pole_hz",
+                        f,
+                        format!(
+                            "must be finite, > 0 and below Nyquist (fs/2 = {} Hz)",
+                            0.5 * fs
+                        ),
+                    ));
+                }
+                // The pole is a design value: std exp is fine (it does not feed the signal
+                // path except through this one constant).
+                (-core::f64::consts::TAU * f / fs).exp()
+            }
+        };
+        let rail = match p.rail_v {
+            None => f64::INFINITY,
+            Some(v) => positive(STAGE, "rail_v", v)?,
+        };
+        let g = if p.inverting { -r } else { r };
+        let b = (1.0 - a) * g;
+        Ok(Self {
+            a: S::splat(a),
+            b: S::splat(b),
+            lo: S::splat(-rail),
+            hi: S::splat(rail),
+            y: S::default(),
+            a_f64: a,
+            b_f64: b,
+            g_f64: g,
+            pole_hz: p.pole_hz,
+            fs_hz: fs,
+        })
+    }
+}
+
+impl Tia<f64> {
+    /// The continuous-time prototype `G / (1 + j f/pole)` (or `G` without a pole), for
+    /// comparing the discretisation with the analogue circuit.
+    pub fn continuous_response(&self, f_hz: f64) -> Complex64 {
+        match self.pole_hz {
+            None => Complex64::new(self.g_f64, 0.0),
+            Some(p) => Complex64::new(self.g_f64, 0.0) / Complex64::new(1.0, f_hz / p),
+        }
+    }
+}
+
+impl<S: Sample> Stage for Tia<S> {
+    type Input = S;
+    type Output = S;
+
+    #[inline]
+    fn tick(&mut self, x: S) -> S {
+        let y = (self.a * self.y + self.b * x).clamp_to(self.lo, self.hi);
+        self.y = y;
+        y
+    }
+
+    fn reset(&mut self) {
+        self.y = S::default();
+    }
+
+    /// DC group delay of `1 / (1 - a z^-1)`: `a / (1 - a)` samples.
+    fn latency_samples(&self) -> f64 {
+        self.a_f64 / (1.0 - self.a_f64)
+    }
+}
+
+impl<S: Sample> Response for Tia<S> {
+    /// `G (1 - a) / (1 - a e^{-j 2 pi f/fs})`, exact for the stage as built (rails ignored).
+    fn response(&self, f_hz: f64) -> Complex64 {
+        let (s, c) = sin_cos_turns(f_hz / self.fs_hz);
+        let den = Complex64::new(1.0 - self.a_f64 * c, self.a_f64 * s);
+        Complex64::new(self.b_f64, 0.0) / den
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn params() -> TiaParams {
+        TiaParams {
+            gain_ohm: 1e5,
+            pole_hz: Some(1e4),
+            inverting: true,
+            rail_v: Some(2.5),
+            fs_hz: 1e6,
+        }
+    }
+
+    #[test]
+    fn rejects_bad_parameters_naming_them() {
+        let bad = [
+            (
+                TiaParams {
+                    gain_ohm: 0.0,
+                    ..params()
+                },
+                "gain_ohm",
+            ),
+            (
+                TiaParams {
+                    gain_ohm: f64::NAN,
+                    ..params()
+                },
+                "gain_ohm",
+            ),
+            (
+                TiaParams {
+                    pole_hz: Some(5e5),
+                    ..params()
+                },
+                "pole_hz",
+            ),
+            (
+                TiaParams {
+                    pole_hz: Some(-1.0),
+                    ..params()
+                },
+                "pole_hz",
+            ),
+            (
+                TiaParams {
+                    pole_hz: Some(f64::INFINITY),
+                    ..params()
+                },
+                "pole_hz",
+            ),
+            (
+                TiaParams {
+                    rail_v: Some(0.0),
+                    ..params()
+                },
+                "rail_v",
+            ),
+            (
+                TiaParams {
+                    rail_v: Some(f64::NAN),
+                    ..params()
+                },
+                "rail_v",
+            ),
+            (
+                TiaParams {
+                    fs_hz: f64::NAN,
+                    ..params()
+                },
+                "fs_hz",
+            ),
+            (
+                TiaParams {
+                    fs_hz: -1.0,
+                    ..params()
+                },
+                "fs_hz",
+            ),
+        ];
+        for (p, name) in bad {
+            let e = Tia::<f64>::new(&p).unwrap_err();
+            assert_eq!((e.stage, e.param), ("tia", name), "{e}");
+        }
+        assert!(Tia::<f64>::new(&params()).is_ok());
+        let no_pole = TiaParams {
+            pole_hz: None,
+            rail_v: None,
+            ..params()
+        };
+        assert!(Tia::<f64>::new(&no_pole).is_ok());
+    }
+
+    #[test]
+    fn latency_is_the_phase_slope_at_dc() {
+        let t = Tia::<f64>::new(&params()).unwrap();
+        let df = 1e-3;
+        let slope =
+            -(t.response(df) / t.response(-df)).arg() / (2.0 * core::f64::consts::TAU * df / 1e6);
+        assert!((slope - t.latency_samples()).abs() < 1e-6 * t.latency_samples());
+    }
+}
