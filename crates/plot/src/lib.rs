@@ -1,1 +1,17 @@
-//! Paper-style PNG figures with a bundled font (no system fontconfig)
+//! Paper-style PNG figures with a bundled font (no system fontconfig).
+//!
+//! Figures are drawn with plotters' bitmap backend; all text uses DejaVu Sans compiled into the
+//! binary (registered with plotters' ab_glyph loader), so rendering works on a bare machine.
+//! Files are written atomically through `gyroemu-io`.
+
+mod axis;
+mod error;
+mod figure;
+mod font;
+mod render;
+
+pub use axis::{finite_bounds, AxisScale, MARGIN_FRACTION};
+pub use error::PlotError;
+pub use figure::{Figure, Series, SeriesStyle, PALETTE};
+pub use font::{ensure_font, FONT_FAMILY};
+pub use render::{render_panels_png, render_png, render_rgb, MAX_SIDE_PX, MIN_SIDE_PX};

@@ -1,0 +1,109 @@
+//! Atomic replacement of a file: write a hidden temporary sibling, sync it, rename it over the
+//! target. Readers never see a half-written file, and a failed write leaves the target untouched.
+
+use crate::IoError;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use tempfile::NamedTempFile;
+
+/// Directory and file name of `path` (a bare name lives in `.`).
+fn split(path: &Path) -> Result<(PathBuf, String), IoError> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| IoError::NoFileName {
+            path: path.to_path_buf(),
+        })?
+        .to_string_lossy()
+        .into_owned();
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    Ok((dir, name))
+}
+
+/// Creates `.<name>.tmpXXXXXX<suffix>` in the target's directory (same filesystem, so the final
+/// rename is atomic). The temp file is deleted on drop unless persisted.
+fn temp_sibling(path: &Path, suffix: &str) -> Result<NamedTempFile, IoError> {
+    let (dir, name) = split(path)?;
+    tempfile::Builder::new()
+        .prefix(&format!(".{name}.tmp"))
+        .suffix(suffix)
+        .tempfile_in(&dir)
+        .map_err(|source| IoError::TempCreate {
+            path: path.to_path_buf(),
+            source,
+        })
+}
+
+/// Syncs the temporary file's content to disk, renames it onto `path`, then (Unix) syncs the
+/// directory so the rename itself survives a crash.
+fn persist(tmp: NamedTempFile, path: &Path) -> Result<(), IoError> {
+    let write_err = |source| IoError::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    // Re-open by path: a producer may have recreated the file instead of writing our handle.
+    File::open(tmp.path())
+        .and_then(|f| f.sync_all())
+        .map_err(write_err)?;
+    tmp.persist(path).map_err(|e| IoError::Persist {
+        path: path.to_path_buf(),
+        source: e.error,
+    })?;
+    #[cfg(unix)]
+    if let Ok((dir, _)) = split(path) {
+        // Best effort: some filesystems refuse fsync on directories.
+        let _ = File::open(dir).and_then(|d| d.sync_all());
+    }
+    Ok(())
+}
+
+/// Streams into a temporary sibling of `path` through a buffered writer, then atomically
+/// replaces `path`. Used by every writer of this crate.
+pub(crate) fn atomic_stream<F>(path: &Path, fill: F) -> Result<(), IoError>
+where
+    F: FnOnce(&mut BufWriter<&mut File>) -> Result<(), IoError>,
+{
+    let mut tmp = temp_sibling(path, "")?;
+    {
+        let mut w = BufWriter::new(tmp.as_file_mut());
+        fill(&mut w)?;
+        w.flush().map_err(|source| IoError::Write {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    }
+    persist(tmp, path)
+}
+
+/// Atomically replaces `path` with `bytes` (temp sibling, flush, fsync, rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
+    atomic_stream(path, |w| {
+        w.write_all(bytes).map_err(|source| IoError::Write {
+            path: path.to_path_buf(),
+            source,
+        })
+    })
+}
+
+/// Atomically produces `path` with a tool that insists on writing to a path itself (e.g. an image
+/// encoder). `produce` receives the temporary sibling's path, which keeps the target's extension
+/// so format detection by extension works; on success the file is synced and renamed onto
+/// `path`, on failure it is deleted and `path` is left untouched.
+pub fn write_atomic_via<F>(path: &Path, produce: F) -> Result<(), IoError>
+where
+    F: FnOnce(&Path) -> Result<(), Box<dyn std::error::Error + Send + Sync>>,
+{
+    let suffix = path
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
+    let tmp = temp_sibling(path, &suffix)?;
+    produce(tmp.path()).map_err(|source| IoError::Producer {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    persist(tmp, path)
+}

@@ -1,0 +1,134 @@
+//! Windowed signal dump for the per-sample loop: keeps only frames whose sample index falls in
+//! a window, so memory is bounded by the window and not by the run length.
+
+use crate::atomic::atomic_stream;
+use crate::csv_table::CsvSink;
+use crate::wav::{check_wav_f32_size, write_interleaved};
+use crate::IoError;
+use std::path::Path;
+
+/// Records frames of `names.len()` channels for sample indices `n` in `[start, start + len)`.
+#[derive(Clone, Debug)]
+pub struct SignalRecorder {
+    names: Vec<String>,
+    fs_hz: f64,
+    start: u64,
+    len: u64,
+    /// Interleaved frames, `data.len() / names.len()` of them; capacity reserved up front.
+    data: Vec<f64>,
+}
+
+impl SignalRecorder {
+    /// A recorder for channels `names`, sampled at `fs_hz`, keeping sample indices
+    /// `[start_sample, start_sample + len_samples)`. Reserves `len_samples * names.len()` floats
+    /// now so that [`record`](Self::record) never allocates (panics like `Vec::with_capacity`
+    /// if that does not fit in memory).
+    pub fn new(names: Vec<String>, fs_hz: f64, start_sample: u64, len_samples: u64) -> Self {
+        // A window running past u64::MAX would make `wants` wrap around to index 0: clip it.
+        let len = len_samples.min((u64::MAX - start_sample).saturating_add(1));
+        let cap = usize::try_from(len)
+            .ok()
+            .and_then(|l| l.checked_mul(names.len()))
+            .expect("SignalRecorder window len_samples * channels overflows usize");
+        SignalRecorder {
+            names,
+            fs_hz,
+            start: start_sample,
+            len,
+            data: Vec::with_capacity(cap),
+        }
+    }
+
+    /// True when sample index `n` lies in the window (one subtraction and one compare).
+    #[inline]
+    pub fn wants(&self, n: u64) -> bool {
+        n.wrapping_sub(self.start) < self.len
+    }
+
+    /// Stores `frame` (one value per channel) as sample `n`; no-op outside the window, never
+    /// allocates. Frames normally arrive in order; a skipped index is filled with NaN, a repeated
+    /// one overwrites. Missing channels of a short frame are NaN, extra values are ignored.
+    #[inline]
+    pub fn record(&mut self, n: u64, frame: &[f64]) {
+        if !self.wants(n) {
+            return;
+        }
+        let ch = self.names.len();
+        let at = (n - self.start) as usize * ch;
+        if at >= self.data.len() {
+            // Within the reserved capacity: these never reallocate.
+            self.data.resize(at + ch, f64::NAN);
+        }
+        let dst = &mut self.data[at..at + ch];
+        let m = ch.min(frame.len());
+        dst[..m].copy_from_slice(&frame[..m]);
+        dst[m..].fill(f64::NAN);
+    }
+
+    /// Channel names in column order.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// Number of frames held (highest recorded index - start + 1).
+    pub fn len(&self) -> usize {
+        if self.names.is_empty() {
+            0
+        } else {
+            self.data.len() / self.names.len()
+        }
+    }
+
+    /// True when nothing has been recorded yet.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// A copy of channel `k` over the recorded frames. Panics if `k >= names().len()`.
+    pub fn channel(&self, k: usize) -> Vec<f64> {
+        let ch = self.names.len();
+        assert!(k < ch, "channel {k} requested but the recorder has {ch}");
+        self.data.iter().skip(k).step_by(ch).copied().collect()
+    }
+
+    /// Writes `<dir>/<stem>.csv` (columns `sample`, `time_s`, then one per name; exact float
+    /// text) and `<dir>/<stem>.wav` (one 32-bit float channel per name at round(fs_hz) Hz),
+    /// both atomically. WAV values are the raw signals, not normalised, so they may exceed +-1:
+    /// read them with `soundfile.read(path)` or `scipy.io.wavfile.read(path)`, not an audio player.
+    /// The WAV size is checked before either file is written.
+    pub fn write(&self, dir: &Path, stem: &str) -> Result<(), IoError> {
+        let csv_path = dir.join(format!("{stem}.csv"));
+        let wav_path = dir.join(format!("{stem}.wav"));
+        let rate = self.fs_hz.round();
+        if !(rate >= 1.0 && rate <= f64::from(u32::MAX)) {
+            return Err(IoError::WavInvalid {
+                path: wav_path,
+                reason: format!(
+                    "fs_hz = {} does not round to a WAV sample rate in 1..=2^32-1 Hz",
+                    self.fs_hz
+                ),
+            });
+        }
+        let rate = rate as u32;
+        let ch = self.names.len();
+        let frames = self.len();
+        check_wav_f32_size(&wav_path, rate, ch as u64, frames as u64)?;
+
+        let mut headers = vec!["sample".to_string(), "time_s".to_string()];
+        headers.extend(self.names.iter().cloned());
+        atomic_stream(&csv_path, |w| {
+            let mut sink = CsvSink::new(w, &csv_path, &headers)?;
+            for (i, frame) in self.data.chunks_exact(ch).enumerate() {
+                let n = self.start + i as u64;
+                sink.int(n as i64)?;
+                sink.f64(n as f64 / self.fs_hz)?;
+                for &x in frame {
+                    sink.f64(x)?;
+                }
+                sink.end_row()?;
+            }
+            sink.finish()
+        })?;
+        write_interleaved(&wav_path, rate, ch, frames, |i, k| self.data[i * ch + k])
+    }
+}

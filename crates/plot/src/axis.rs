@@ -1,0 +1,219 @@
+//! Axis ranges and tick labels that survive degenerate data and SI magnitudes.
+//!
+//! Data in SI units spans 1e-18 (F) to 1e6 (Hz). plotters' tick generator compares spans with
+//! `f64::EPSILON` in absolute terms, so such data is first scaled by a power of 1000 (shown as
+//! "×10⁻⁹" next to the axis, like matplotlib's offset text), then padded by 5 %.
+
+use plotters::coord::ranged1d::Ranged;
+use plotters::coord::types::RangedCoordf64;
+
+/// Fraction of the data span added on each side of the axis.
+pub const MARGIN_FRACTION: f64 = 0.05;
+
+/// One axis: plotted range in scaled units, the scale exponent and the tick label format.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AxisScale {
+    /// Lower end of the plotted range, in units of 10^`exp10`.
+    pub lo: f64,
+    /// Upper end, in units of 10^`exp10`.
+    pub hi: f64,
+    /// Data are divided by 10^`exp10` before plotting (a multiple of 3, 0 for ordinary magnitudes).
+    pub exp10: i32,
+    /// Decimals of every tick label (same for all ticks, as in printed figures).
+    pub decimals: usize,
+    factor: f64,
+}
+
+/// Smallest and largest finite value, or `None` if there is none.
+pub fn finite_bounds(vals: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
+    vals.into_iter()
+        .filter(|v| v.is_finite())
+        .fold(None, |acc, v| match acc {
+            None => Some((v, v)),
+            Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
+        })
+}
+
+/// Engineering exponent (multiple of 3) for the largest magnitude `m`; 0 when plain numbers read well.
+fn engineering_exponent(m: f64) -> i32 {
+    if m == 0.0 || (1e-2..1e6).contains(&m) {
+        0
+    } else {
+        (3.0 * (m.log10() / 3.0).floor()).clamp(-306.0, 306.0) as i32
+    }
+}
+
+impl AxisScale {
+    /// Axis for the finite values of `vals` with about `n_ticks` ticks: empty input gives
+    /// [0, 1]; a constant `v` gives `v ± 10 %` (± 1 for 0); spans too small for f64 ticks are widened.
+    pub fn from_values(vals: impl IntoIterator<Item = f64>, n_ticks: usize) -> Self {
+        let (lo, hi, exp10) = match finite_bounds(vals) {
+            None => (0.0, 1.0, 0),
+            Some((lo, hi)) => {
+                let e = engineering_exponent(lo.abs().max(hi.abs()));
+                let f = 10f64.powi(e);
+                let (mut lo, mut hi) = (lo / f, hi / f);
+                let mid = 0.5 * (lo + hi);
+                // Below ~1e-12 relative span the tick positions cannot be resolved in f64.
+                let min_span = mid.abs() * 1e-12;
+                if hi - lo <= min_span {
+                    let mut half = if mid != 0.0 { mid.abs() * 0.1 } else { 1.0 };
+                    if half < 1e-300 {
+                        half = 1.0;
+                    }
+                    lo = mid - half;
+                    hi = mid + half;
+                }
+                let pad = MARGIN_FRACTION * (hi - lo);
+                (lo - pad, hi + pad, e)
+            }
+        };
+        let ticks = RangedCoordf64::from(lo..hi).key_points(n_ticks.max(2));
+        let decimals = common_decimals(&ticks, hi - lo);
+        AxisScale {
+            lo,
+            hi,
+            exp10,
+            decimals,
+            factor: 10f64.powi(exp10),
+        }
+    }
+
+    /// Maps a data value to plotted (scaled) units.
+    #[inline]
+    pub fn map(&self, v: f64) -> f64 {
+        v / self.factor
+    }
+
+    /// Tick label for the scaled value `v`, never "-0".
+    pub fn label(&self, v: f64) -> String {
+        let s = format!("{:.*}", self.decimals, v);
+        match s.strip_prefix('-') {
+            Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
+            _ => s,
+        }
+    }
+
+    /// "×10ⁿ" to print beside the axis when the data were scaled, else `None`.
+    pub fn exponent_text(&self) -> Option<String> {
+        if self.exp10 == 0 {
+            return None;
+        }
+        const SUP: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+        let mut s = String::from("×10");
+        if self.exp10 < 0 {
+            s.push('⁻');
+        }
+        for d in self.exp10.unsigned_abs().to_string().bytes() {
+            s.push(SUP[(d - b'0') as usize]);
+        }
+        Some(s)
+    }
+}
+
+/// Fewest decimals (0..=12) that print every tick exactly to within 1e-6 of the tick spacing.
+fn common_decimals(ticks: &[f64], span: f64) -> usize {
+    let step = ticks
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(f64::INFINITY, f64::min);
+    let tol = if step.is_finite() && step > 0.0 {
+        step * 1e-6
+    } else {
+        span.abs() * 1e-6
+    };
+    (0..=12)
+        .find(|&d| {
+            ticks.iter().all(|&t| {
+                let r: f64 = format!("{t:.d$}").parse().unwrap_or(f64::NAN);
+                (r - t).abs() <= tol
+            })
+        })
+        .unwrap_or(12)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bounds_skip_non_finite() {
+        assert_eq!(
+            finite_bounds([f64::NAN, 2.0, f64::INFINITY, -1.0]),
+            Some((-1.0, 2.0))
+        );
+        assert_eq!(finite_bounds([f64::NAN]), None);
+        assert_eq!(finite_bounds(Vec::<f64>::new()), None);
+    }
+
+    #[test]
+    fn margins_are_five_percent() {
+        let a = AxisScale::from_values([0.0, 10.0], 8);
+        assert_eq!((a.lo, a.hi, a.exp10), (-0.5, 10.5, 0));
+    }
+
+    #[test]
+    fn degenerate_ranges_have_a_span() {
+        for v in [
+            vec![],
+            vec![f64::NAN],
+            vec![0.0],
+            vec![3.0, 3.0],
+            vec![-2e-12],
+            vec![f64::MAX],
+            vec![5e-324],
+        ] {
+            let a = AxisScale::from_values(v.clone(), 8);
+            assert!(
+                a.lo.is_finite() && a.hi.is_finite() && a.hi > a.lo,
+                "{v:?} -> {a:?}"
+            );
+            for x in v.iter().filter(|x| x.is_finite()) {
+                let m = a.map(*x);
+                assert!(a.lo <= m && m <= a.hi, "{x} -> {m} outside {a:?}");
+            }
+        }
+        let c = AxisScale::from_values([3.0], 8);
+        assert!(
+            (c.lo - 2.67).abs() < 1e-12 && (c.hi - 3.33).abs() < 1e-12,
+            "{c:?}"
+        );
+    }
+
+    #[test]
+    fn si_magnitudes_are_scaled_by_powers_of_1000() {
+        let a = AxisScale::from_values([1.2e-9, 4.5e-9], 8);
+        assert_eq!(a.exp10, -9);
+        assert_eq!(a.exponent_text().as_deref(), Some("×10⁻⁹"));
+        assert!((a.map(4.5e-9) - 4.5).abs() < 1e-12);
+        let b = AxisScale::from_values([0.0, 2.5e7], 8);
+        assert_eq!(b.exponent_text().as_deref(), Some("×10⁶"));
+        assert_eq!(
+            AxisScale::from_values([19_990.0, 20_010.0], 8).exponent_text(),
+            None
+        );
+    }
+
+    #[test]
+    fn tick_labels_share_decimals_and_never_show_minus_zero() {
+        let a = AxisScale::from_values([0.0, 1.0], 8);
+        let ticks = RangedCoordf64::from(a.lo..a.hi).key_points(8);
+        let labels: Vec<String> = ticks.iter().map(|&t| a.label(t)).collect();
+        let decs: Vec<usize> = labels
+            .iter()
+            .map(|l| l.split('.').nth(1).map_or(0, str::len))
+            .collect();
+        assert!(decs.windows(2).all(|w| w[0] == w[1]), "{labels:?}");
+        for (l, t) in labels.iter().zip(&ticks) {
+            assert!((l.parse::<f64>().unwrap() - t).abs() < 1e-9, "{l} vs {t}");
+        }
+        assert_eq!(
+            a.label(-1e-17),
+            if a.decimals == 0 {
+                "0".to_string()
+            } else {
+                format!("0.{}", "0".repeat(a.decimals))
+            }
+        );
+    }
+}
