@@ -105,6 +105,7 @@ impl Sample for f64x4 {
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
 

@@ -1,0 +1,156 @@
+//! The quantiser and the DAC: noise power, symmetry, idempotence, clipping, the hold's
+//! frequency response, parameter errors.
+
+use gyroemu_am::{Dac, Quantizer};
+use gyroemu_core::{Response, Stage};
+use num_complex::Complex64;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::f64::consts::{PI, TAU};
+
+/// A busy signal: three incommensurate tones, peak below 0.95 of full scale.
+fn busy(n: usize, full_scale: f64) -> impl Iterator<Item = f64> {
+    (0..n).map(move |i| {
+        let t = i as f64;
+        full_scale
+            * (0.45 * (TAU * 0.013_127_941_3 * t).sin()
+                + 0.3 * (TAU * 0.171_428_571_9 * t + 1.0).sin()
+                + 0.2 * (TAU * 0.031_622_776_6 * t + 2.0).cos())
+    })
+}
+
+#[test]
+fn noise_power_is_step_squared_over_twelve() {
+    for bits in [8u32, 12, 16, 24] {
+        let full_scale = 2.5;
+        let mut q = Quantizer::<f64>::new(bits, full_scale).unwrap();
+        assert_eq!(q.step(), 2.0 * full_scale / 2f64.powi(bits as i32));
+        let n = 1 << 20;
+        let mut sum = 0.0;
+        let mut worst: f64 = 0.0;
+        for x in busy(n, full_scale) {
+            let e = q.tick(x) - x;
+            worst = worst.max(e.abs());
+            sum += e * e;
+        }
+        let ratio = sum / n as f64 / (q.step() * q.step() / 12.0);
+        println!("{bits} bits: noise power / (step^2/12) = {ratio:.4}");
+        assert!((ratio - 1.0).abs() < 0.03, "{bits} bits: {ratio}");
+        assert!(worst <= 0.5 * q.step() * (1.0 + 1e-12));
+    }
+}
+
+#[test]
+fn odd_symmetric_idempotent_and_clipping() {
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    for bits in [2u32, 5, 12, 32] {
+        let fs = 1.7;
+        let q = Quantizer::<f64>::new(bits, fs).unwrap();
+        let step = q.step();
+        let top = fs - step; // largest level
+        for _ in 0..20_000 {
+            let x: f64 = rng.random_range(-1.5 * fs..1.5 * fs);
+            let y = q.quantize(x);
+            assert_eq!(q.quantize(y), y, "idempotent");
+            // On the level grid: y / step is an integer code (to rounding).
+            let code = y / step;
+            assert!((code - code.round()).abs() < 1e-6);
+            assert!((-fs..=top).contains(&y));
+            if x.abs() <= top {
+                assert_eq!(q.quantize(-x), -y, "odd symmetry at {x}");
+                assert!((y - x).abs() <= 0.5 * step * (1.0 + 1e-12));
+            }
+            if x >= top + 0.5 * step {
+                assert_eq!(y, top);
+            }
+            if x <= -fs {
+                assert_eq!(y, -fs);
+            }
+        }
+        assert_eq!(q.quantize(0.0), 0.0); // mid-tread: zero is a level
+        assert_eq!(q.quantize(0.49 * step), 0.0);
+        assert_eq!(q.quantize(1e9), top);
+        assert_eq!(q.quantize(-1e9), -fs);
+    }
+}
+
+#[test]
+fn dac_hold_response_matches_the_hold_integral() {
+    let fs = 1e6;
+    let dac = Dac::<f64>::new(fs, None).unwrap();
+    let ts = 1.0 / fs;
+    for f in [
+        0.0, 1.0, 15_000.0, 123_456.7, 499_999.0, -300_000.0, 1.3e6, 2.0e6,
+    ] {
+        let h = dac.response(f);
+        // (1/Ts) * integral_0^Ts e^{-j 2 pi f t} dt, the hold's average, by 20 000-point
+        // midpoint rule, which is exact enough here (error ~ (2 pi f Ts / M)^2 / 24).
+        let m = 20_000;
+        let mut acc = Complex64::new(0.0, 0.0);
+        for i in 0..m {
+            let t = (i as f64 + 0.5) / m as f64 * ts;
+            acc += Complex64::from_polar(1.0, -TAU * f * t);
+        }
+        let want = acc / m as f64;
+        assert!((h - want).norm() < 1e-7, "f = {f}: {h} vs {want}");
+        // And the closed form (1 - e^{-j w Ts}) / (j w Ts)
+        if f != 0.0 {
+            let w = TAU * f * ts;
+            let cf = (Complex64::new(1.0, 0.0) - Complex64::from_polar(1.0, -w))
+                / Complex64::new(0.0, w);
+            // (the closed form cancels at small w, losing ~1e-16 / w)
+            assert!((h - cf).norm() < 1e-13 + 1e-15 / w.abs(), "f = {f}");
+        }
+    }
+    assert_eq!(dac.response(0.0), Complex64::new(1.0, 0.0));
+    assert!(dac.response(fs).norm() < 1e-16); // null at fs
+                                              // Group delay at DC: -d arg H / d omega = Ts/2, i.e. latency_samples().
+    let df = 1.0;
+    let gd = -(dac.response(df).arg() - dac.response(-df).arg()) / (TAU * 2.0 * df) * fs;
+    assert!((gd - dac.latency_samples()).abs() < 1e-9);
+    assert_eq!(dac.latency_samples(), 0.5);
+    // Gain at a 16-samples-per-period carrier: sinc(1/16).
+    let g = dac.response(fs / 16.0).norm();
+    assert!((g - (PI / 16.0).sin() / (PI / 16.0)).abs() < 1e-15);
+}
+
+#[test]
+fn dac_quantises_or_passes_through() {
+    let mut ideal = Dac::<f64>::new(1e6, None).unwrap();
+    let mut real = Dac::<f64>::new(1e6, Some((12, 1.0))).unwrap();
+    let q = Quantizer::<f64>::new(12, 1.0).unwrap();
+    assert!(ideal.quantizer().is_none());
+    assert_eq!(real.quantizer().map(|q| q.bits()), Some(12));
+    for x in busy(10_000, 1.0) {
+        assert_eq!(ideal.tick(x), x);
+        assert_eq!(real.tick(x), q.quantize(x));
+    }
+    assert_eq!(real.fs_hz(), 1e6);
+}
+
+#[test]
+fn bad_parameters_are_refused() {
+    for (bits, fs) in [
+        (1, 1.0),
+        (33, 1.0),
+        (0, 1.0),
+        (12, 0.0),
+        (12, -1.0),
+        (12, f64::NAN),
+    ] {
+        let e = Quantizer::<f64>::new(bits, fs).unwrap_err();
+        assert_eq!(e.stage, "quantizer");
+        let e2 = Dac::<f64>::new(1e6, Some((bits, fs))).unwrap_err();
+        assert_eq!(e2, e);
+    }
+    assert_eq!(Quantizer::<f64>::new(1, 1.0).unwrap_err().param, "bits");
+    assert_eq!(
+        Quantizer::<f64>::new(8, 0.0).unwrap_err().param,
+        "full_scale"
+    );
+    for fs in [0.0, -1.0, f64::INFINITY, f64::NAN] {
+        let e = Dac::<f64>::new(fs, None).unwrap_err();
+        assert_eq!((e.stage, e.param), ("dac", "fs_hz"));
+    }
+    assert!(Quantizer::<f64>::new(2, 1.0).is_ok() && Quantizer::<f64>::new(32, 1.0).is_ok());
+}

@@ -1,0 +1,89 @@
+//! Stage invariants (process on random chunkings == tick, reset), parameter errors and the
+//! phase shifter.
+
+use gyroemu_core::Stage;
+use gyroemu_nco::{Nco, PhaseShifter};
+use num_complex::Complex64;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::f64::consts::{FRAC_PI_2, TAU};
+
+#[test]
+fn process_on_random_chunks_equals_tick_and_reset_reproduces() {
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mut a = Nco::new(-31_415.926_535, 1e6, 2.5).unwrap();
+    let mut b = a.clone();
+    let n = 100_000;
+    let want: Vec<Complex64> = (0..n).map(|_| a.tick(())).collect();
+    let mut got = vec![Complex64::new(0.0, 0.0); n];
+    let mut i = 0;
+    while i < n {
+        let len = rng.random_range(0..300).min(n - i);
+        b.process(&vec![(); len], &mut got[i..i + len]);
+        i += len;
+    }
+    assert!(want.iter().zip(&got).all(|(x, y)| x == y));
+    a.reset();
+    let again: Vec<Complex64> = (0..n).map(|_| a.tick(())).collect();
+    assert_eq!(want, again);
+    assert_eq!(a.latency_samples(), 0.0);
+}
+
+#[test]
+fn start_phase_and_phasor_without_advance() {
+    let nco = Nco::new(1000.0, 48_000.0, 1.0).unwrap();
+    assert!((nco.phase_rad() - 1.0).abs() < 1e-15);
+    let p = nco.phasor();
+    assert!((p - Complex64::new(1f64.cos(), 1f64.sin())).norm() < 1e-15);
+    assert_eq!(nco.phasor(), p);
+    let neg = Nco::new(0.0, 1.0, -FRAC_PI_2).unwrap();
+    assert_eq!(neg.phase_word(), 3 << 62);
+}
+
+#[test]
+fn bad_parameters_are_refused() {
+    let nyq = Nco::new(500.0, 1000.0, 0.0).unwrap_err();
+    assert_eq!((nyq.stage, nyq.param), ("nco", "f_hz"));
+    assert!(Nco::new(-500.0, 1000.0, 0.0).is_err());
+    assert!(Nco::new(600.0, 1000.0, 0.0).is_err());
+    assert!(Nco::new(f64::NAN, 1000.0, 0.0).is_err());
+    assert!(Nco::new(f64::INFINITY, 1000.0, 0.0).is_err());
+    for fs in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let e = Nco::new(1.0, fs, 0.0).unwrap_err();
+        assert_eq!(e.param, "fs_hz");
+    }
+    let e = Nco::new(1.0, 1000.0, f64::NAN).unwrap_err();
+    assert_eq!(e.param, "phase_rad");
+    assert!(Nco::new(499.999_999, 1000.0, 0.0).is_ok());
+    assert!(Nco::new(0.0, 1000.0, 0.0).is_ok());
+    let e = PhaseShifter::new(f64::NAN).unwrap_err();
+    assert_eq!((e.stage, e.param), ("phase_shifter", "shift_rad"));
+}
+
+#[test]
+fn quadrature_shifter_turns_cos_into_sin_exactly() {
+    let q = PhaseShifter::quadrature();
+    let mut nco = Nco::new(15_000.123, 1e6, 0.4).unwrap();
+    for _ in 0..100_000 {
+        let p = nco.tick(());
+        let y = q.apply(p);
+        assert_eq!(y.re, p.im); // Re(out) = sin(phi), bit for bit
+        assert_eq!(y.im, -p.re);
+    }
+}
+
+#[test]
+fn general_shift_matches_closed_form() {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    for _ in 0..1000 {
+        let shift = rng.random_range(-20.0..20.0);
+        let phi = rng.random_range(0.0..TAU);
+        let mut s = PhaseShifter::new(shift).unwrap();
+        let y = s.tick(Complex64::new(phi.cos(), phi.sin()));
+        assert!((y.re - (phi - shift).cos()).abs() < 1e-14);
+        assert!((y.im - (phi - shift).sin()).abs() < 1e-14);
+        s.reset();
+    }
+    let nominal = PhaseShifter::new(FRAC_PI_2).unwrap();
+    assert!((nominal.rotation() - PhaseShifter::quadrature().rotation()).norm() < 1e-16);
+}
