@@ -1,1 +1,16 @@
-//! Experiment layer: configs, the board assembled from the stages, Coriolis and rotating sweeps, theory overlays
+//! The experiment layer of gyroemu: the config, the board assembled from the stage crates and
+//! run sample by sample, the Coriolis and rotating-excitation sweeps, and the exact theory
+//! that the figures overlay.
+
+pub mod board;
+pub mod config;
+pub mod fit;
+pub mod presets;
+pub mod probe;
+pub mod sweep;
+pub mod theory;
+pub mod validate;
+
+pub use config::{Config, ExperimentKind, RateTable, WindowKind};
+pub use sweep::{run_sweep, PointResult, SweepError, SweepResult};
+pub use validate::{parse_config, ConfigError};
