@@ -1,1 +1,86 @@
-fn main() {}
+//! `gyroemu`: emulate a MEMS gyroscope readout board sample by sample and reproduce the
+//! figures of Casinovi et al., "Electrostatic Self-Calibration of Vibratory Gyroscopes"
+//! (MEMS 2012).
+
+mod commands;
+mod progress;
+mod report;
+mod reproduce;
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "gyroemu",
+    version,
+    about = "Sample-level emulator of a MEMS gyroscope readout board and its electrostatic self-calibration"
+)]
+struct Cli {
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long, global = true)]
+    threads: Option<usize>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Reproduce Figs. 4, 5, 6, 8 and 9 on the embedded default configs.
+    Reproduce {
+        /// Output folder.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Shorten the averaging (Fig. 9: 15 s instead of 500 s) for a fast look.
+        #[arg(long)]
+        quick: bool,
+    },
+    /// Run one experiment described by a TOML config.
+    Run {
+        /// The config file (see `gyroemu config`).
+        config: PathBuf,
+        /// Output folder.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+    },
+    /// Print a complete, commented config that `run` accepts.
+    Config {
+        /// Preset name (default: m2tfg-coriolis); `--list` shows them.
+        #[arg(long)]
+        preset: Option<String>,
+        /// List the presets.
+        #[arg(long)]
+        list: bool,
+    },
+}
+
+/// Exit code for a config or usage the emulator refuses.
+pub const EXIT_BAD_INPUT: u8 = 2;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    if let Some(t) = cli.threads {
+        if t == 0 {
+            eprintln!("error: --threads = 0: must be at least 1");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+        // Only fails when a pool exists already, which cannot happen this early.
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build_global();
+    }
+    let result = match cli.command {
+        Command::Reproduce { out, quick } => reproduce::reproduce(&out, quick),
+        Command::Run { config, out } => commands::run(&config, &out),
+        Command::Config { preset, list } => commands::config(preset.as_deref(), list),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            let bad_input = e.downcast_ref::<commands::BadInput>().is_some();
+            ExitCode::from(if bad_input { EXIT_BAD_INPUT } else { 1 })
+        }
+    }
+}
