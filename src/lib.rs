@@ -7,6 +7,7 @@
 pub use gyroemu_am as am;
 pub use gyroemu_core as core;
 pub use gyroemu_core::{Complex64, ParamError, Response, Sample, Stage};
+pub use gyroemu_experiment as experiment;
 pub use gyroemu_lpf as lpf;
 pub use gyroemu_mixer as mixer;
 pub use gyroemu_nco as nco;

@@ -1,0 +1,69 @@
+//! Shared helpers of the accuracy tests: the closed forms of THEORY.md written out again here,
+//! independently of `gyroemu::experiment::theory`, and small config builders.
+#![allow(dead_code)]
+
+use gyroemu::experiment::{parse_config, run_sweep, Config, SweepResult};
+use std::f64::consts::PI;
+
+pub const DEG: f64 = PI / 180.0;
+
+/// THEORY.md eqs. 2-3, in degrees.
+pub fn theta_deg(f0: f64, q: f64, lambda: f64, f1: f64, f2: f64, rate_dps: f64) -> [f64; 2] {
+    let x = 2.0 * q * lambda * rate_dps * DEG / (2.0 * PI * f0);
+    [(x * f2 / f1).atan() / DEG, (x * f1 / f2).atan() / DEG]
+}
+
+/// THEORY.md section 4, exact plant psi (major-axis estimator), degrees.
+pub fn psi_deg(f0: f64, q: f64, rate_dps: f64) -> f64 {
+    let w0 = 2.0 * PI * f0;
+    let w = rate_dps * DEG;
+    let dp = (q * w * (2.0 * w0 + w) / (w0 * (w0 + w))).atan();
+    let dm = (q * w * (2.0 * w0 - w) / (w0 * (w0 - w))).atan();
+    0.5 * (dp + dm) / DEG
+}
+
+/// A config for the M^2-TFG-like board with the given device and sweep.
+#[allow(clippy::too_many_arguments)]
+pub fn config(
+    kind: &str,
+    f0: f64,
+    q: f64,
+    lambda: f64,
+    f2_over_f1: f64,
+    rates: &[f64],
+    average_s: f64,
+) -> Config {
+    let (fs, pole, cutoff, dec) = if f0 > 1e6 {
+        (16.0 * f0, 4.0 * f0, 2000.0, 2000)
+    } else {
+        (16.0 * f0, 4.0 * f0, 200.0, 100)
+    };
+    let text = format!(
+        r#"
+[device]
+f0_hz = {f0}
+q = {q}
+angular_gain = {lambda}
+[drive]
+f1 = 1.0
+f2 = {f2_over_f1}
+[board]
+fs_hz = {fs}
+tia_pole_hz = {pole}
+lpf_cutoff_hz = {cutoff}
+decimation = {dec}
+[experiment]
+kind = "{kind}"
+rates_dps = {rates:?}
+average_s = {average_s}
+"#
+    );
+    let cfg = parse_config(&text).expect("test config parses");
+    cfg.validate().expect("test config validates");
+    cfg
+}
+
+/// Runs a sweep with no progress output.
+pub fn run(cfg: &Config) -> SweepResult {
+    run_sweep(cfg, &|_, _| {}, None).expect("sweep runs")
+}
