@@ -137,12 +137,21 @@ pub fn sweep_figure(cfg: &Config, r: &SweepResult, title: &str) -> Figure {
     for k in 0..2 {
         fig = fig.with(Series {
             name: format!("mode {} emulated", k + 1),
-            style: SeriesStyle::Points,
+            style: if k == 0 {
+                SeriesStyle::Points
+            } else {
+                SeriesStyle::OpenPoints
+            },
             xs: xs.clone(),
             ys: r.points.iter().map(|p| p.phase_deg[k]).collect(),
         });
     }
-    fig = fig.with(theory_series(cfg, x_max, 0, 1.0, "exact theory, mode 1"));
+    let theory_name = if r.rate_table == RateTable::Sinusoid {
+        "small-signal theory (first-order low-pass), mode 1"
+    } else {
+        "exact theory, mode 1"
+    };
+    fig = fig.with(theory_series(cfg, x_max, 0, 1.0, theory_name));
     if (cfg.drive.f1 - cfg.drive.f2).abs() > 0.0 {
         fig = fig.with(theory_series(cfg, x_max, 1, 1.0, "exact theory, mode 2"));
     }

@@ -84,6 +84,8 @@ pub fn reproduce(out: &Path, quick: bool) -> Result<()> {
         }
         render_png(&f, &out.join(format!("{fig}.png")))?;
     }
+    let (rt_cfg, _, _) = get("m2tfg-ratetable");
+    render_png(&bandwidth(rt_cfg, out)?, &out.join("fig_bandwidth.png"))?;
     let (cc, cr, _) = get("baw-coriolis");
     let (_, rr, _) = get("baw-rotating");
     render_png(&fig6(cc, cr, rr), &out.join("fig6.png"))?;
@@ -120,10 +122,105 @@ pub fn reproduce(out: &Path, quick: bool) -> Result<()> {
     });
     write_json(&out.join("summary.json"), &summary)?;
     eprintln!(
-        "wrote {0}/fig4.png fig5.png fig6.png fig8.png fig9.png fig_ratetable.png summary.json and one folder per experiment",
+        "wrote {0}/fig4.png fig5.png fig6.png fig8.png fig9.png fig_ratetable.png fig_bandwidth.png summary.json and one folder per experiment",
         out.display()
     );
     Ok(())
+}
+
+/// Rate-table frequencies of the bandwidth figure, Hz (the corner is f0/(2Q) = 0.21 Hz).
+const BANDWIDTH_FREQS_HZ: [f64; 9] = [0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0];
+/// Rate-table amplitude of the bandwidth figure, deg/s (small: the first-order model is linear).
+const BANDWIDTH_AMPLITUDE_DPS: f64 = 5.0;
+
+/// What the mechanical bandwidth does to a rate-table measurement: the phase amplitude per
+/// unit rate against the table frequency, emulated, beside the first-order low-pass of
+/// THEORY.md section 3 (DC gain 2 Q lambda / w0, corner f0/(2Q)). Writes `bandwidth.csv`.
+fn bandwidth(base: &Config, out: &Path) -> Result<Figure> {
+    use gyroemu_experiment::theory::rate_table_gain;
+    use gyroemu_io::{write_csv, CsvCell, CsvTable};
+    use rayon::prelude::*;
+    let d = &base.device;
+    let runs: Vec<(f64, SweepResult)> = BANDWIDTH_FREQS_HZ
+        .par_iter()
+        .map(|&f| {
+            let mut cfg = base.clone();
+            cfg.experiment.table_freq_hz = Some(f);
+            cfg.experiment.rates_dps = vec![BANDWIDTH_AMPLITUDE_DPS];
+            cfg.experiment.average_s = (2.0 / f).max(4.0);
+            check_config(&cfg, "bandwidth")?;
+            Ok((f, run_sweep(&cfg, &|_, _| {}, None)?))
+        })
+        .collect::<Result<_>>()?;
+    let gain = |r: &SweepResult, k: usize| r.points[0].phase_deg[k] / BANDWIDTH_AMPLITUDE_DPS;
+    let theory = |f: f64| rate_table_gain(d.f0_hz, d.q, d.angular_gain, 1.0, 1.0, f);
+    let mut rows = Vec::new();
+    for (f, r) in &runs {
+        let lag = r.points[0].table_lag_deg.unwrap_or([f64::NAN; 2]);
+        let (g, ph) = theory(*f);
+        rows.push(
+            [
+                *f,
+                gain(r, 0),
+                gain(r, 1),
+                g,
+                lag[0],
+                lag[1],
+                ph.to_degrees(),
+            ]
+            .map(CsvCell::F64)
+            .to_vec(),
+        );
+    }
+    let headers = [
+        "table_freq_hz",
+        "gain_mode1_deg_per_dps",
+        "gain_mode2_deg_per_dps",
+        "theory_gain_deg_per_dps",
+        "lag_mode1_deg",
+        "lag_mode2_deg",
+        "theory_lag_deg",
+    ];
+    let dir = out.join("m2tfg-ratetable");
+    std::fs::create_dir_all(&dir)?;
+    write_csv(
+        &dir.join("bandwidth.csv"),
+        &CsvTable {
+            headers: headers.map(String::from).to_vec(),
+            rows,
+        },
+    )?;
+    let fmax = BANDWIDTH_FREQS_HZ[BANDWIDTH_FREQS_HZ.len() - 1];
+    let fs: Vec<f64> = (0..=200)
+        .map(|i| 0.01 + (fmax - 0.01) * i as f64 / 200.0)
+        .collect();
+    let corner = d.f0_hz / (2.0 * d.q);
+    Ok(Figure::new(
+        &format!(
+            "Mechanical bandwidth: rate table at Q = {}, corner f0/(2Q) = {corner:.3} Hz",
+            d.q
+        ),
+        "Rate-table frequency (Hz)",
+        "Phase amplitude per unit rate (deg per deg/s)",
+    )
+    .with(Series {
+        name: format!("mode 1 emulated ({BANDWIDTH_AMPLITUDE_DPS} deg/s amplitude)"),
+        style: SeriesStyle::Points,
+        xs: runs.iter().map(|r| r.0).collect(),
+        ys: runs.iter().map(|r| gain(&r.1, 0)).collect(),
+    })
+    .with(Series {
+        name: "mode 2 emulated".into(),
+        style: SeriesStyle::OpenPoints,
+        xs: runs.iter().map(|r| r.0).collect(),
+        ys: runs.iter().map(|r| gain(&r.1, 1)).collect(),
+    })
+    .with(Series {
+        name: "first-order low-pass: (2 Q lambda / w0) / sqrt(1 + (2 pi f tau)^2)".into(),
+        style: SeriesStyle::Line,
+        ys: fs.iter().map(|&f| theory(f).0).collect(),
+        xs: fs,
+    }))
 }
 
 /// The paper-style real-I-channel estimate of mode 1, for the rotating figures.
@@ -159,7 +256,7 @@ fn fig6(cfg: &Config, cor: &SweepResult, rot: &SweepResult) -> Figure {
     })
     .with(Series {
         name: format!("rotating excitation, mode 1 (Omega / {lambda})"),
-        style: SeriesStyle::Points,
+        style: SeriesStyle::OpenPoints,
         xs: rot.points.iter().map(|p| p.rate_dps / lambda).collect(),
         ys: rot.points.iter().map(|p| p.phase_deg[0]).collect(),
     })

@@ -7,6 +7,8 @@ use plotters::style::RGBColor;
 pub enum SeriesStyle {
     /// Filled circle markers (measurements).
     Points,
+    /// Larger hollow circles, for a second measured series drawn over the first.
+    OpenPoints,
     /// Solid line (simulation, theory).
     Line,
     /// Dashed line (second model, limits).

@@ -139,6 +139,27 @@ fn px_round(v: f64) -> i32 {
 
 /// Draws one figure filling `area`: title, framed axes with grid, tick labels, axis labels with
 /// the scale exponent (if any) at the axis end, series, legend in the upper left.
+/// The upper corner whose quarter of the plot holds fewer data points (upper left on a tie),
+/// so the legend hides as little as possible.
+fn legend_corner(points: &[(f64, f64)], xa: &AxisScale, ya: &AxisScale) -> SeriesLabelPosition {
+    let frac = |v: f64, a: &AxisScale| (a.map(v) - a.lo) / (a.hi - a.lo);
+    let (mut left, mut right) = (0usize, 0usize);
+    for &(x, y) in points {
+        if frac(y, ya) > 0.5 {
+            if frac(x, xa) < 0.5 {
+                left += 1;
+            } else {
+                right += 1;
+            }
+        }
+    }
+    if right < left {
+        SeriesLabelPosition::UpperRight
+    } else {
+        SeriesLabelPosition::UpperLeft
+    }
+}
+
 fn draw_figure(area: &Area, fig: &Figure) -> DrawResult {
     let (w, h) = area.dim_in_pixel();
     let s = text_scale(w, h);
@@ -234,6 +255,14 @@ fn draw_figure(area: &Area, fig: &Figure) -> DrawResult {
                         .map(|p| Circle::new(p, radius, color.filled())),
                 )?;
             }
+            SeriesStyle::OpenPoints => {
+                let ring = color.stroke_width(lw.max(2));
+                chart.draw_series(
+                    pts()
+                        .filter(|(x, y)| x.is_finite() && y.is_finite())
+                        .map(|p| Circle::new(p, 2 * radius, ring)),
+                )?;
+            }
             SeriesStyle::Line | SeriesStyle::DashedLine => {
                 // Lines break at non-finite points instead of bridging the gap.
                 let v: Vec<(f64, f64)> = pts().collect();
@@ -270,6 +299,10 @@ fn draw_figure(area: &Area, fig: &Figure) -> DrawResult {
         match series.style {
             SeriesStyle::Points => anno.legend(move |(x, y)| {
                 EmptyElement::at((x, y)) + Circle::new((glyph_w / 2, 0), radius, color.filled())
+            }),
+            SeriesStyle::OpenPoints => anno.legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + Circle::new((glyph_w / 2, 0), 2 * radius, color.stroke_width(lw.max(2)))
             }),
             SeriesStyle::Line => anno.legend(move |(x, y)| {
                 EmptyElement::at((x, y)) + PathElement::new(vec![(0, 0), (glyph_w, 0)], line)
@@ -312,7 +345,7 @@ fn draw_figure(area: &Area, fig: &Figure) -> DrawResult {
     if fig.series.iter().any(|s| !s.name.is_empty()) {
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
+            .position(legend_corner(&all, &xa, &ya))
             .margin(px(10.0))
             .legend_area_size(glyph_w + px(10.0))
             .label_font(legend_font)
