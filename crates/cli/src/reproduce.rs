@@ -196,7 +196,7 @@ fn bandwidth(base: &Config, out: &Path) -> Result<Figure> {
         .collect();
     let corner = d.f0_hz / (2.0 * d.q);
     Ok(Figure::new(
-        &format!(
+        format!(
             "Mechanical bandwidth: rate table at Q = {}, corner f0/(2Q) = {corner:.3} Hz",
             d.q
         ),
