@@ -1,0 +1,207 @@
+//! The `gyroemu` binary end to end: presets round-trip, bad input exits 2 naming the key and
+//! writing nothing, a run writes its files, and results are byte-identical across reruns and
+//! thread counts.
+
+use gyroemu_experiment::parse_config;
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn gyroemu(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gyroemu"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+const SMALL: &str = r#"
+[device]
+f0_hz = 15000.0
+q = 1000.0
+angular_gain = 1.0
+[drive]
+f1 = 1.0
+f2 = 1.0
+[board]
+fs_hz = 240000.0
+lpf_cutoff_hz = 200.0
+decimation = 100
+[experiment]
+kind = "coriolis"
+rates_dps = [50.0, 100.0, 150.0, 175.0, 25.0]
+average_s = 0.1
+"#;
+
+#[test]
+fn every_preset_prints_a_config_that_parses_and_validates() {
+    let list = gyroemu(&["config", "--list"]);
+    assert!(list.status.success());
+    let names: Vec<String> = String::from_utf8_lossy(&list.stdout)
+        .lines()
+        .map(|l| l.split_whitespace().next().unwrap().to_string())
+        .collect();
+    assert!(names.len() >= 4, "{names:?}");
+    for name in names {
+        let o = gyroemu(&["config", "--preset", &name]);
+        assert!(o.status.success(), "{name}");
+        let cfg = parse_config(&String::from_utf8_lossy(&o.stdout))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        cfg.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+    assert_eq!(
+        gyroemu(&["config", "--preset", "nope"]).status.code(),
+        Some(2)
+    );
+}
+
+fn run_config(text: &str, dir: &Path, extra: &[&str]) -> Output {
+    let cfg = dir.join("c.toml");
+    std::fs::write(&cfg, text).unwrap();
+    let out = dir.join("out");
+    let mut args = extra.to_vec();
+    let (c, o) = (
+        cfg.to_str().unwrap().to_string(),
+        out.to_str().unwrap().to_string(),
+    );
+    args.extend(["run", c.as_str(), "--out", o.as_str()]);
+    gyroemu(&args)
+}
+
+#[test]
+fn bad_configs_exit_2_naming_key_value_and_rule_and_write_nothing() {
+    let cases = [
+        (
+            SMALL.replace("q = 1000.0", "q = -1.0"),
+            vec!["device.q", "-1", "> 0"],
+        ),
+        (
+            SMALL.replace("q = 1000.0", "q = nan"),
+            vec!["device.q", "NaN"],
+        ),
+        (
+            SMALL.replace("fs_hz = 240000.0", "fs_hz = 20000.0"),
+            vec!["board.fs_hz", "2*f0"],
+        ),
+        (
+            SMALL.replace("decimation = 100", "decimation = 0"),
+            vec!["board.decimation", ">= 1"],
+        ),
+        (
+            SMALL.replace("lpf_cutoff_hz = 200.0", "lpf_cutoff_hz = 5000.0"),
+            vec!["board.lpf_cutoff_hz", "Nyquist"],
+        ),
+        (
+            SMALL.replace("q = 1000.0", "q = 1000.0\nqq = 3"),
+            vec!["line 5", "qq"],
+        ),
+        (
+            SMALL.replace("q = 1000.0", "q = \"high\""),
+            vec!["line 4", "expected f64"],
+        ),
+        (
+            SMALL.replace("angular_gain = 1.0\n", ""),
+            vec!["angular_gain"],
+        ),
+        (
+            SMALL.replace("kind = \"coriolis\"", "kind = \"spinning\""),
+            vec!["spinning"],
+        ),
+        (String::new(), vec!["empty"]),
+    ];
+    for (text, needles) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        let o = run_config(&text, dir.path(), &[]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        for n in needles {
+            assert!(err.contains(n), "`{n}` missing from: {err}");
+        }
+        assert!(
+            !dir.path().join("out").exists(),
+            "nothing may be written on bad input"
+        );
+    }
+}
+
+#[test]
+fn run_writes_results_and_is_deterministic_across_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = run_config(SMALL, dir.path(), &["--threads", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = dir.path().join("out");
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    for col in [
+        "rate_dps",
+        "phase_mode1_deg",
+        "phase_mode2_deg",
+        "theory_mode1_deg",
+        "theory_mode2_deg",
+    ] {
+        assert!(
+            header.split(',').any(|h| h == col),
+            "{col} missing in {header}"
+        );
+    }
+    assert_eq!(csv.lines().count(), 1 + 5);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert!(summary["mode1"]["slope_deg_per_dps"].as_f64().unwrap() > 0.0);
+    assert!(out.join("plot.png").metadata().unwrap().len() > 1000);
+
+    let dir2 = tempfile::tempdir().unwrap();
+    assert!(run_config(SMALL, dir2.path(), &["--threads", "2"])
+        .status
+        .success());
+    let out2 = dir2.path().join("out");
+    for f in ["results.csv", "summary.json"] {
+        assert_eq!(
+            std::fs::read(out.join(f)).unwrap(),
+            std::fs::read(out2.join(f)).unwrap(),
+            "{f} differs"
+        );
+    }
+}
+
+#[test]
+fn reproduce_quick_writes_every_figure_and_the_slope_ratio() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = gyroemu(&["reproduce", "--quick", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in [
+        "fig4.png",
+        "fig5.png",
+        "fig6.png",
+        "fig8.png",
+        "fig9.png",
+        "fig_ratetable.png",
+        "fig_bandwidth.png",
+    ] {
+        assert!(out.join(f).metadata().unwrap().len() > 1000, "{f}");
+    }
+    for d in [
+        "m2tfg-coriolis",
+        "m2tfg-rotating",
+        "baw-coriolis",
+        "baw-rotating",
+    ] {
+        assert!(out.join(d).join("results.csv").exists(), "{d}");
+    }
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    // Fig. 6: the Coriolis slope over the rotating slope is lambda.
+    for pair in ["fig8_fig9", "fig4_fig5"] {
+        let e = s[pair]["ratio_relative_error"].as_f64().unwrap();
+        assert!(e.abs() < 1e-4, "{pair}: {e}");
+    }
+    for fig in ["fig4", "fig5", "fig8", "fig9"] {
+        assert!(
+            s["max_abs_error_mdeg"][fig].as_f64().unwrap() < 1.0,
+            "{fig}"
+        );
+    }
+}
