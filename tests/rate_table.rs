@@ -1,6 +1,7 @@
 //! A sinusoidal rate table: the phase follows Omega through a first-order low-pass with time
 //! constant tau = 2Q/w0 and DC gain 2 Q lambda / w0 (THEORY.md section 3). At a small
 //! amplitude the emulated phase amplitude and lag match that model.
+#![allow(clippy::needless_range_loop)] // mode indices address parallel arrays
 
 mod common;
 use common::*;
