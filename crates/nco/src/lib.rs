@@ -13,11 +13,13 @@
 
 mod dd;
 mod nco;
+mod rotating;
 mod shifter;
 mod trig;
 mod word;
 
 pub use nco::Nco;
+pub use rotating::{RotatingNco, RESYNC};
 pub use shifter::PhaseShifter;
 pub use trig::{phasor_of_word, TABLE_BITS};
 pub use word::{ratio_to_word, turns_of_word};
