@@ -37,6 +37,10 @@ pub trait Sample:
     fn round_away(self) -> Self;
     /// True when every lane is finite.
     fn all_finite(self) -> bool;
+    /// `self * a + b`: fused (one rounding) when the build targets FMA (x86-64-v3, see
+    /// `.cargo/config.toml`), two roundings otherwise. The choice is the same for every lane
+    /// type, so f64x4 lanes keep the bits of the scalar path in either build.
+    fn mul_add(self, a: Self, b: Self) -> Self;
 }
 
 impl Sample for f64 {
@@ -72,6 +76,17 @@ impl Sample for f64 {
     fn all_finite(self) -> bool {
         self.is_finite()
     }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        #[cfg(target_feature = "fma")]
+        {
+            f64::mul_add(self, a, b)
+        }
+        #[cfg(not(target_feature = "fma"))]
+        {
+            self * a + b
+        }
+    }
 }
 
 impl Sample for f64x4 {
@@ -101,6 +116,17 @@ impl Sample for f64x4 {
     #[inline(always)]
     fn all_finite(self) -> bool {
         self.is_finite().all()
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        #[cfg(target_feature = "fma")]
+        {
+            f64x4::mul_add(self, a, b)
+        }
+        #[cfg(not(target_feature = "fma"))]
+        {
+            self * a + b
+        }
     }
 }
 
@@ -133,5 +159,16 @@ mod tests {
             assert_eq!(c.lane(i), xs[i].clamp_to(-1.0, 1.0));
         }
         assert!(!f64x4::from_fn(|i| if i == 2 { f64::NAN } else { 0.0 }).all_finite());
+    }
+
+    #[test]
+    fn mul_add_lanes_match_scalar_and_fuse_when_the_build_has_fma() {
+        let (a, b, c) = (0.1, 10.0, -1.0);
+        let v = f64x4::splat(a).mul_add(f64x4::splat(b), f64x4::splat(c));
+        let s = Sample::mul_add(a, b, c);
+        assert_eq!(v.lane(3).to_bits(), s.to_bits());
+        // 0.1 * 10 - 1 is 0 with two roundings and 2^-54 with one.
+        let fused = cfg!(target_feature = "fma");
+        assert_eq!(s == 0.0, !fused, "{s:e}");
     }
 }

@@ -73,8 +73,9 @@ pub(crate) struct Section<S> {
     b0: S,
     b1: S,
     b2: S,
-    a1: S,
-    a2: S,
+    /// -a1 and -a2, stored negated so the recursion is pure multiply-adds.
+    neg_a1: S,
+    neg_a2: S,
     s1: S,
     s2: S,
 }
@@ -85,8 +86,8 @@ impl<S: Sample> Section<S> {
             b0: S::splat(c.b0),
             b1: S::splat(c.b1),
             b2: S::splat(c.b2),
-            a1: S::splat(c.a1),
-            a2: S::splat(c.a2),
+            neg_a1: S::splat(-c.a1),
+            neg_a2: S::splat(-c.a2),
             s1: S::default(),
             s2: S::default(),
         }
@@ -96,9 +97,10 @@ impl<S: Sample> Section<S> {
     /// (no large internal gain for low-pass sections).
     #[inline(always)]
     pub fn tick_df2t(&mut self, x: S) -> S {
-        let y = self.b0 * x + self.s1;
-        self.s1 = self.b1 * x - self.a1 * y + self.s2;
-        self.s2 = self.b2 * x - self.a2 * y;
+        // Multiply-adds ordered so the recursion through y is two fused steps long.
+        let y = self.b0.mul_add(x, self.s1);
+        self.s1 = self.neg_a1.mul_add(y, self.b1.mul_add(x, self.s2));
+        self.s2 = self.neg_a2.mul_add(y, self.b2 * x);
         y
     }
 

@@ -23,9 +23,10 @@ const STAGE: &str = "mixer.stage1";
 #[derive(Clone, Debug)]
 pub struct Stage1Mixer<S> {
     ref_phase_rad: f64,
-    /// `cos phi`, `sin phi` of the reference rotation, computed once.
-    cos_ref: S,
-    sin_ref: S,
+    /// `cos phi`, `sin phi` of the reference rotation, computed once. The carrier is one
+    /// scalar phasor for all lanes, so the rotation is done in scalar and broadcast once.
+    cos_ref: f64,
+    sin_ref: f64,
     _s: PhantomData<S>,
 }
 
@@ -38,8 +39,8 @@ impl<S: Sample> Stage1Mixer<S> {
         let (s, c) = detmath::sin_cos(phi - TAU * (phi / TAU).round());
         Ok(Self {
             ref_phase_rad: phi,
-            cos_ref: S::splat(c),
-            sin_ref: S::splat(s),
+            cos_ref: c,
+            sin_ref: s,
             _s: PhantomData,
         })
     }
@@ -57,12 +58,13 @@ impl<S: Sample> Stage for Stage1Mixer<S> {
 
     #[inline]
     fn tick(&mut self, (y, carrier): (S, Complex64)) -> Iq<S> {
-        let (pc, ps) = (S::splat(carrier.re), S::splat(carrier.im));
+        let (pc, ps) = (carrier.re, carrier.im);
         // e^{j(w0 t + phi)} = (pc + j ps)(cos phi + j sin phi).
         let cos_th = pc * self.cos_ref - ps * self.sin_ref;
         let sin_th = ps * self.cos_ref + pc * self.sin_ref;
-        let y2 = y + y;
-        Iq::new(y2 * cos_th, -(y2 * sin_th))
+        // 2y cos = y (2 cos) and -(2y sin) = y (-2 sin) exactly: scaling by 2 and negation
+        // do not round.
+        Iq::new(y * S::splat(2.0 * cos_th), y * S::splat(-2.0 * sin_th))
     }
 
     fn reset(&mut self) {}

@@ -94,7 +94,12 @@ impl<S: Sample> Resonator<S> {
 
     #[inline(always)]
     fn row(e: &[S; 6], z: &[S; 6]) -> S {
-        e[0] * z[0] + e[1] * z[1] + e[2] * z[2] + e[3] * z[3] + e[4] * z[4] + e[5] * z[5]
+        // The force terms first (they do not wait for the state), then two independent
+        // multiply-add chains over the state, so the recursion through x stays short.
+        let f = e[4].mul_add(z[4], e[5] * z[5]);
+        let a = e[0].mul_add(z[0], e[1].mul_add(z[1], f));
+        let b = e[2].mul_add(z[2], e[3] * z[3]);
+        a + b
     }
 
     /// One step with a time-varying rate (rad/s, per lane): the step matrix is

@@ -40,6 +40,8 @@ pub struct Tia<S> {
     b: S,
     lo: S,
     hi: S,
+    /// Without rails the clamp is skipped (a predictable branch instead of two lane ops).
+    has_rails: bool,
     y: S,
     a_f64: f64,
     b_f64: f64,
@@ -83,6 +85,7 @@ impl<S: Sample> Tia<S> {
             b: S::splat(b),
             lo: S::splat(-rail),
             hi: S::splat(rail),
+            has_rails: p.rail_v.is_some(),
             y: S::default(),
             a_f64: a,
             b_f64: b,
@@ -110,7 +113,10 @@ impl<S: Sample> Stage for Tia<S> {
 
     #[inline]
     fn tick(&mut self, x: S) -> S {
-        let y = (self.a * self.y + self.b * x).clamp_to(self.lo, self.hi);
+        let mut y = self.a.mul_add(self.y, self.b * x);
+        if self.has_rails {
+            y = y.clamp_to(self.lo, self.hi);
+        }
         self.y = y;
         y
     }
