@@ -33,7 +33,7 @@ fn check(f0: f64, q: f64, ratio: f64, rates: &[f64]) {
             .iter()
             .find(|c| c.rate_dps == p.rate_dps)
             .expect("compensation per point");
-        let chain_mdeg = c.tia_mdeg + c.dac_hold_mdeg;
+        let chain_mdeg = c.tia_mdeg + c.dac_hold_mdeg + c.lowpass_mdeg;
         if f0 < 1e6 {
             assert!(
                 chain_mdeg > 0.04,

@@ -95,3 +95,33 @@ pub fn config(preset: Option<&str>, list: bool) -> Result<()> {
     print!("{text}");
     Ok(())
 }
+
+/// `gyroemu bench`: prints point-samples per second for the chain and each stage.
+pub fn bench(preset_name: &str, samples: u64) -> Result<()> {
+    let cfg =
+        gyroemu_experiment::presets::preset(preset_name).map_err(|e| BadInput(e.to_string()))?;
+    if samples < 100 * cfg.board.decimation as u64 {
+        return Err(BadInput(format!(
+            "--samples = {samples}: must be at least 100 decimation blocks ({})",
+            100 * cfg.board.decimation
+        ))
+        .into());
+    }
+    eprintln!(
+        "bench: preset {preset_name}, fs = {} Hz, {samples} input samples per lane group, 4 operating points per group",
+        cfg.board.fs_hz
+    );
+    println!(
+        "{:<40} {:>7} {:>14}",
+        "what", "threads", "M point-samples/s"
+    );
+    for t in gyroemu_experiment::bench::all(&cfg, samples) {
+        println!(
+            "{:<40} {:>7} {:>14.1}",
+            t.name,
+            t.threads,
+            t.point_samples_per_s / 1e6
+        );
+    }
+    Ok(())
+}

@@ -44,6 +44,15 @@ enum Command {
         #[arg(long, default_value = "out")]
         out: PathBuf,
     },
+    /// Measure throughput: the whole chain on 1 and on all threads, and each stage.
+    Bench {
+        /// Preset whose board is measured (the rotating one exercises every stage).
+        #[arg(long, default_value = "m2tfg-rotating")]
+        preset: String,
+        /// Input samples per lane group.
+        #[arg(long, default_value_t = 1 << 24)]
+        samples: u64,
+    },
     /// Print a complete, commented config that `run` accepts.
     Config {
         /// Preset name (default: m2tfg-coriolis); `--list` shows them.
@@ -74,6 +83,7 @@ fn main() -> ExitCode {
         Command::Reproduce { out, quick } => reproduce::reproduce(&out, quick),
         Command::Run { config, out } => commands::run(&config, &out),
         Command::Config { preset, list } => commands::config(preset.as_deref(), list),
+        Command::Bench { preset, samples } => commands::bench(&preset, samples),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

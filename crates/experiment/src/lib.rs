@@ -2,6 +2,7 @@
 //! run sample by sample, the Coriolis and rotating-excitation sweeps, and the exact theory
 //! that the figures overlay.
 
+pub mod bench;
 pub mod board;
 pub mod config;
 pub mod fit;

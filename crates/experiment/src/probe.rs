@@ -15,6 +15,7 @@ pub struct Probe {
     nodes: [bool; 7],
     full: SignalRecorder,
     decimated: SignalRecorder,
+    full_window: (u64, u64),
 }
 
 const FULL_NODES: [(&str, [&str; 4]); 5] = [
@@ -79,8 +80,16 @@ impl Probe {
             lane,
             nodes: on,
             full: SignalRecorder::new(names(&full_table, 0), fs_hz, start, len),
+            full_window: (start, len),
             decimated: SignalRecorder::new(names(&dec_table, 5), fs_out, start_out, len_out),
         }
+    }
+
+    /// Whether input samples `n0 .. n0 + m` touch the full-rate window.
+    #[inline]
+    pub fn wants_block(&self, n0: u64, m: u64) -> bool {
+        let (start, len) = self.full_window;
+        !self.full.names().is_empty() && n0 < start.saturating_add(len) && n0 + m > start
     }
 
     /// Records the full-rate nodes of input sample `n`.

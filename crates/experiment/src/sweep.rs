@@ -56,8 +56,9 @@ pub struct Compensation {
     pub tia_mdeg: f64,
     /// DAC zero-order hold (about Omega Ts / 2), removed from psi.
     pub dac_hold_mdeg: f64,
-    /// Stage-1 low-pass, -arg L(fm): compensated by passing the Omega references through the
-    /// same low-pass decimator, so it never enters psi (reported for information).
+    /// Stage-1 low-pass, -arg L(fm): it delays the envelope but not the Omega references
+    /// (taken at the decimated instants), so it is removed from psi from the filter's exact
+    /// discrete response.
     pub lowpass_mdeg: f64,
     /// Pipeline delay between drive and reference, samples (0: both use the same sample).
     pub pipeline_delay_samples: u64,
@@ -348,12 +349,14 @@ fn post_process(
                 let sgn = omega.signum();
                 let tia_t = sgn * term(&|f| tia.response(f));
                 let hold_t = sgn * term(&|f| dac.response(f));
-                let chain = tia_t + hold_t;
+                // A real low-pass multiplies the baseband sidebands by L(fm) and conj L(fm).
+                let lp_t = -sgn * lp.response(fm).arg();
+                let chain = tia_t + hold_t + lp_t;
                 comp.push(Compensation {
                     rate_dps: rate,
                     tia_mdeg: tia_t / DEG * 1e3,
                     dac_hold_mdeg: hold_t / DEG * 1e3,
-                    lowpass_mdeg: -lp.response(fm).arg() / DEG * 1e3,
+                    lowpass_mdeg: lp_t / DEG * 1e3,
                     pipeline_delay_samples: 0,
                 });
                 let mut raw = [0.0; 2];
