@@ -67,7 +67,62 @@ nodes = ["drive", "velocity", "tia", "stage1", "lowpass", "stage2"]
     let (hd, rows_d) = read_csv(&dir.path().join("dump_decimated.csv"));
     assert!(hd.contains(&"lp_i1".to_string()) && hd.contains(&"c2_q".to_string()));
     assert_eq!(rows_d.len(), (0.01 * fs / 100.0) as usize);
+    // Decimated sample k is formed at input sample kM + M - 1.
+    for r in &rows_d {
+        let expect = (r[0] * 100.0 + 99.0) / fs;
+        assert!((r[1] - expect).abs() < 1e-12, "time_s {} vs {expect}", r[1]);
+    }
     for stem in ["dump_fullrate.wav", "dump_decimated.wav"] {
         assert!(dir.path().join(stem).metadata().unwrap().len() > 44);
     }
+}
+
+#[test]
+fn dumps_of_points_not_emulated_or_past_their_run_are_refused() {
+    let base = |rate: f64, start: f64, dur: f64| {
+        format!(
+            r#"
+[device]
+f0_hz = 15000.0
+q = 1000.0
+angular_gain = 1.0
+[drive]
+f1 = 1.0
+f2 = 1.0
+[board]
+fs_hz = 240000.0
+lpf_cutoff_hz = 200.0
+decimation = 100
+[experiment]
+kind = "rotating"
+rates_dps = [100.0, 150.0]
+settle_s = 0.5
+average_s = 2.0
+[dump]
+rate_dps = {rate}
+start_s = {start}
+duration_s = {dur}
+nodes = ["drive"]
+"#
+        )
+    };
+    // 0 is not emulated in a rotating sweep.
+    let e = parse_config(&base(0.0, 0.1, 0.01))
+        .unwrap()
+        .validate()
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("dump.rate_dps"), "{e}");
+    // At 100 deg/s a half modulation period is 1.8 s, so of the 2 s asked one half period
+    // (1.8 s) is averaged and the point's run ends at 0.5 + 1.8 = 2.3 s.
+    let e = parse_config(&base(100.0, 2.35, 0.01))
+        .unwrap()
+        .validate()
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("dump.duration_s") && e.contains("run"), "{e}");
+    parse_config(&base(100.0, 2.2, 0.01))
+        .unwrap()
+        .validate()
+        .unwrap();
 }

@@ -67,7 +67,27 @@ enum Command {
 /// Exit code for a config or usage the emulator refuses.
 pub const EXIT_BAD_INPUT: u8 = 2;
 
+/// The build targets x86-64-v3 (`.cargo/config.toml`); on an older CPU say so instead of
+/// dying on an illegal instruction.
+fn cpu_supports_build() -> Result<(), String> {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    {
+        if !(std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma"))
+        {
+            return Err("this gyroemu was built for x86-64-v3 (AVX2 + FMA), which this CPU lacks; rebuild with \
+                 RUSTFLAGS=\"-C target-cpu=x86-64\" cargo build --release (see docs/performance.md)"
+                .into());
+        }
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
+    if let Err(e) = cpu_supports_build() {
+        eprintln!("error: {e}");
+        return ExitCode::FAILURE;
+    }
     let cli = Cli::parse();
     if let Some(t) = cli.threads {
         if t == 0 {

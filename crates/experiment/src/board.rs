@@ -127,7 +127,11 @@ impl<S: Sample> Board<S> {
         let kind = cfg.experiment.kind;
         let table = cfg.experiment.rate_table == RateTable::Sinusoid;
         let carrier = Nco::new(cfg.device.f0_hz, fs, 0.0)?;
-        let shifter = PhaseShifter::new((90.0 + cfg.board.phase_shifter_error_deg).to_radians())?;
+        // The nominal shifter is exactly -j (cos -> sin with no rounding).
+        let shifter = match cfg.board.phase_shifter_error_deg {
+            0.0 => PhaseShifter::quadrature(),
+            e => PhaseShifter::new((90.0 + e).to_radians())?,
+        };
         let modulation: Vec<Nco> = (0..S::LANES)
             .map(|i| {
                 let f_mod = match kind {

@@ -30,7 +30,7 @@ const DEC_NODES: [(&str, [&str; 8]); 2] = [
     (
         "lowpass",
         [
-            "lp_i1", "lp_q1", "lp_i2", "lp_q2", "ref_cos", "ref_sin", "", "",
+            "lp_i1", "lp_q1", "lp_i2", "lp_q2", "mod_cos", "mod_sin", "", "",
         ],
     ),
     (
@@ -81,7 +81,9 @@ impl Probe {
             nodes: on,
             full: SignalRecorder::new(names(&full_table, 0), fs_hz, start, len),
             full_window: (start, len),
-            decimated: SignalRecorder::new(names(&dec_table, 5), fs_out, start_out, len_out),
+            // Decimated sample k is formed at input sample kM + M - 1.
+            decimated: SignalRecorder::new(names(&dec_table, 5), fs_out, start_out, len_out)
+                .with_time_origin((decimation - 1) as f64 / fs_hz),
         }
     }
 

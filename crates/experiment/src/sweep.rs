@@ -253,6 +253,34 @@ fn coriolis_theory_rad(cfg: &Config, omega: f64) -> [f64; 2] {
     [phase_lag_rad(x[2], x0[2]), phase_lag_rad(x[3], x0[3])]
 }
 
+/// Exact rotating-excitation psi per mode: the closed form for an ideal device; otherwise the
+/// major-axis estimator applied to the continuous-time velocity phasors of the imperfect plant
+/// at the two sidebands w0 +- Omega (drive sidebands F1/2, F1/2 on mode 1 and -j F2/2, +j F2/2
+/// on mode 2), psi_k = (arg(V_k(-)/M-) - arg(V_k(+)/M+))/2 as in THEORY.md section 6.
+fn rotating_theory_rad(cfg: &Config, omega: f64) -> [f64; 2] {
+    let d = &cfg.device;
+    if is_ideal(cfg) || omega == 0.0 {
+        return [theory::rotating_psi_rad(d.f0_hz, d.q, omega); 2];
+    }
+    let p = resonator_params(cfg);
+    let fm = omega / core::f64::consts::TAU;
+    let (f1, f2) = (cfg.drive.f1, cfg.drive.f2);
+    let j = Complex64::new(0.0, 1.0);
+    let v = |sign: f64| {
+        let force = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2];
+        continuous_steady_state(&p, 0.0, d.f0_hz + sign * fm, force)
+    };
+    let (vp, vm) = (v(1.0), v(-1.0));
+    let m = [
+        (Complex64::new(1.0, 0.0), Complex64::new(1.0, 0.0)),
+        (-j, j),
+    ];
+    [0, 1].map(|k| {
+        let (mp, mm) = m[k];
+        0.5 * ((vm[2 + k] / mm).arg() - (vp[2 + k] / mp).arg())
+    })
+}
+
 /// The exact theory of the quantity a sweep measures at `rate_dps`, per mode, degrees (the
 /// rate-table case is the small-signal first-order model of THEORY.md section 3).
 pub fn theory_deg(cfg: &Config, rate_dps: f64) -> [f64; 2] {
@@ -267,7 +295,7 @@ pub fn theory_deg(cfg: &Config, rate_dps: f64) -> [f64; 2] {
                 |a: f64, b: f64| theory::rate_table_gain(d.f0_hz, d.q, d.angular_gain, a, b, ft).0;
             [g(f1, f2) * omega, g(f2, f1) * omega]
         }
-        (ExperimentKind::Rotating, _) => [theory::rotating_psi_rad(d.f0_hz, d.q, omega); 2],
+        (ExperimentKind::Rotating, _) => rotating_theory_rad(cfg, omega),
     };
     rad.map(|r| r / DEG)
 }

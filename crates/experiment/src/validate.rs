@@ -1,7 +1,7 @@
 //! Config parsing and validation before any sample is computed. Each error names the key,
 //! the value and the rule (and the line and column when TOML parsing located it).
 
-use crate::config::{Config, ExperimentKind, RateTable, DUMP_NODES};
+use crate::config::{Config, ExperimentKind, RateTable, WindowKind, DUMP_NODES};
 use crate::theory::mechanical_tau_s;
 use thiserror::Error;
 
@@ -306,13 +306,33 @@ impl Config {
                 )?;
             }
         }
+        if e.window == WindowKind::Hann {
+            let slowest_hz = match (e.kind, e.rate_table) {
+                (ExperimentKind::Rotating, _) => e
+                    .rates_dps
+                    .iter()
+                    .map(|r| r.abs() / 360.0)
+                    .filter(|&f| f > 0.0)
+                    .reduce(f64::min),
+                (ExperimentKind::Coriolis, RateTable::Sinusoid) => e.table_freq_hz,
+                _ => None,
+            };
+            if let Some(f) = slowest_hz {
+                if e.average_s * f < 10.0 {
+                    warnings.push(format!(
+                        "experiment.window = \"hann\" spans only {:.2} periods of the slowest modulation ({f} Hz): below 10 periods it leaks more than 0.1 mdeg; use boxcar or average longer",
+                        e.average_s * f
+                    ));
+                }
+            }
+        }
         if let Some(dump) = &self.dump {
-            let total = self.settle_s() + e.average_s;
+            let emulated = crate::sweep::emulated_rates_dps(self);
             check(
-                dump.rate_dps == 0.0 || e.rates_dps.contains(&dump.rate_dps),
+                emulated.contains(&dump.rate_dps),
                 "dump.rate_dps",
                 dump.rate_dps,
-                "must be 0 or one of experiment.rates_dps",
+                &format!("must be one of the emulated rates {emulated:?}"),
             )?;
             check(
                 dump.start_s.is_finite() && dump.start_s >= 0.0,
@@ -321,11 +341,17 @@ impl Config {
                 "must be a finite number >= 0",
             )?;
             positive("dump.duration_s", dump.duration_s)?;
+            // The point runs settling plus its own averaging window (whole half periods).
+            let p = crate::sweep::plan_point(self, dump.rate_dps);
+            let n_settle = (self.settle_s() * self.fs_out_hz()).ceil();
+            let total = (n_settle + p.n_avg as f64 + 1.0) / self.fs_out_hz();
             check(
                 dump.start_s + dump.duration_s <= total,
                 "dump.duration_s",
                 dump.duration_s,
-                &format!("the window start_s + duration_s must end within the run ({total} s)"),
+                &format!(
+                    "the window start_s + duration_s must end within that point's run ({total} s)"
+                ),
             )?;
             let frames = dump.duration_s * b.fs_hz;
             check(

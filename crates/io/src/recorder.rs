@@ -12,6 +12,8 @@ use std::path::Path;
 pub struct SignalRecorder {
     names: Vec<String>,
     fs_hz: f64,
+    /// Time of sample index 0, s (a decimated stream's sample k stands for a later input).
+    t0_s: f64,
     start: u64,
     len: u64,
     /// Interleaved frames, `data.len() / names.len()` of them; capacity reserved up front.
@@ -33,10 +35,19 @@ impl SignalRecorder {
         SignalRecorder {
             names,
             fs_hz,
+            t0_s: 0.0,
             start: start_sample,
             len,
             data: Vec::with_capacity(cap),
         }
+    }
+
+    /// Sets the time of sample index 0 (the `time_s` column is `t0_s + n / fs_hz`): a
+    /// decimated stream whose sample k is formed at input sample kM + M - 1 starts at
+    /// (M - 1)/fs_in.
+    pub fn with_time_origin(mut self, t0_s: f64) -> Self {
+        self.t0_s = t0_s;
+        self
     }
 
     /// True when sample index `n` lies in the window (one subtraction and one compare).
@@ -121,7 +132,7 @@ impl SignalRecorder {
             for (i, frame) in self.data.chunks_exact(ch).enumerate() {
                 let n = self.start + i as u64;
                 sink.int(n as i64)?;
-                sink.f64(n as f64 / self.fs_hz)?;
+                sink.f64(self.t0_s + n as f64 / self.fs_hz)?;
                 for &x in frame {
                     sink.f64(x)?;
                 }
