@@ -77,13 +77,24 @@ pub fn run(config: &Path, out: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Writes to stdout; a reader that closed the pipe early (`| head`) ends the output quietly.
+fn print_out(text: &str) -> Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
+}
+
 /// `gyroemu config [--preset NAME] [--list]`.
 pub fn config(preset: Option<&str>, list: bool) -> Result<()> {
     if list {
-        for (name, what, _) in PRESETS {
-            println!("{name:18} {what}");
-        }
-        return Ok(());
+        let list: String = PRESETS
+            .iter()
+            .map(|(name, what, _)| format!("{name:18} {what}\n"))
+            .collect();
+        return print_out(&list);
     }
     let name = preset.unwrap_or("m2tfg-coriolis");
     let text = preset_text(name).ok_or_else(|| {
@@ -92,8 +103,7 @@ pub fn config(preset: Option<&str>, list: bool) -> Result<()> {
             PRESETS.iter().map(|p| p.0).collect::<Vec<_>>().join(", ")
         ))
     })?;
-    print!("{text}");
-    Ok(())
+    print_out(text)
 }
 
 /// `gyroemu bench`: prints point-samples per second for the chain and each stage.
@@ -112,12 +122,12 @@ pub fn bench(preset_name: &str, samples: u64) -> Result<()> {
         cfg.board.fs_hz
     );
     println!(
-        "{:<40} {:>7} {:>14}",
+        "{:<48} {:>7} {:>14}",
         "what", "threads", "M point-samples/s"
     );
     for t in gyroemu_experiment::bench::all(&cfg, samples) {
         println!(
-            "{:<40} {:>7} {:>14.1}",
+            "{:<48} {:>7} {:>14.1}",
             t.name,
             t.threads,
             t.point_samples_per_s / 1e6

@@ -68,26 +68,42 @@ enum Command {
 pub const EXIT_BAD_INPUT: u8 = 2;
 
 /// The build targets x86-64-v3 (`.cargo/config.toml`); on an older CPU say so instead of
-/// dying on an illegal instruction.
-fn cpu_supports_build() -> Result<(), String> {
+/// dying on an illegal instruction. `is_x86_feature_detected!` cannot tell: it folds to `true`
+/// when the build enables the feature, so this asks `cpuid` directly (AVX2: leaf 7 EBX bit 5;
+/// FMA: leaf 1 ECX bit 12; BMI2: leaf 7 EBX bit 8), before any other code runs.
+#[inline(never)]
+fn cpu_supports_build() -> Result<(), &'static str> {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
     {
-        if !(std::arch::is_x86_feature_detected!("avx2")
-            && std::arch::is_x86_feature_detected!("fma"))
-        {
-            return Err("this gyroemu was built for x86-64-v3 (AVX2 + FMA), which this CPU lacks; rebuild with \
-                 RUSTFLAGS=\"-C target-cpu=x86-64\" cargo build --release (see docs/performance.md)"
-                .into());
+        let (l1, l7) = (
+            core::arch::x86_64::__cpuid(1),
+            core::arch::x86_64::__cpuid_count(7, 0),
+        );
+        let fma = l1.ecx & (1 << 12) != 0;
+        let avx2 = l7.ebx & (1 << 5) != 0;
+        let bmi2 = l7.ebx & (1 << 8) != 0;
+        if !(fma && avx2 && bmi2) {
+            return Err("this gyroemu was built for x86-64-v3 (AVX2, FMA, BMI2), which this CPU lacks; rebuild with \
+                 RUSTFLAGS=\"-C target-cpu=x86-64\" cargo build --release (see docs/performance.md)\n");
         }
     }
     Ok(())
 }
 
 fn main() -> ExitCode {
+    // Nothing but the CPU check may run before it: the rest is out of line.
     if let Err(e) = cpu_supports_build() {
-        eprintln!("error: {e}");
+        // Static bytes only: formatting could already use AVX to copy them.
+        let mut err = std::io::stderr();
+        std::io::Write::write_all(&mut err, b"error: ").ok();
+        std::io::Write::write_all(&mut err, e.as_bytes()).ok();
         return ExitCode::FAILURE;
     }
+    run_cli()
+}
+
+#[inline(never)]
+fn run_cli() -> ExitCode {
     let cli = Cli::parse();
     if let Some(t) = cli.threads {
         if t == 0 {

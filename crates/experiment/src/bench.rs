@@ -4,7 +4,7 @@
 
 use crate::board::{Board, Point};
 use crate::config::Config;
-use gyroemu_core::{f64x4, Stage};
+use gyroemu_core::{f64x4, Sample, Stage};
 use rayon::prelude::*;
 use std::hint::black_box;
 use std::time::Instant;
@@ -65,11 +65,11 @@ fn stage<T: Stage>(mut st: T, n: u64, lanes: usize, input: impl Fn(u64) -> T::In
 
 /// Every figure: the chain on 1 thread and on all threads, then each stage on 1 thread.
 pub fn all(cfg: &Config, n_in: u64) -> Vec<Throughput> {
-    use crate::board::{decimator_mode, resonator_params, tia_params};
+    use crate::board::{resonator_params, tia_params};
     use gyroemu_am::{AmInput, AmModulator, DrivePattern};
-    use gyroemu_lpf::{Decimator, LowPass, LowPassDesign};
+    use gyroemu_lpf::{LowPass, LowPassDesign};
     use gyroemu_mixer::{Iq, Stage1Mixer, Stage2Mixer};
-    use gyroemu_nco::Nco;
+    use gyroemu_nco::{Nco, PhaseShifter, RotatingNco};
     use gyroemu_resonator::Resonator;
     use gyroemu_tia::Tia;
     let threads = rayon::current_num_threads();
@@ -95,9 +95,27 @@ pub fn all(cfg: &Config, n_in: u64) -> Vec<Throughput> {
         })
     };
     let nco = Nco::new(cfg.device.f0_hz, fs, 0.0).expect("valid");
+    let carrier = RotatingNco::<f64>::new(std::slice::from_ref(&nco));
     push(
-        "nco (scalar, shared by 4 lanes)",
+        "carrier RotatingNco (scalar, 4 lanes share it)",
+        stage(carrier, n_in, 4, |_| ()),
+    );
+    let mods: Vec<Nco> = lane_rates(cfg)
+        .iter()
+        .map(|r| Nco::new(r / std::f64::consts::TAU, fs, 0.0).expect("valid"))
+        .collect();
+    push(
+        "modulation RotatingNco (f64x4)",
+        stage(RotatingNco::<f64x4>::new(&mods), n_in, 4, |_| ()),
+    );
+    push(
+        "table Nco (exact re-sets only)",
         stage(nco, n_in, 4, |_| ()),
+    );
+    let c = |i: u64| gyroemu_core::Complex64::new(x(i).lane(0), 0.5);
+    push(
+        "phase shifter (scalar)",
+        stage(PhaseShifter::quadrature(), n_in, 4, c),
     );
     let am = AmModulator::<f64x4>::new(DrivePattern::Rotating, 1.0, 1.0).expect("valid");
     push(
@@ -126,9 +144,6 @@ pub fn all(cfg: &Config, n_in: u64) -> Vec<Throughput> {
     };
     let lp = LowPass::<f64x4>::new(design, fs).expect("valid");
     push("low-pass (one channel)", stage(lp, n_in, 4, x));
-    let dec =
-        Decimator::<f64x4>::new(decimator_mode(cfg), cfg.board.decimation, fs).expect("valid");
-    push("low-pass decimator (one channel)", stage(dec, n_in, 4, x));
     let s2 = Stage2Mixer::<f64x4>::default();
     push(
         "stage-2 mixer (per decimated sample)",

@@ -144,7 +144,8 @@ pub struct ExperimentConfig {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DumpConfig {
-    /// Which operating point, deg/s (must be one of `rates_dps`, or 0).
+    /// Which operating point, deg/s (one of the emulated rates: `rates_dps`, plus 0 in a
+    /// constant-rate Coriolis run).
     pub rate_dps: f64,
     /// Start of the window, s from the start of the run.
     pub start_s: f64,

@@ -1,5 +1,6 @@
 //! The board in f64x4 lanes gives each lane the result the scalar board gives for that
-//! operating point alone (bit for bit: the arithmetic is lane-wise and FMA-free).
+//! operating point alone (bit for bit: the arithmetic is lane-wise, and `Sample::mul_add` is
+//! fused or not alike for f64 and f64x4).
 
 use gyroemu_core::f64x4;
 use gyroemu_experiment::board::Board;

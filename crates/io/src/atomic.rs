@@ -48,6 +48,13 @@ fn persist(tmp: NamedTempFile, path: &Path) -> Result<(), IoError> {
     File::open(tmp.path())
         .and_then(|f| f.sync_all())
         .map_err(write_err)?;
+    // Temporary files are created 0600; a result file is for sharing like any other (0644).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o644))
+            .map_err(write_err)?;
+    }
     tmp.persist(path).map_err(|e| IoError::Persist {
         path: path.to_path_buf(),
         source: e.error,

@@ -3,9 +3,10 @@
 //!
 //! With references `(r_c, r_s) ~ (cos Omega t, sin Omega t)` the outputs are the C-term `2 z r_c`
 //! and the S-term `2 z r_s`; averaged over a whole number of half modulation periods they give
-//! `C` and `S`, from which [`crate::sideband_estimate`] reads psi and alpha. The references may be
-//! passed through the same low-pass as `z`: a common phase shift of `z` and the references
-//! leaves psi unchanged, which compensates the low-pass term `-arg L(j Omega)`.
+//! `C` and `S`, from which [`crate::sideband_estimate`] reads psi and alpha. A common phase shift
+//! of `z` and the references leaves psi unchanged, so the low-pass term `-arg L(j Omega)` can be
+//! compensated by filtering the references too; the board instead takes the references at the
+//! decimated instants and removes the term from the filter's exact response (fewer channels).
 
 use core::marker::PhantomData;
 use gyroemu_core::{Sample, Stage};

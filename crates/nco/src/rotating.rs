@@ -46,8 +46,10 @@ impl<S: Sample> RotatingNco<S> {
     }
 
     /// Sets the phasor exactly from the accumulator and advances the accumulator by one
-    /// re-set interval.
-    #[inline]
+    /// re-set interval. Out of line and cold: it runs once per 64 samples, and keeping it
+    /// out of the sample loop leaves the loop's registers to the recursions.
+    #[cold]
+    #[inline(never)]
     fn resync(&mut self) {
         let p: [gyroemu_core::Complex64; 4] =
             core::array::from_fn(|i| phasor_of_word(self.phase[i]));
