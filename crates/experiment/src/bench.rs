@@ -38,7 +38,7 @@ pub fn chain(cfg: &Config, n_in: u64, groups: usize) -> f64 {
         .map(|&r| Point {
             rate_rad_s: r,
             n_avg: n_out / 2,
-            frac: 0.0,
+            window: crate::board::PointWindow::Boxcar { frac: 0.0 },
         })
         .collect();
     let n_settle = n_out - n_out / 2 - 1;

@@ -23,9 +23,28 @@ pub struct Point {
     pub rate_rad_s: f64,
     /// Whole decimated samples in the averaging window.
     pub n_avg: u64,
-    /// Weight of the sample just after the window (boxcar: the fractional end of a whole
-    /// number of half periods, so the average spans exactly that time).
-    pub frac: f64,
+    /// How the samples of the window are weighted.
+    pub window: PointWindow,
+}
+
+/// The weights of a point's averaging window.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PointWindow {
+    /// Weight 1 on `n_avg` samples and `frac` (in [0, 1)) on the next: the fractional end of a
+    /// whole number of half periods, so the average spans exactly that time.
+    Boxcar { frac: f64 },
+    /// Hann weights over `n_avg` samples.
+    Hann,
+}
+
+impl Point {
+    /// The averaged span in decimated samples.
+    pub fn span_samples(&self) -> f64 {
+        match self.window {
+            PointWindow::Boxcar { frac } => self.n_avg as f64 + frac,
+            PointWindow::Hann => self.n_avg as f64,
+        }
+    }
 }
 
 /// What one lane measured, averaged after settling.
@@ -374,20 +393,15 @@ impl<S: Sample> Board<S> {
 /// Weight of decimated sample `j` (counted from the end of settling) in a lane's window.
 #[inline]
 fn window_weight(j: u64, p: &Point) -> f64 {
-    if p.frac < 0.0 {
-        // Hann over n_avg samples (frac < 0 marks it).
-        if j < p.n_avg {
+    match p.window {
+        _ if j > p.n_avg => 0.0,
+        PointWindow::Hann if j == p.n_avg => 0.0,
+        PointWindow::Hann => {
             let (s, _) = detmath::sin_cos_turns(0.5 * (j as f64 + 0.5) / p.n_avg as f64);
             s * s
-        } else {
-            0.0
         }
-    } else if j < p.n_avg {
-        1.0
-    } else if j == p.n_avg {
-        p.frac
-    } else {
-        0.0
+        PointWindow::Boxcar { frac } if j == p.n_avg => frac,
+        PointWindow::Boxcar { .. } => 1.0,
     }
 }
 

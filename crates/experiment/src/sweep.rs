@@ -4,7 +4,7 @@
 //! chain terms, and puts the exact theory beside each result.
 
 use crate::board::{
-    decimator_mode, resonator_params, tia_params, Board, LaneResult, Point, MAX_LANES,
+    decimator_mode, resonator_params, tia_params, Board, LaneResult, Point, PointWindow, MAX_LANES,
 };
 use crate::config::{Config, ExperimentKind, RateTable, WindowKind};
 use crate::fit::{fit_line, LineFit};
@@ -108,7 +108,7 @@ pub fn plan_point(cfg: &Config, rate_dps: f64) -> Point {
         return Point {
             rate_rad_s,
             n_avg: (e.average_s * fs_out).floor().max(1.0) as u64,
-            frac: -1.0,
+            window: PointWindow::Hann,
         };
     }
     // The period whose whole multiples make the boxcar exact.
@@ -125,10 +125,12 @@ pub fn plan_point(cfg: &Config, rate_dps: f64) -> Point {
     Point {
         rate_rad_s,
         n_avg: x.floor() as u64,
-        frac: if period_s.is_some() {
-            x - x.floor()
-        } else {
-            0.0
+        window: PointWindow::Boxcar {
+            frac: if period_s.is_some() {
+                x - x.floor()
+            } else {
+                0.0
+            },
         },
     }
 }
@@ -318,13 +320,7 @@ fn post_process(
     let mut out = Vec::new();
     let mut comp = Vec::new();
     let zero = rates.iter().position(|&r| r == 0.0);
-    let averaged = |p: &Point| {
-        if p.frac < 0.0 {
-            p.n_avg as f64 / fs_out
-        } else {
-            (p.n_avg as f64 + p.frac) / fs_out
-        }
-    };
+    let averaged = |p: &Point| p.span_samples() / fs_out;
     for (i, &rate) in rates.iter().enumerate() {
         if !e.rates_dps.contains(&rate) {
             continue; // the implicit zero-rate reference
