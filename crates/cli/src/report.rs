@@ -85,7 +85,7 @@ pub fn summary(cfg: &Config, r: &SweepResult) -> serde_json::Value {
             "r2": r.fit[k].r2,
             "theory_slope_deg_per_dps": r.theory_slope_deg_per_dps[k],
             "slope_relative_error": r.fit[k].slope / r.theory_slope_deg_per_dps[k] - 1.0,
-            "max_abs_error_mdeg": r.points.iter().map(|p| ((p.phase_deg[k] - p.theory_deg[k]) * 1e3).abs()).fold(0.0, f64::max),
+            "max_abs_error_mdeg": r.max_abs_error_mdeg(k),
         })
     };
     json!({

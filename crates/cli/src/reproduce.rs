@@ -102,12 +102,7 @@ pub fn reproduce(out: &Path, quick: bool) -> Result<()> {
             "ratio_relative_error": ratio / lambda - 1.0,
         })
     };
-    let max_err = |r: &SweepResult| {
-        r.points
-            .iter()
-            .flat_map(|p| (0..2).map(move |k| ((p.phase_deg[k] - p.theory_deg[k]) * 1e3).abs()))
-            .fold(0.0, f64::max)
-    };
+    let max_err = |r: &SweepResult| r.max_abs_error_mdeg(0).max(r.max_abs_error_mdeg(1));
     let summary = json!({
         "fig8_fig9": pair("m2tfg-coriolis", "m2tfg-rotating"),
         "fig4_fig5": pair("baw-coriolis", "baw-rotating"),

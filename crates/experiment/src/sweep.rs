@@ -84,6 +84,16 @@ pub struct SweepResult {
     pub point_samples: u64,
 }
 
+impl SweepResult {
+    /// Largest |measured - theory| of one mode over the points, millidegrees.
+    pub fn max_abs_error_mdeg(&self, mode: usize) -> f64 {
+        self.points
+            .iter()
+            .map(|p| ((p.phase_deg[mode] - p.theory_deg[mode]) * 1e3).abs())
+            .fold(0.0, f64::max)
+    }
+}
+
 /// Progress callback: (input samples done, total).
 pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
 
@@ -145,7 +155,7 @@ pub fn run_sweep(
     let points: Vec<Point> = rates.iter().map(|&r| plan_point(cfg, r)).collect();
     let fs_out = cfg.fs_out_hz();
     let settle_s = cfg.settle_s();
-    let n_settle = (settle_s * fs_out).ceil() as u64;
+    let n_settle = cfg.n_settle_out();
     let m = cfg.board.decimation as u64;
     let groups: Vec<&[Point]> = points.chunks(MAX_LANES).collect();
     let group_samples =
@@ -283,20 +293,22 @@ fn rotating_theory_rad(cfg: &Config, omega: f64) -> [f64; 2] {
     })
 }
 
+/// Small-signal phase amplitude per unit rate-table amplitude, per mode (rad per rad/s).
+fn rate_table_gains(cfg: &Config) -> [f64; 2] {
+    let d = &cfg.device;
+    let (f1, f2) = (cfg.drive.f1, cfg.drive.f2);
+    let ft = cfg.experiment.table_freq_hz.unwrap_or(0.0);
+    let g = |a: f64, b: f64| theory::rate_table_gain(d.f0_hz, d.q, d.angular_gain, a, b, ft).0;
+    [g(f1, f2), g(f2, f1)]
+}
+
 /// The exact theory of the quantity a sweep measures at `rate_dps`, per mode, degrees (the
 /// rate-table case is the small-signal first-order model of THEORY.md section 3).
 pub fn theory_deg(cfg: &Config, rate_dps: f64) -> [f64; 2] {
-    let d = &cfg.device;
-    let (f1, f2) = (cfg.drive.f1, cfg.drive.f2);
     let omega = rate_dps * DEG;
     let rad = match (cfg.experiment.kind, cfg.experiment.rate_table) {
         (ExperimentKind::Coriolis, RateTable::Constant) => coriolis_theory_rad(cfg, omega),
-        (ExperimentKind::Coriolis, RateTable::Sinusoid) => {
-            let ft = cfg.experiment.table_freq_hz.unwrap_or(0.0);
-            let g =
-                |a: f64, b: f64| theory::rate_table_gain(d.f0_hz, d.q, d.angular_gain, a, b, ft).0;
-            [g(f1, f2) * omega, g(f2, f1) * omega]
-        }
+        (ExperimentKind::Coriolis, RateTable::Sinusoid) => rate_table_gains(cfg).map(|g| g * omega),
         (ExperimentKind::Rotating, _) => rotating_theory_rad(cfg, omega),
     };
     rad.map(|r| r / DEG)
@@ -412,12 +424,7 @@ fn post_process(
             let g = 2.0 * d.q * d.angular_gain / w0;
             [g * f2 / f1, g * f1 / f2]
         }
-        (ExperimentKind::Coriolis, RateTable::Sinusoid) => {
-            let ft = e.table_freq_hz.unwrap_or(0.0);
-            let g =
-                |a: f64, b: f64| theory::rate_table_gain(d.f0_hz, d.q, d.angular_gain, a, b, ft).0;
-            [g(f1, f2), g(f2, f1)]
-        }
+        (ExperimentKind::Coriolis, RateTable::Sinusoid) => rate_table_gains(cfg),
         (ExperimentKind::Rotating, _) => [2.0 * d.q / w0; 2],
     };
     Ok(SweepResult {

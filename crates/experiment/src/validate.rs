@@ -99,6 +99,11 @@ impl Config {
         })
     }
 
+    /// Settling in decimated samples (the whole output periods that cover `settle_s`).
+    pub fn n_settle_out(&self) -> u64 {
+        (self.settle_s() * self.fs_out_hz()).ceil() as u64
+    }
+
     /// Checks every rule that does not need the stages built; returns warnings.
     pub fn validate(&self) -> Result<Vec<String>, ConfigError> {
         let d = &self.device;
@@ -343,8 +348,7 @@ impl Config {
             positive("dump.duration_s", dump.duration_s)?;
             // The point runs settling plus its own averaging window (whole half periods).
             let p = crate::sweep::plan_point(self, dump.rate_dps);
-            let n_settle = (self.settle_s() * self.fs_out_hz()).ceil();
-            let total = (n_settle + p.n_avg as f64 + 1.0) / self.fs_out_hz();
+            let total = (self.n_settle_out() + p.n_avg + 1) as f64 / self.fs_out_hz();
             check(
                 dump.start_s + dump.duration_s <= total,
                 "dump.duration_s",
