@@ -13,6 +13,12 @@ pub struct Config {
     pub experiment: ExperimentConfig,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dump: Option<DumpConfig>,
+    /// Noise sources (absent: a noiseless board).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise: Option<NoiseConfig>,
+    /// The analyses of `gyroemu selfcal` (absent: only the two sweeps and their comparison).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub selfcal: Option<SelfcalConfig>,
 }
 
 /// The resonator (THEORY.md section 2).
@@ -83,6 +89,56 @@ pub struct BoardConfig {
     /// Error of the board's 90-degree phase shifter, degrees.
     #[serde(default)]
     pub phase_shifter_error_deg: f64,
+    /// ADC resolution in bits after each TIA (absent: ideal ADC).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adc_bits: Option<u32>,
+    /// ADC full scale, V (the input range is -full scale to +full scale).
+    #[serde(default = "default_adc_full_scale")]
+    pub adc_full_scale_v: f64,
+}
+
+/// White, seeded noise sources (docs/user-guide.md gives the models).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoiseConfig {
+    /// Seed of the random streams; each operating point draws from its own stream, derived
+    /// from the seed and the point's index in `rates_dps`.
+    #[serde(default)]
+    pub seed: u64,
+    /// Resonator temperature, K (thermomechanical noise 4 k T m w0 / Q).
+    #[serde(default = "default_temperature")]
+    pub temperature_k: f64,
+    /// Effective modal mass, kg (absent: no thermomechanical noise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub effective_mass_kg: Option<f64>,
+    /// TIA input current noise density, A/sqrt(Hz).
+    #[serde(default)]
+    pub tia_current_noise_a_per_rthz: f64,
+    /// TIA output voltage noise density, V/sqrt(Hz) (within the TIA's own bandwidth).
+    #[serde(default)]
+    pub tia_voltage_noise_v_per_rthz: f64,
+}
+
+/// The analyses `gyroemu selfcal` adds to its two sweeps; each runs only when its key is set.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SelfcalConfig {
+    /// Length of the zero-rate Coriolis record whose Allan deviation is reported, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub allan_record_s: Option<f64>,
+    /// Longest averaging time of the self-calibration error against averaging time, s
+    /// (the rotating sweep then runs this long; the analysis starts at 1 s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tau_max_s: Option<f64>,
+    /// Temperature offsets of the drift scenario, K (empty: no drift scenario).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub drift_delta_t_k: Vec<f64>,
+    /// Temperature coefficient of f0, ppm/K (silicon: about -30).
+    #[serde(default = "default_f0_tc")]
+    pub f0_tc_ppm_per_k: f64,
+    /// Temperature coefficient of Q, ppm/K (thermoelastic damping: Q falls as T rises).
+    #[serde(default = "default_q_tc")]
+    pub q_tc_ppm_per_k: f64,
 }
 
 /// Which excitation the sweep uses.
@@ -187,4 +243,16 @@ fn default_window() -> WindowKind {
 }
 fn default_rate_table() -> RateTable {
     RateTable::Constant
+}
+fn default_adc_full_scale() -> f64 {
+    1.0
+}
+fn default_temperature() -> f64 {
+    300.0
+}
+fn default_f0_tc() -> f64 {
+    -30.0
+}
+fn default_q_tc() -> f64 {
+    -3000.0
 }

@@ -11,6 +11,7 @@ pub mod probe;
 pub mod sweep;
 pub mod theory;
 pub mod validate;
+mod validate_noise;
 
 pub use config::{Config, ExperimentKind, RateTable, WindowKind};
 pub use sweep::{run_sweep, PointResult, SweepError, SweepResult};

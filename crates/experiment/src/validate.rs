@@ -331,6 +331,7 @@ impl Config {
                 }
             }
         }
+        self.validate_noise_adc_selfcal(&mut warnings)?;
         if let Some(dump) = &self.dump {
             let emulated = crate::sweep::emulated_rates_dps(self);
             check(

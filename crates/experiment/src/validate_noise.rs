@@ -1,0 +1,118 @@
+//! Validation of the noise, ADC and self-calibration keys (kept apart from the core rules of
+//! `validate.rs`; same error form: key, value, rule).
+
+use crate::config::Config;
+use crate::validate::ConfigError;
+
+fn rule(ok: bool, key: &str, v: impl std::fmt::Display, r: &str) -> Result<(), ConfigError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(ConfigError::key(key, v, r))
+    }
+}
+
+fn non_negative(key: &str, v: f64) -> Result<(), ConfigError> {
+    rule(
+        v.is_finite() && v >= 0.0,
+        key,
+        v,
+        "must be a finite number >= 0",
+    )
+}
+
+fn positive(key: &str, v: f64) -> Result<(), ConfigError> {
+    rule(v.is_finite() && v > 0.0, key, v, "must be a finite number > 0")
+}
+
+impl Config {
+    /// The rules of the `[noise]` and `[selfcal]` sections and of the ADC keys.
+    pub(crate) fn validate_noise_adc_selfcal(
+        &self,
+        warnings: &mut Vec<String>,
+    ) -> Result<(), ConfigError> {
+        let b = &self.board;
+        if let Some(bits) = b.adc_bits {
+            rule(
+                (2..=32).contains(&bits),
+                "board.adc_bits",
+                bits,
+                "must be an integer from 2 to 32",
+            )?;
+        }
+        positive("board.adc_full_scale_v", b.adc_full_scale_v)?;
+        if let Some(n) = &self.noise {
+            positive("noise.temperature_k", n.temperature_k)?;
+            if let Some(m) = n.effective_mass_kg {
+                positive("noise.effective_mass_kg", m)?;
+            }
+            non_negative(
+                "noise.tia_current_noise_a_per_rthz",
+                n.tia_current_noise_a_per_rthz,
+            )?;
+            non_negative(
+                "noise.tia_voltage_noise_v_per_rthz",
+                n.tia_voltage_noise_v_per_rthz,
+            )?;
+            let silent = n.effective_mass_kg.is_none()
+                && n.tia_current_noise_a_per_rthz == 0.0
+                && n.tia_voltage_noise_v_per_rthz == 0.0
+                && b.adc_bits.is_none();
+            if silent {
+                warnings.push(
+                    "[noise] is present but sets no source (effective_mass_kg, tia_*_noise, board.adc_bits): the run is noiseless".into(),
+                );
+            }
+        }
+        if let Some(s) = &self.selfcal {
+            if let Some(t) = s.allan_record_s {
+                let min = 10.0 / self.fs_out_hz();
+                rule(
+                    t.is_finite() && t >= 10.0 && t >= min,
+                    "selfcal.allan_record_s",
+                    t,
+                    "must be a finite number >= 10 s (the Allan deviation needs a record of many averaging times)",
+                )?;
+            }
+            if let Some(t) = s.tau_max_s {
+                rule(
+                    t.is_finite() && t >= 2.0,
+                    "selfcal.tau_max_s",
+                    t,
+                    "must be a finite number >= 2 s (the analysis starts at 1 s)",
+                )?;
+            }
+            for (i, &dt) in s.drift_delta_t_k.iter().enumerate() {
+                rule(
+                    dt.is_finite() && dt.abs() <= 200.0,
+                    &format!("selfcal.drift_delta_t_k[{i}]"),
+                    dt,
+                    "must be finite and within -200..200 K",
+                )?;
+            }
+            rule(
+                s.f0_tc_ppm_per_k.is_finite() && s.f0_tc_ppm_per_k.abs() < 1e4,
+                "selfcal.f0_tc_ppm_per_k",
+                s.f0_tc_ppm_per_k,
+                "must be finite and within -1e4..1e4 ppm/K",
+            )?;
+            rule(
+                s.q_tc_ppm_per_k.is_finite() && s.q_tc_ppm_per_k.abs() < 1e5,
+                "selfcal.q_tc_ppm_per_k",
+                s.q_tc_ppm_per_k,
+                "must be finite and within -1e5..1e5 ppm/K",
+            )?;
+            for (i, &dt) in s.drift_delta_t_k.iter().enumerate() {
+                let q_scale = 1.0 + s.q_tc_ppm_per_k * 1e-6 * dt;
+                let f_scale = 1.0 + s.f0_tc_ppm_per_k * 1e-6 * dt;
+                rule(
+                    q_scale > 0.0 && f_scale > 0.0,
+                    &format!("selfcal.drift_delta_t_k[{i}]"),
+                    dt,
+                    "the temperature coefficients must keep Q and f0 > 0 at this offset",
+                )?;
+            }
+        }
+        Ok(())
+    }
+}
