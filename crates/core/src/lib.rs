@@ -4,6 +4,7 @@
 
 pub mod detmath;
 pub mod error;
+pub mod noise;
 pub mod sample;
 pub mod stage;
 

@@ -41,6 +41,9 @@ pub trait Sample:
     /// `.cargo/config.toml`), two roundings otherwise. The choice is the same for every lane
     /// type, so f64x4 lanes keep the bits of the scalar path in either build.
     fn mul_add(self, a: Self, b: Self) -> Self;
+    /// The first `LANES` lanes of a 4-lane vector (lane 0 for `f64`): how lane-parallel
+    /// helpers such as the noise generator hand their lanes to either sample type.
+    fn from_x4(v: f64x4) -> Self;
 }
 
 impl Sample for f64 {
@@ -56,6 +59,10 @@ impl Sample for f64 {
     #[inline(always)]
     fn lane(self, _i: usize) -> f64 {
         self
+    }
+    #[inline(always)]
+    fn from_x4(v: f64x4) -> Self {
+        v.to_array()[0]
     }
     #[inline(always)]
     fn clamp_to(self, lo: Self, hi: Self) -> Self {
@@ -102,6 +109,10 @@ impl Sample for f64x4 {
     #[inline(always)]
     fn lane(self, i: usize) -> f64 {
         self.to_array()[i]
+    }
+    #[inline(always)]
+    fn from_x4(v: f64x4) -> Self {
+        v
     }
     #[inline(always)]
     fn clamp_to(self, lo: Self, hi: Self) -> Self {

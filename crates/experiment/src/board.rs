@@ -4,13 +4,14 @@
 
 use crate::config::{Config, ExperimentKind, RateTable};
 use crate::probe::Probe;
-use gyroemu_am::{AmInput, AmModulator, Dac, DrivePattern};
+use gyroemu_am::{AmInput, AmModulator, Dac, DrivePattern, Quantizer};
+use gyroemu_core::noise::{held_white_sigma, stream_seed, NoiseRng};
 use gyroemu_core::{detmath, Complex64, ParamError, Sample, Stage};
 use gyroemu_lpf::{DecimateMode, KahanSum, LowPass, LowPassDesign};
 use gyroemu_mixer::{Iq, Stage1Mixer, Stage2Mixer};
 use gyroemu_nco::{Nco, PhaseShifter, RotatingNco};
-use gyroemu_resonator::{ModeParams, Resonator, ResonatorParams};
-use gyroemu_tia::{Tia, TiaParams};
+use gyroemu_resonator::{thermomechanical_accel_psd, ModeParams, Resonator, ResonatorParams};
+use gyroemu_tia::{input_referred_noise_a_per_rthz, Tia, TiaParams};
 
 /// At most this many lanes (the width of `f64x4`).
 pub const MAX_LANES: usize = 4;
@@ -109,7 +110,55 @@ const CORIOLIS: u8 = 0;
 const RATE_TABLE: u8 = 1;
 const ROTATING: u8 = 2;
 
+/// The seeded noise of one lane group: one stream per lane (per operating point) and the
+/// per-sample standard deviations of the force (per unit mass) and input-current sources.
+#[derive(Clone, Debug)]
+struct NoiseState<S> {
+    rng: NoiseRng,
+    sigma_force: [S; 2],
+    sigma_current: [S; 2],
+}
+
+/// A value that stopped being finite inside the chain: where and when.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("non-finite value at the output of stage `{stage}` at input sample {sample} (t = {time_s} s) of the operating point at {rate_dps} deg/s: the chain overflowed; check the drive amplitudes, the gains and the full scales")]
+pub struct NonFinite {
+    /// The first stage (in chain order) whose output was not finite.
+    pub stage: &'static str,
+    /// Input sample index from the start of the run.
+    pub sample: u64,
+    /// The same as a time, s.
+    pub time_s: f64,
+    /// The operating point's rate, deg/s.
+    pub rate_dps: f64,
+}
+
+/// Optional outputs of a run beyond each lane's average.
+#[derive(Clone, Debug, Default)]
+pub struct RunExtras {
+    /// Per lane, ascending: extra ends `(n, frac)` of the lane's boxcar window (weight 1 on
+    /// `n` samples and `frac` on the next); each yields the average as if the window ended
+    /// there (the averaging-time analysis). Needs a boxcar point window at least as long.
+    pub checkpoints: Vec<Vec<(u64, f64)>>,
+    /// Decimated samples per row of the recorded series (0: no series). Each row holds the
+    /// mean over its block of the averaged channels (after settling).
+    pub series_block: u64,
+}
+
+/// What a run returns with [`RunExtras`].
+#[derive(Clone, Debug, Default)]
+pub struct RunOutput {
+    /// Per lane: the average over the point's window.
+    pub lanes: Vec<LaneResult>,
+    /// Per lane: one result per checkpoint.
+    pub checkpoints: Vec<Vec<LaneResult>>,
+    /// Per lane: the series rows (Coriolis: I1, Q1, I2, Q2 of the low-passed stage-1 outputs;
+    /// rotating: C and S of both modes as in [`LaneResult`], 8 values).
+    pub series: Vec<Vec<[f64; 8]>>,
+}
+
 /// Per-sample work shared by every lane; all fields are built before the first sample.
+#[derive(Clone)]
 pub struct Board<S: Sample> {
     kind: ExperimentKind,
     table: bool,
@@ -133,13 +182,34 @@ pub struct Board<S: Sample> {
     mix2: Stage2Mixer<S>,
     fs_hz: f64,
     table_f_hz: f64,
+    /// Phase-shifter error on the modulation's quadrature copy (rotating runs): (cos, sin).
+    mod_shift: Option<(S, S)>,
+    noise: NoiseState<S>,
+    /// ADC after each TIA (absent: ideal).
+    adc: Option<[Quantizer<S>; 2]>,
+    /// Noise or ADC present: the sample loop takes its imperfect shape.
+    imperfect: bool,
+    /// The board as built, for locating a non-finite value by replay.
+    pristine: Option<Box<Board<S>>>,
 }
 
 impl<S: Sample> Board<S> {
     /// Builds the board for up to `S::LANES` operating points (rates in rad/s; unused lanes
-    /// repeat the last point).
+    /// repeat the last point); lane `i` draws noise stream `i`.
     pub fn new(cfg: &Config, rates_rad_s: &[f64]) -> Result<Self, ParamError> {
+        let streams: Vec<u64> = (0..rates_rad_s.len() as u64).collect();
+        Self::with_streams(cfg, rates_rad_s, &streams)
+    }
+
+    /// As [`Board::new`], with the noise stream of each lane given (a sweep passes each
+    /// point's index, so its noise does not depend on the lane group or shard that runs it).
+    pub fn with_streams(
+        cfg: &Config,
+        rates_rad_s: &[f64],
+        streams: &[u64],
+    ) -> Result<Self, ParamError> {
         assert!(!rates_rad_s.is_empty() && rates_rad_s.len() <= S::LANES);
+        assert_eq!(rates_rad_s.len(), streams.len());
         let lanes = rates_rad_s.len();
         let lane_rate = |i: usize| rates_rad_s[i.min(lanes - 1)];
         let fs = cfg.board.fs_hz;
@@ -192,7 +262,41 @@ impl<S: Sample> Board<S> {
                 "must be an integer >= 1",
             ));
         }
-        Ok(Self {
+        let seed = cfg.noise.as_ref().map_or(0, |n| n.seed);
+        let lane_stream = |i: usize| streams[i.min(lanes - 1)];
+        let rng = NoiseRng::new(core::array::from_fn(|i| stream_seed(seed, lane_stream(i))));
+        let f0 = [params.mode1.f0_hz, params.mode2.f0_hz];
+        let q = [params.mode1.q, params.mode2.q];
+        let (sigma_force, sigma_current) = match &cfg.noise {
+            None => ([0.0; 2], [0.0; 2]),
+            Some(n) => {
+                let force = core::array::from_fn(|k| {
+                    n.effective_mass_kg.map_or(0.0, |m| {
+                        let psd = thermomechanical_accel_psd(n.temperature_k, m, f0[k], q[k]);
+                        held_white_sigma(psd, fs, f0[k])
+                    })
+                });
+                let i_n = input_referred_noise_a_per_rthz(
+                    n.tia_current_noise_a_per_rthz,
+                    n.tia_voltage_noise_v_per_rthz,
+                    cfg.board.tia_gain_ohm,
+                );
+                let current = core::array::from_fn(|k| held_white_sigma(i_n * i_n, fs, f0[k]));
+                (force, current)
+            }
+        };
+        let adc = match cfg.board.adc_bits {
+            None => None,
+            Some(b) => {
+                let q = Quantizer::new(b, cfg.board.adc_full_scale_v)?;
+                Some([q, q])
+            }
+        };
+        let imperfect = cfg.noise.is_some() || adc.is_some();
+        let eps = cfg.board.phase_shifter_error_deg.to_radians();
+        let mod_shift = (kind == ExperimentKind::Rotating && eps != 0.0)
+            .then(|| (S::splat(eps.cos()), S::splat(eps.sin())));
+        let mut board = Self {
             kind,
             table,
             lanes,
@@ -211,7 +315,18 @@ impl<S: Sample> Board<S> {
             mix2: Stage2Mixer::default(),
             fs_hz: fs,
             table_f_hz,
-        })
+            mod_shift,
+            noise: NoiseState {
+                rng,
+                sigma_force: sigma_force.map(S::splat),
+                sigma_current: sigma_current.map(S::splat),
+            },
+            adc,
+            imperfect,
+            pristine: None,
+        };
+        board.pristine = Some(Box::new(board.clone()));
+        Ok(board)
     }
 
     /// Runs `n_settle` decimated samples of settling, then averages each lane over its window.
@@ -222,28 +337,99 @@ impl<S: Sample> Board<S> {
         points: &[Point],
         probe: Option<&mut Probe>,
         progress: &(dyn Fn(u64) + Sync),
-    ) -> Vec<LaneResult> {
-        match (self.kind, self.table) {
-            (ExperimentKind::Coriolis, false) => {
-                self.run_kind::<CORIOLIS>(n_settle, points, probe, progress)
-            }
-            (ExperimentKind::Coriolis, true) => {
-                self.run_kind::<RATE_TABLE>(n_settle, points, probe, progress)
-            }
-            (ExperimentKind::Rotating, _) => {
-                self.run_kind::<ROTATING>(n_settle, points, probe, progress)
-            }
-        }
+    ) -> Result<Vec<LaneResult>, NonFinite> {
+        let extras = RunExtras::default();
+        Ok(self
+            .run_with(n_settle, points, probe, &extras, progress)?
+            .lanes)
     }
 
+    /// [`Board::run`] with checkpoints and a recorded series.
+    pub fn run_with(
+        &mut self,
+        n_settle: u64,
+        points: &[Point],
+        probe: Option<&mut Probe>,
+        extras: &RunExtras,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<RunOutput, NonFinite> {
+        let r = match (self.kind, self.table, self.imperfect) {
+            (ExperimentKind::Coriolis, false, false) => {
+                self.run_kind::<CORIOLIS, false>(n_settle, points, probe, extras, progress)
+            }
+            (ExperimentKind::Coriolis, false, true) => {
+                self.run_kind::<CORIOLIS, true>(n_settle, points, probe, extras, progress)
+            }
+            (ExperimentKind::Coriolis, true, false) => {
+                self.run_kind::<RATE_TABLE, false>(n_settle, points, probe, extras, progress)
+            }
+            (ExperimentKind::Coriolis, true, true) => {
+                self.run_kind::<RATE_TABLE, true>(n_settle, points, probe, extras, progress)
+            }
+            (ExperimentKind::Rotating, _, false) => {
+                self.run_kind::<ROTATING, false>(n_settle, points, probe, extras, progress)
+            }
+            (ExperimentKind::Rotating, _, true) => {
+                self.run_kind::<ROTATING, true>(n_settle, points, probe, extras, progress)
+            }
+        };
+        r.map_err(|k| self.locate_fault(k))
+    }
+
+    /// Replays the run from the board as built, checking every stage's output on every
+    /// sample up to block `k_bad` (where the decimated output stopped being finite), and
+    /// names the first stage and sample that went non-finite.
+    #[cold]
+    fn locate_fault(&self, k_bad: u64) -> NonFinite {
+        let m = self.decimation as u64;
+        let rate_dps = |lane: usize| self.rate.lane(lane).to_degrees();
+        let fallback = NonFinite {
+            stage: "lowpass",
+            sample: k_bad * m + m - 1,
+            time_s: (k_bad * m + m - 1) as f64 / self.fs_hz,
+            rate_dps: rate_dps(0),
+        };
+        let Some(pristine) = &self.pristine else {
+            return fallback;
+        };
+        let mut board = (**pristine).clone();
+        let mut probe = Probe::finite_check(self.lanes);
+        for k in 0..=k_bad {
+            let n0 = k * m;
+            match (self.kind, self.table) {
+                (ExperimentKind::Coriolis, false) => {
+                    board.block::<CORIOLIS, true>(n0, Some(&mut probe));
+                }
+                (ExperimentKind::Coriolis, true) => {
+                    board.block::<RATE_TABLE, true>(n0, Some(&mut probe));
+                }
+                (ExperimentKind::Rotating, _) => {
+                    board.block::<ROTATING, true>(n0, Some(&mut probe));
+                }
+            }
+            if let Some((stage, sample, lane)) = probe.fault() {
+                return NonFinite {
+                    stage,
+                    sample,
+                    time_s: sample as f64 / self.fs_hz,
+                    rate_dps: rate_dps(lane),
+                };
+            }
+        }
+        fallback
+    }
+
+    /// The sample loop of one experiment shape. Returns the decimated index at which an
+    /// output stopped being finite, if one did.
     #[allow(clippy::needless_range_loop)] // mode and lane indices address parallel arrays
-    fn run_kind<const K: u8>(
+    fn run_kind<const K: u8, const NZ: bool>(
         &mut self,
         n_settle: u64,
         points: &[Point],
         mut probe: Option<&mut Probe>,
+        extras: &RunExtras,
         progress: &(dyn Fn(u64) + Sync),
-    ) -> Vec<LaneResult> {
+    ) -> Result<RunOutput, u64> {
         let lanes = self.lanes;
         let m = self.decimation as u64;
         let n_out = n_settle + points.iter().map(|p| p.n_avg + 1).max().unwrap_or(1);
@@ -252,13 +438,20 @@ impl<S: Sample> Board<S> {
         let mut prev_z = [Iq::<S>::default(); 2];
         let mut unwrapped = [S::splat(0.0); 2];
         let report_every = (65_536 / m).max(1);
+        let mut ck_next = [0usize; MAX_LANES];
+        let mut ck_out: Vec<Vec<LaneResult>> = vec![Vec::new(); lanes];
+        let mut series: Vec<Vec<[f64; 8]>> = vec![Vec::new(); lanes];
+        let mut series_acc = [S::splat(0.0); 8];
         for k in 0..n_out {
             let n0 = k * m;
             // The recording path only for blocks that touch the dump window.
             let (z, r) = match probe.as_deref_mut() {
-                Some(p) if p.wants_block(n0, m) => self.block::<K>(n0, Some(p)),
-                _ => self.block::<K>(n0, None),
+                Some(p) if p.wants_block(n0, m) => self.block::<K, NZ>(n0, Some(p)),
+                _ => self.block::<K, NZ>(n0, None),
             };
+            if !(z[0].i + z[0].q + z[1].i + z[1].q).all_finite() {
+                return Err(k);
+            }
             if let Some(p) = probe.as_deref_mut() {
                 p.record_decimated(k, &z, &r, self.kind);
             }
@@ -270,15 +463,13 @@ impl<S: Sample> Board<S> {
                 continue;
             }
             let j = k - n_settle;
-            let w = S::from_fn(|i| window_weight(j, &points[i.min(lanes - 1)]));
-            for i in 0..lanes {
-                weight_sum[i] += w.lane(i);
-            }
+            // This sample's value of every averaged channel, unweighted.
+            let mut x = [S::splat(0.0); 8];
             match K {
                 CORIOLIS => {
                     for md in 0..2 {
-                        acc.ch[2 * md].add(w * z[md].i);
-                        acc.ch[2 * md + 1].add(w * z[md].q);
+                        x[2 * md] = z[md].i;
+                        x[2 * md + 1] = z[md].q;
                     }
                 }
                 RATE_TABLE => {
@@ -294,53 +485,76 @@ impl<S: Sample> Board<S> {
                             (b * a.conj()).arg()
                         });
                         unwrapped[md] += d;
-                        acc.ch[2 * md].add(w * unwrapped[md] * S::splat(2.0 * tc));
-                        acc.ch[2 * md + 1].add(w * unwrapped[md] * S::splat(-2.0 * ts));
+                        x[2 * md] = unwrapped[md] * S::splat(2.0 * tc);
+                        x[2 * md + 1] = unwrapped[md] * S::splat(-2.0 * ts);
                     }
                     prev_z = z;
                 }
                 _ => {
                     for (base, zm) in [(0, z[0]), (4, z[1])] {
                         let o = self.mix2.tick((zm, r));
-                        acc.ch[base].add(w * o.c.i);
-                        acc.ch[base + 1].add(w * o.c.q);
-                        acc.ch[base + 2].add(w * o.s.i);
-                        acc.ch[base + 3].add(w * o.s.q);
+                        x[base] = o.c.i;
+                        x[base + 1] = o.c.q;
+                        x[base + 2] = o.s.i;
+                        x[base + 3] = o.s.q;
                     }
                 }
             }
+            for (i, cks) in extras.checkpoints.iter().enumerate().take(lanes) {
+                while let Some(&(n, frac)) = cks.get(ck_next[i]) {
+                    if n != j {
+                        break;
+                    }
+                    let v: [f64; 8] = core::array::from_fn(|c| {
+                        (acc.ch[c].value().lane(i) + frac * x[c].lane(i)) / (n as f64 + frac)
+                    });
+                    ck_out[i].push(lane_result::<K>(&v));
+                    ck_next[i] += 1;
+                }
+            }
+            if extras.series_block > 0 {
+                for c in 0..8 {
+                    series_acc[c] += x[c];
+                }
+                if (j + 1).is_multiple_of(extras.series_block) {
+                    let scale = 1.0 / extras.series_block as f64;
+                    for (i, rows) in series.iter_mut().enumerate() {
+                        rows.push(core::array::from_fn(|c| series_acc[c].lane(i) * scale));
+                    }
+                    series_acc = [S::splat(0.0); 8];
+                }
+            }
+            let w = S::from_fn(|i| window_weight(j, &points[i.min(lanes - 1)]));
+            for i in 0..lanes {
+                weight_sum[i] += w.lane(i);
+            }
+            let used = if K == ROTATING { 8 } else { 4 };
+            for c in 0..used {
+                acc.ch[c].add(w * x[c]);
+            }
         }
         progress(n_out * m);
-        (0..lanes)
+        let lanes_out = (0..lanes)
             .map(|i| {
-                let v = |c: usize| acc.ch[c].value().lane(i) / weight_sum[i];
-                let ph = |c: usize| Complex64::new(v(c), v(c + 1));
-                match K {
-                    CORIOLIS => LaneResult {
-                        z: [ph(0), ph(2)],
-                        ..Default::default()
-                    },
-                    RATE_TABLE => LaneResult {
-                        table_phase: [ph(0), ph(2)],
-                        ..Default::default()
-                    },
-                    _ => LaneResult {
-                        c: [ph(0), ph(4)],
-                        s: [ph(2), ph(6)],
-                        ..Default::default()
-                    },
-                }
+                let v: [f64; 8] =
+                    core::array::from_fn(|c| acc.ch[c].value().lane(i) / weight_sum[i]);
+                lane_result::<K>(&v)
             })
-            .collect()
+            .collect();
+        Ok(RunOutput {
+            lanes: lanes_out,
+            checkpoints: ck_out,
+            series,
+        })
     }
 
     /// One decimation block of input samples `n0 .. n0 + M` through the whole chain, fused
     /// (every stage on every sample, no buffers: a two-pass variant through an L1 buffer
     /// measured 17 % slower). Returns the low-passed stage-1 outputs at the block's last
     /// sample (the decimated output) and the modulation references (cos, sin of Omega t)
-    /// at that same sample.
+    /// at that same sample. `NZ`: the noise sources and the ADC are in the chain.
     #[inline(always)]
-    fn block<const K: u8>(
+    fn block<const K: u8, const NZ: bool>(
         &mut self,
         n0: u64,
         mut probe: Option<&mut Probe>,
@@ -355,23 +569,46 @@ impl<S: Sample> Board<S> {
             } else {
                 (zero, zero)
             };
+            // The drive's quadrature copy passes the (imperfect) phase shifter:
+            // sin(Omega t - eps); the stage-2 references stay exact.
+            let drive_sin = match self.mod_shift {
+                Some((ce, se)) if K == ROTATING => mod_sin * ce - mod_cos * se,
+                _ => mod_sin,
+            };
             let drive = self.am.tick(AmInput {
                 carrier_i: S::splat(c_re),
                 carrier_q: S::splat(cq),
                 mod_cos,
-                mod_sin,
+                mod_sin: drive_sin,
             });
-            let u = [self.dac[0].tick(drive[0]), self.dac[1].tick(drive[1])];
-            let p = if K == RATE_TABLE {
+            let mut u = [self.dac[0].tick(drive[0]), self.dac[1].tick(drive[1])];
+            if NZ {
+                // Brownian force on each mode, after the DAC (it acts on the proof mass).
+                let (a, b) = self.noise.rng.normal_pair();
+                u[0] = S::from_x4(a).mul_add(self.noise.sigma_force[0], u[0]);
+                u[1] = S::from_x4(b).mul_add(self.noise.sigma_force[1], u[1]);
+            }
+            let mut p = if K == RATE_TABLE {
                 let (_, sin_t) = self.table_nco.tick(());
                 self.plant.tick_with_rate(u, self.rate * S::splat(sin_t))
             } else {
                 self.plant.tick(u)
             };
-            let y = [
+            if NZ {
+                // Amplifier noise, referred to the TIA input.
+                let (a, b) = self.noise.rng.normal_pair();
+                p.current[0] = S::from_x4(a).mul_add(self.noise.sigma_current[0], p.current[0]);
+                p.current[1] = S::from_x4(b).mul_add(self.noise.sigma_current[1], p.current[1]);
+            }
+            let mut y = [
                 self.tia[0].tick(p.current[0]),
                 self.tia[1].tick(p.current[1]),
             ];
+            if NZ {
+                if let Some(adc) = &self.adc {
+                    y = [adc[0].quantize(y[0]), adc[1].quantize(y[1])];
+                }
+            }
             let carrier = Complex64::new(c_re, c_im);
             let z = [
                 self.mix1[0].tick((y[0], carrier)),
@@ -385,8 +622,31 @@ impl<S: Sample> Board<S> {
             let i2 = self.lp[2].tick(z[1].i);
             let q2 = self.lp[3].tick(z[1].q);
             out = ([Iq::new(i1, q1), Iq::new(i2, q2)], [mod_cos, mod_sin]);
+            if let Some(pr) = probe.as_deref_mut() {
+                pr.check_lowpass(n0 + j, &out.0);
+            }
         }
         out
+    }
+}
+
+/// A lane's averaged channels as the result of its experiment shape.
+fn lane_result<const K: u8>(v: &[f64; 8]) -> LaneResult {
+    let ph = |c: usize| Complex64::new(v[c], v[c + 1]);
+    match K {
+        CORIOLIS => LaneResult {
+            z: [ph(0), ph(2)],
+            ..Default::default()
+        },
+        RATE_TABLE => LaneResult {
+            table_phase: [ph(0), ph(2)],
+            ..Default::default()
+        },
+        _ => LaneResult {
+            c: [ph(0), ph(4)],
+            s: [ph(2), ph(6)],
+            ..Default::default()
+        },
     }
 }
 

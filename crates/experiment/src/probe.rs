@@ -16,6 +16,10 @@ pub struct Probe {
     full: SignalRecorder,
     decimated: SignalRecorder,
     full_window: (u64, u64),
+    /// Finite-check mode (locating a non-finite value): every lane of every node is checked
+    /// and the first fault kept as (stage, input sample, lane); nothing is recorded.
+    check_lanes: usize,
+    fault: Option<(&'static str, u64, usize)>,
 }
 
 const FULL_NODES: [(&str, [&str; 4]); 5] = [
@@ -84,12 +88,56 @@ impl Probe {
             // Decimated sample k is formed at input sample kM + M - 1.
             decimated: SignalRecorder::new(names(&dec_table, 5), fs_out, start_out, len_out)
                 .with_time_origin((decimation - 1) as f64 / fs_hz),
+            check_lanes: 0,
+            fault: None,
+        }
+    }
+
+    /// A probe that records nothing and checks that every node of the first `lanes` lanes
+    /// stays finite (the replay that names the stage where a run overflowed).
+    pub fn finite_check(lanes: usize) -> Self {
+        Self {
+            lane: 0,
+            nodes: [false; 7],
+            full: SignalRecorder::new(Vec::new(), 1.0, 0, 0),
+            decimated: SignalRecorder::new(Vec::new(), 1.0, 0, 0),
+            full_window: (0, 0),
+            check_lanes: lanes,
+            fault: None,
+        }
+    }
+
+    /// The first non-finite node found in finite-check mode: (stage, input sample, lane).
+    pub fn fault(&self) -> Option<(&'static str, u64, usize)> {
+        self.fault
+    }
+
+    fn check<S: Sample>(&mut self, stage: &'static str, n: u64, values: &[S]) {
+        if self.fault.is_some() {
+            return;
+        }
+        for lane in 0..self.check_lanes {
+            if values.iter().any(|v| !v.lane(lane).is_finite()) {
+                self.fault = Some((stage, n, lane));
+                return;
+            }
+        }
+    }
+
+    /// Checks the low-pass outputs of input sample `n` (finite-check mode only).
+    #[inline]
+    pub fn check_lowpass<S: Sample>(&mut self, n: u64, z: &[Iq<S>; 2]) {
+        if self.check_lanes > 0 {
+            self.check("lowpass", n, &[z[0].i, z[0].q, z[1].i, z[1].q]);
         }
     }
 
     /// Whether input samples `n0 .. n0 + m` touch the full-rate window.
     #[inline]
     pub fn wants_block(&self, n0: u64, m: u64) -> bool {
+        if self.check_lanes > 0 {
+            return true;
+        }
         let (start, len) = self.full_window;
         !self.full.names().is_empty() && n0 < start.saturating_add(len) && n0 + m > start
     }
@@ -104,6 +152,15 @@ impl Probe {
         y: &[S; 2],
         z: &[Iq<S>; 2],
     ) {
+        if self.check_lanes > 0 {
+            // Chain order, so the first stage that overflowed is the one named.
+            self.check("am/dac (drive)", n, u);
+            self.check("resonator", n, &[p.q[0], p.q[1], p.v[0], p.v[1]]);
+            self.check("resonator (motional current)", n, &p.current);
+            self.check("tia/adc", n, y);
+            self.check("mixer (stage 1)", n, &[z[0].i, z[0].q, z[1].i, z[1].q]);
+            return;
+        }
         if self.full.names().is_empty() || !self.full.wants(n) {
             return;
         }

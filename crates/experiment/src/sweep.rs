@@ -4,7 +4,8 @@
 //! chain terms, and puts the exact theory beside each result.
 
 use crate::board::{
-    decimator_mode, resonator_params, tia_params, Board, LaneResult, Point, PointWindow, MAX_LANES,
+    decimator_mode, resonator_params, tia_params, Board, LaneResult, NonFinite, Point,
+    PointWindow, MAX_LANES,
 };
 use crate::config::{Config, ExperimentKind, RateTable, WindowKind};
 use crate::fit::{fit_line, LineFit};
@@ -172,11 +173,14 @@ pub fn run_sweep(
     });
     // Build every board first, so a bad parameter fails before any sample is computed.
     let mut boards = Vec::with_capacity(groups.len());
-    for g in &groups {
+    for (gi, g) in groups.iter().enumerate() {
         let r: Vec<f64> = g.iter().map(|p| p.rate_rad_s).collect();
-        boards.push(Board::<f64x4>::new(cfg, &r)?);
+        // Each point draws the noise stream of its index in the emulated rates.
+        let streams: Vec<u64> = (0..g.len()).map(|i| (gi * MAX_LANES + i) as u64).collect();
+        boards.push(Board::<f64x4>::with_streams(cfg, &r, &streams)?);
     }
-    let outcomes: Vec<(Vec<LaneResult>, Option<Probe>)> = boards
+    type Outcome = (Result<Vec<LaneResult>, NonFinite>, Option<Probe>);
+    let outcomes: Vec<Outcome> = boards
         .into_par_iter()
         .zip(groups.par_iter())
         .enumerate()
@@ -205,6 +209,7 @@ pub fn run_sweep(
         .collect();
     let mut lane_results = Vec::with_capacity(points.len());
     for (res, probe) in outcomes {
+        let res = res?;
         if let (Some(p), Some(dir)) = (probe, dump_dir) {
             p.write(dir, "dump")
                 .map_err(|e| SweepError::Output(e.to_string()))?;
@@ -230,6 +235,8 @@ pub enum SweepError {
     Param(#[from] ParamError),
     #[error("writing the signal dump failed: {0}")]
     Output(String),
+    #[error(transparent)]
+    NonFinite(#[from] NonFinite),
 }
 
 fn is_ideal(cfg: &Config) -> bool {
@@ -268,7 +275,9 @@ fn coriolis_theory_rad(cfg: &Config, omega: f64) -> [f64; 2] {
 /// Exact rotating-excitation psi per mode: the closed form for an ideal device; otherwise the
 /// major-axis estimator applied to the continuous-time velocity phasors of the imperfect plant
 /// at the two sidebands w0 +- Omega (drive sidebands F1/2, F1/2 on mode 1 and -j F2/2, +j F2/2
-/// on mode 2), psi_k = (arg(V_k(-)/M-) - arg(V_k(+)/M+))/2 as in THEORY.md section 6.
+/// on mode 2), psi_k = (arg(V_k(-)/M-) - arg(V_k(+)/M+))/2 as in THEORY.md section 6. A
+/// phase-shifter error eps makes the mode-2 modulation sin(Omega t - eps), which turns its
+/// sidebands by e^{-+j eps}.
 fn rotating_theory_rad(cfg: &Config, omega: f64) -> [f64; 2] {
     let d = &cfg.device;
     if is_ideal(cfg) || omega == 0.0 {
@@ -278,8 +287,10 @@ fn rotating_theory_rad(cfg: &Config, omega: f64) -> [f64; 2] {
     let fm = omega / core::f64::consts::TAU;
     let (f1, f2) = (cfg.drive.f1, cfg.drive.f2);
     let j = Complex64::new(0.0, 1.0);
+    let eps = cfg.board.phase_shifter_error_deg * DEG;
     let v = |sign: f64| {
-        let force = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2];
+        let turn = Complex64::from_polar(1.0, -sign * eps);
+        let force = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
         continuous_steady_state(&p, 0.0, d.f0_hz + sign * fm, force)
     };
     let (vp, vm) = (v(1.0), v(-1.0));

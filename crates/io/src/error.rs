@@ -98,6 +98,14 @@ pub enum IoError {
         /// Largest admissible sample byte count.
         limit_bytes: u64,
     },
+    /// The SigMF request is malformed (no channels, unequal lengths, bad rate, names not matching).
+    #[error("cannot write SigMF recording {}: {reason}", .path.display())]
+    SigmfInvalid {
+        /// Requested data file (`<stem>.sigmf-data`).
+        path: PathBuf,
+        /// What is wrong with the request.
+        reason: String,
+    },
     /// A caller-supplied producer (e.g. a PNG renderer) failed while filling the temporary file.
     #[error("cannot produce {}: {source}", .path.display())]
     Producer {

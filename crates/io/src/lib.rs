@@ -1,15 +1,17 @@
-//! Outputs: atomic file writes, CSV, JSON, multichannel WAV and windowed signal dumps.
+//! Outputs: atomic file writes, CSV, JSON, multichannel WAV, SigMF and windowed signal dumps.
 //!
 //! Every writer goes through a hidden temporary file in the target's directory that is flushed,
 //! fsynced and renamed over the target, so a crash or error never leaves a half-written file
 //! under the final name. Formats are chosen to open with one line of Python:
-//! `pandas.read_csv`, `json.load`, `soundfile.read`.
+//! `pandas.read_csv`, `json.load`, `soundfile.read`, `sigmf.sigmffile.fromfile` (or
+//! `numpy.fromfile(.., dtype="<f8")`).
 
 mod atomic;
 mod csv_table;
 mod error;
 mod json;
 mod recorder;
+mod sigmf;
 mod wav;
 
 pub use atomic::{write_atomic, write_atomic_via};
@@ -17,4 +19,8 @@ pub use csv_table::{format_f64, write_csv, CsvCell, CsvTable};
 pub use error::IoError;
 pub use json::write_json;
 pub use recorder::SignalRecorder;
+pub use sigmf::{
+    write_sigmf, SigmfChannel, SigmfFiles, SigmfMeta, DEFAULT_HW, GYROEMU_EXTENSION_VERSION,
+    SIGMF_DATATYPE_REAL_F64, SIGMF_VERSION,
+};
 pub use wav::{check_wav_f32_size, write_wav_f32, WAV_F32_HEADER_BYTES, WAV_F32_MAX_DATA_BYTES};

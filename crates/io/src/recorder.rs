@@ -3,6 +3,9 @@
 
 use crate::atomic::atomic_stream;
 use crate::csv_table::CsvSink;
+use crate::sigmf::{
+    check_request, unit_from_name, write_sigmf_frames, SigmfChannel, SigmfMeta, DEFAULT_HW,
+};
 use crate::wav::{check_wav_f32_size, write_interleaved};
 use crate::IoError;
 use std::path::Path;
@@ -102,11 +105,17 @@ impl SignalRecorder {
         self.data.iter().skip(k).step_by(ch).copied().collect()
     }
 
-    /// Writes `<dir>/<stem>.csv` (columns `sample`, `time_s`, then one per name; exact float
-    /// text) and `<dir>/<stem>.wav` (one 32-bit float channel per name at round(fs_hz) Hz),
-    /// both atomically. WAV values are the raw signals, not normalised, so they may exceed +-1:
-    /// read them with `soundfile.read(path)` or `scipy.io.wavfile.read(path)`, not an audio player.
-    /// The WAV size is checked before either file is written.
+    /// Writes, each atomically:
+    /// - `<dir>/<stem>.csv` (columns `sample`, `time_s`, then one per name; exact float text);
+    /// - `<dir>/<stem>.wav` (one 32-bit float channel per name at round(fs_hz) Hz). WAV values
+    ///   are the raw signals, not normalised, so they may exceed +-1: read them with
+    ///   `soundfile.read(path)` or `scipy.io.wavfile.read(path)`, not an audio player;
+    /// - `<dir>/<stem>.sigmf-data` + `<dir>/<stem>.sigmf-meta` (SigMF 1.2.0, `rf64_le`, full
+    ///   f64 precision at the exact fs_hz; capture `core:global_index` = first sample index,
+    ///   `gyroemu:t0_s` = time origin, `gyroemu:channels` = names with units read from their
+    ///   suffixes): `np.fromfile(path, dtype="<f8").reshape(-1, n_channels)`.
+    ///
+    /// The WAV size and the SigMF request are checked before any file is written.
     pub fn write(&self, dir: &Path, stem: &str) -> Result<(), IoError> {
         let csv_path = dir.join(format!("{stem}.csv"));
         let wav_path = dir.join(format!("{stem}.wav"));
@@ -124,6 +133,8 @@ impl SignalRecorder {
         let ch = self.names.len();
         let frames = self.len();
         check_wav_f32_size(&wav_path, rate, ch as u64, frames as u64)?;
+        let meta = self.sigmf_meta(stem);
+        check_request(&dir.join(format!("{stem}.sigmf-data")), &meta, ch)?;
 
         let mut headers = vec!["sample".to_string(), "time_s".to_string()];
         headers.extend(self.names.iter().cloned());
@@ -140,6 +151,31 @@ impl SignalRecorder {
             }
             sink.finish()
         })?;
-        write_interleaved(&wav_path, rate, ch, frames, |i, k| self.data[i * ch + k])
+        write_interleaved(&wav_path, rate, ch, frames, |i, k| self.data[i * ch + k])?;
+        write_sigmf_frames(dir, stem, &meta, ch, frames, |i, k| self.data[i * ch + k])?;
+        Ok(())
+    }
+
+    /// SigMF description of this recorder's dump `stem`.
+    fn sigmf_meta(&self, stem: &str) -> SigmfMeta {
+        SigmfMeta {
+            sample_rate_hz: self.fs_hz,
+            channels: self
+                .names
+                .iter()
+                .map(|n| SigmfChannel {
+                    name: n.clone(),
+                    unit: unit_from_name(n).to_string(),
+                })
+                .collect(),
+            description: format!(
+                "gyroemu signal dump {stem}: {} frame(s) from sample index {}",
+                self.len(),
+                self.start
+            ),
+            hw: DEFAULT_HW.to_string(),
+            global_index: self.start,
+            t0_s: self.t0_s,
+        }
     }
 }

@@ -132,7 +132,10 @@ fn recorder_keeps_exactly_the_window() {
 
     let dir = tempfile::tempdir().unwrap();
     r.write(dir.path(), "dump").unwrap();
-    assert_eq!(entries(dir.path()), vec!["dump.csv", "dump.wav"]);
+    assert_eq!(
+        entries(dir.path()),
+        vec!["dump.csv", "dump.sigmf-data", "dump.sigmf-meta", "dump.wav"]
+    );
 
     let mut rd = csv::Reader::from_path(dir.path().join("dump.csv")).unwrap();
     let hdr: Vec<String> = rd.headers().unwrap().iter().map(String::from).collect();

@@ -16,10 +16,12 @@ mod discretise;
 mod params;
 mod plant;
 mod steady;
+mod thermal;
 
 pub use params::{ModeParams, ResonatorParams};
 pub use plant::{PlantOutput, Resonator};
 pub use steady::continuous_steady_state;
+pub use thermal::{thermomechanical_accel_psd, thermomechanical_force_psd};
 
 /// Stage name used in every [`gyroemu_core::ParamError`] of this crate.
 pub const STAGE: &str = "resonator";

@@ -7,3 +7,6 @@
 mod tia;
 
 pub use tia::{Tia, TiaParams};
+
+mod noise;
+pub use noise::input_referred_noise_a_per_rthz;
