@@ -183,12 +183,18 @@ mod tests {
         let lag1 = xs.windows(2).map(|w| w[0] * w[1]).sum::<f64>() / n;
         assert!(mean.abs() < 5.0 / n.sqrt(), "mean {mean}");
         assert!((var - 1.0).abs() < 5.0 * (2.0 / n).sqrt(), "var {var}");
-        assert!((kurt - 3.0).abs() < 5.0 * (24.0 / n).sqrt(), "kurtosis {kurt}");
+        assert!(
+            (kurt - 3.0).abs() < 5.0 * (24.0 / n).sqrt(),
+            "kurtosis {kurt}"
+        );
         assert!(lag1.abs() < 5.0 / n.sqrt(), "lag-1 correlation {lag1}");
         // Tail: P(|x| > 3) = 0.0026998 (erfc(3/sqrt 2)); binomial sigma.
         let tail = xs.iter().filter(|x| x.abs() > 3.0).count() as f64 / n;
         let p = 0.002_699_796;
-        assert!((tail - p).abs() < 5.0 * (p * (1.0 - p) / n).sqrt(), "tail {tail}");
+        assert!(
+            (tail - p).abs() < 5.0 * (p * (1.0 - p) / n).sqrt(),
+            "tail {tail}"
+        );
     }
 
     #[test]

@@ -4,8 +4,8 @@
 //! chain terms, and puts the exact theory beside each result.
 
 use crate::board::{
-    decimator_mode, resonator_params, tia_params, Board, LaneResult, NonFinite, Point,
-    PointWindow, MAX_LANES,
+    decimator_mode, resonator_params, tia_params, Board, LaneResult, NonFinite, Point, PointWindow,
+    MAX_LANES,
 };
 use crate::config::{Config, ExperimentKind, RateTable, WindowKind};
 use crate::fit::{fit_line, LineFit};
