@@ -325,8 +325,10 @@ pub fn theory_deg(cfg: &Config, rate_dps: f64) -> [f64; 2] {
     rad.map(|r| r / DEG)
 }
 
+/// Turns each emulated point's lane averages into phases, compensation, theory and fits (the
+/// `samples` and rate fields of the result are left for the caller).
 #[allow(clippy::needless_range_loop)] // mode indices address parallel arrays
-fn post_process(
+pub fn post_process(
     cfg: &Config,
     rates: &[f64],
     points: &[Point],
