@@ -23,8 +23,19 @@ impl ConfigError {
         Self {
             location: None,
             key: Some(key.to_string()),
-            detail: format!(" = {value}: {rule}"),
+            detail: format!(" = {}: {rule}", readable(value.to_string())),
         }
+    }
+}
+
+/// A number as the user would write it: very large or very small magnitudes in exponent
+/// form (`1e300`, `-1e-9`) instead of hundreds of digits; anything else unchanged.
+fn readable(value: String) -> String {
+    match value.parse::<f64>() {
+        Ok(x) if x.is_finite() && x != 0.0 && !(1e-5..1e16).contains(&x.abs()) => {
+            format!("{x:e}")
+        }
+        _ => value,
     }
 }
 
@@ -38,19 +49,86 @@ pub fn parse_config(text: &str) -> Result<Config, ConfigError> {
         });
     }
     toml::from_str::<Config>(text).map_err(|e| {
-        let location = e.span().map(|s| {
-            let before = &text[..s.start.min(text.len())];
-            let line = before.matches('\n').count() + 1;
-            let col = before.len() - before.rfind('\n').map(|i| i + 1).unwrap_or(0) + 1;
-            format!("line {line}, column {col}")
-        });
+        let message = e.message().trim().to_string();
+        let Some(span) = e.span() else {
+            return ConfigError {
+                location: None,
+                key: None,
+                detail: message,
+            };
+        };
+        let start = floor_char_boundary(text, span.start);
+        let before = &text[..start];
+        let line = before.matches('\n').count() + 1;
+        let col = before[before.rfind('\n').map(|i| i + 1).unwrap_or(0)..]
+            .chars()
+            .count()
+            + 1;
         ConfigError {
-            location,
-            key: None,
-            detail: e.message().trim().to_string(),
+            location: Some(format!("line {line}, column {col}")),
+            key: Some(key_at(text, start, &message)),
+            detail: format!(": {message}"),
         }
     })
 }
+
+/// The largest char boundary at or below `i` (TOML spans are byte offsets).
+fn floor_char_boundary(text: &str, i: usize) -> usize {
+    let mut i = i.min(text.len());
+    while !text.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
+}
+
+/// The dotted key a TOML error at byte `offset` is about: the table header above it plus the
+/// key of its line (or of the nearest `key =` line above, for a multi-line value), or the
+/// field a "missing field" / "unknown field" message names. Best effort: it only labels
+/// the message, the line and column stay exact.
+fn key_at(text: &str, offset: usize, message: &str) -> String {
+    let mut table = String::new();
+    let mut key = None;
+    let mut on_header = false;
+    let mut line_start = 0;
+    for raw in text.split_inclusive('\n') {
+        if line_start > offset {
+            break;
+        }
+        let l = raw.split('#').next().unwrap_or("").trim();
+        on_header = l.starts_with('[');
+        if on_header {
+            table = l.trim_matches(|c| c == '[' || c == ']').trim().to_string();
+            key = None;
+        } else if let Some((k, _)) = l.split_once('=') {
+            let k = k.trim().trim_matches('"');
+            if !k.is_empty() && !k.contains(char::is_whitespace) {
+                key = Some(k.to_string());
+            }
+        }
+        line_start += raw.len();
+    }
+    let named = ["missing field `", "unknown field `"]
+        .iter()
+        .find_map(|p| message.strip_prefix(p))
+        .and_then(|rest| rest.split('`').next())
+        .map(str::to_string);
+    // A missing field's span is its table, so the key is the table's child.
+    let leaf = named.or(key);
+    // An unknown table is reported at its own header: the key is the table itself.
+    if on_header && leaf.as_deref() == table.rsplit('.').next() {
+        return table;
+    }
+    match (table.is_empty(), leaf) {
+        (true, Some(k)) => k,
+        (false, Some(k)) => format!("{table}.{k}"),
+        (false, None) => table,
+        (true, None) => "(top level)".into(),
+    }
+}
+
+/// Most input samples one operating point may run: 2^53, so every sample index and count
+/// is exact as an f64.
+pub const MAX_RUN_SAMPLES: f64 = 9_007_199_254_740_992.0;
 
 fn check(
     ok: bool,
@@ -188,6 +266,16 @@ impl Config {
             b.lpf_cutoff_hz,
             "must be below f0_hz so the low-pass removes the 2*f0 mixing product",
         )?;
+        // The design itself: f64 must realise it with its poles inside the unit circle.
+        gyroemu_lpf::LowPass::<f64>::new(crate::board::lowpass_design(self), b.fs_hz).map_err(
+            |e| {
+                ConfigError::key(
+                    "board.lpf_cutoff_hz",
+                    b.lpf_cutoff_hz,
+                    format!("the stage-1 low-pass cannot be built: {}", e.rule),
+                )
+            },
+        )?;
         if let Some(bits) = b.dac_bits {
             check(
                 (2..=32).contains(&bits),
@@ -248,6 +336,21 @@ impl Config {
             &format!(
                 "must cover at least one output sample period ({} s)",
                 1.0 / self.fs_out_hz()
+            ),
+        )?;
+        // Sample indices and counts must stay exact in f64 (and far from u64 overflow).
+        let run_samples = (self.settle_s() + e.average_s) * b.fs_hz;
+        check(
+            run_samples <= MAX_RUN_SAMPLES,
+            if e.settle_s.is_some_and(|s| s > e.average_s) {
+                "experiment.settle_s"
+            } else {
+                "experiment.average_s"
+            },
+            e.settle_s.filter(|&s| s > e.average_s).unwrap_or(e.average_s),
+            &format!(
+                "settling plus averaging must span at most 2^53 = {MAX_RUN_SAMPLES:e} input samples per point (here {run_samples:e} at fs_hz = {})",
+                b.fs_hz
             ),
         )?;
         if e.kind == ExperimentKind::Rotating {
@@ -349,7 +452,11 @@ impl Config {
             positive("dump.duration_s", dump.duration_s)?;
             // The point runs settling plus its own averaging window (whole half periods).
             let p = crate::sweep::plan_point(self, dump.rate_dps);
-            let total = (self.n_settle_out() + p.n_avg + 1) as f64 / self.fs_out_hz();
+            let n_out = self
+                .n_settle_out()
+                .saturating_add(p.n_avg)
+                .saturating_add(1);
+            let total = n_out as f64 / self.fs_out_hz();
             check(
                 dump.start_s + dump.duration_s <= total,
                 "dump.duration_s",

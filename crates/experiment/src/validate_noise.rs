@@ -2,7 +2,7 @@
 //! `validate.rs`; same error form: key, value, rule).
 
 use crate::config::Config;
-use crate::validate::ConfigError;
+use crate::validate::{ConfigError, MAX_RUN_SAMPLES};
 
 fn rule(ok: bool, key: &str, v: impl std::fmt::Display, r: &str) -> Result<(), ConfigError> {
     if ok {
@@ -22,7 +22,12 @@ fn non_negative(key: &str, v: f64) -> Result<(), ConfigError> {
 }
 
 fn positive(key: &str, v: f64) -> Result<(), ConfigError> {
-    rule(v.is_finite() && v > 0.0, key, v, "must be a finite number > 0")
+    rule(
+        v.is_finite() && v > 0.0,
+        key,
+        v,
+        "must be a finite number > 0",
+    )
 }
 
 impl Config {
@@ -65,21 +70,26 @@ impl Config {
             }
         }
         if let Some(s) = &self.selfcal {
+            let max_s = MAX_RUN_SAMPLES / b.fs_hz;
             if let Some(t) = s.allan_record_s {
-                let min = 10.0 / self.fs_out_hz();
+                let min = (10.0 / self.fs_out_hz()).max(10.0);
                 rule(
-                    t.is_finite() && t >= 10.0 && t >= min,
+                    t.is_finite() && t >= min && t <= max_s,
                     "selfcal.allan_record_s",
                     t,
-                    "must be a finite number >= 10 s (the Allan deviation needs a record of many averaging times)",
+                    &format!(
+                        "must be a finite number from {min} s (at least 10 s and 10 output samples: the Allan deviation needs a record of many averaging times) to {max_s:e} s (2^53 input samples)"
+                    ),
                 )?;
             }
             if let Some(t) = s.tau_max_s {
                 rule(
-                    t.is_finite() && t >= 2.0,
+                    t.is_finite() && t >= 2.0 && t <= max_s,
                     "selfcal.tau_max_s",
                     t,
-                    "must be a finite number >= 2 s (the analysis starts at 1 s)",
+                    &format!(
+                        "must be a finite number from 2 s (the analysis starts at 1 s) to {max_s:e} s (2^53 input samples)"
+                    ),
                 )?;
             }
             for (i, &dt) in s.drift_delta_t_k.iter().enumerate() {

@@ -31,8 +31,72 @@ pub enum LowPassDesign {
 }
 
 /// Section coefficients of a design (validated): whether the sections are lock-in one-poles,
-/// how many sections are used, and their coefficients.
+/// how many sections are used, and their coefficients. A design that f64 cannot realise
+/// (a cutoff so close to 0 or to fs/2 that a pole rounds onto the unit circle, or the
+/// numerator to zero) is refused, naming the parameter that caused it.
 pub(crate) fn sections(
+    design: LowPassDesign,
+    fs_hz: f64,
+) -> ParamResult<(bool, usize, [Coefs; MAX_ORDER])> {
+    let (one_pole, n, out) = raw_sections(design, fs_hz)?;
+    let (param, value) = match design {
+        LowPassDesign::Butterworth { cutoff_hz, .. } => ("cutoff_hz", cutoff_hz),
+        LowPassDesign::LockIn { tau_s, .. } => ("tau_s", tau_s),
+    };
+    // A biquad's stability sums are rounded (to a few eps); require them to exceed that,
+    // so a pole that only rounding keeps inside is refused too. The lock-in one-pole has
+    // its pole at 1 - k exactly, inside for any k in (0, 1].
+    let margin = if one_pole { 0.0 } else { 8.0 * f64::EPSILON };
+    for c in &out[..n] {
+        realisable(c, margin).map_err(|why| {
+            ParamError::new(
+                STAGE,
+                param,
+                value,
+                format!("{why} at fs_hz = {fs_hz} (too close to 0 or to fs/2 for f64)"),
+            )
+        })?;
+    }
+    Ok((one_pole, n, out))
+}
+
+/// Largest pole radius of `1 + a1 z^-1 + a2 z^-2` (both roots of `z^2 + a1 z + a2`).
+pub(crate) fn pole_radius(a1: f64, a2: f64) -> f64 {
+    let disc = a1 * a1 - 4.0 * a2;
+    if disc < 0.0 {
+        // Complex pair: |z|^2 = a2.
+        a2.sqrt()
+    } else {
+        let r = disc.sqrt();
+        (0.5 * (-a1 + r)).abs().max((0.5 * (-a1 - r)).abs())
+    }
+}
+
+/// Checks one built section: finite coefficients, poles strictly inside the unit circle
+/// (the stability triangle `|a2| < 1`, `1 + a1 + a2 > 0`, `1 - a1 + a2 > 0`, evaluated on
+/// the coefficients as stored, each by more than `margin`) and a unit DC gain within 1 %
+/// (a numerator rounded to zero or a pole at `z = 1` fails this).
+fn realisable(c: &Coefs, margin: f64) -> Result<(), String> {
+    let all = [c.b0, c.b1, c.b2, c.a1, c.a2];
+    if !all.iter().all(|v| v.is_finite()) {
+        return Err(format!("the section coefficients are not finite ({all:?})"));
+    }
+    let a_at_1 = c.a_sum();
+    let a_at_minus_1 = 1.0 - c.a1 + c.a2;
+    if !(1.0 - c.a2.abs() > margin && a_at_1 > margin && a_at_minus_1 > margin) {
+        return Err(format!(
+            "a pole is not safely inside the unit circle in f64 (|pole| = {}, stability sums 1 +- a1 + a2 = {a_at_1:e}, {a_at_minus_1:e} must exceed the rounding {margin:e})",
+            pole_radius(c.a1, c.a2)
+        ));
+    }
+    let dc = c.dc_gain();
+    if !(dc.is_finite() && (dc - 1.0).abs() <= 0.01) {
+        return Err(format!("a section's DC gain rounds to {dc} instead of 1"));
+    }
+    Ok(())
+}
+
+fn raw_sections(
     design: LowPassDesign,
     fs_hz: f64,
 ) -> ParamResult<(bool, usize, [Coefs; MAX_ORDER])> {
@@ -96,6 +160,106 @@ pub(crate) fn sections(
             // arithmetic; record k (not `a`) so the response is the one built.
             out[..n].fill(Coefs::one_pole(k));
             Ok((true, n, out))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_complex::Complex64;
+
+    /// Both poles of `z^2 + a1 z + a2` by the complex quadratic formula (independent of
+    /// `pole_radius`, which branches on the discriminant's sign).
+    fn poles(a1: f64, a2: f64) -> [Complex64; 2] {
+        let d = Complex64::new(a1 * a1 - 4.0 * a2, 0.0).sqrt();
+        [(-a1 + d) * 0.5, (-a1 - d) * 0.5]
+    }
+
+    #[test]
+    fn every_accepted_section_has_its_poles_inside_the_unit_circle() {
+        let fs = 1.0e6;
+        let mut checked = 0;
+        for order in 1..=MAX_ORDER {
+            let mut designs = vec![];
+            for e in -18..=0 {
+                let fc = 0.5 * fs * 10f64.powi(e);
+                designs.push(LowPassDesign::Butterworth {
+                    order,
+                    cutoff_hz: fc * 0.999,
+                });
+                // Towards Nyquist: fs/2 (1 - 10^e).
+                designs.push(LowPassDesign::Butterworth {
+                    order,
+                    cutoff_hz: 0.5 * fs * (1.0 - 10f64.powi(e.min(-1))),
+                });
+                designs.push(LowPassDesign::LockIn {
+                    order,
+                    tau_s: 10f64.powi(e + 6),
+                });
+            }
+            for d in designs {
+                if let Ok((_, n, c)) = sections(d, fs) {
+                    for s in &c[..n] {
+                        for p in poles(s.a1, s.a2) {
+                            assert!(p.norm() < 1.0, "{d:?}: pole {p}");
+                        }
+                        assert!(s.b0.is_finite() && s.b1.is_finite() && s.b2.is_finite());
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked > 300, "{checked}");
+    }
+
+    #[test]
+    fn cutoffs_f64_cannot_realise_are_refused_naming_the_cutoff() {
+        let fs = 1.0e6;
+        // cos(2 pi fc/fs) rounds to 1 (fc/fs < 1e-9): a pole at z = 1, numerator 0.
+        // tan(pi fc/fs) below eps/2: the first-order pole rounds to 1.
+        // fc within 1e-9 fs of Nyquist: 1 + cos rounds to (nearly) 0, a pole at z = -1.
+        for (order, fc) in [
+            (2, 1e-4),
+            (4, 1e-6),
+            (1, 1e-12),
+            (3, 1e-12),
+            (2, 0.5 * fs * (1.0 - 1e-12)),
+            (8, 0.5 * fs * (1.0 - 1e-11)),
+            (5, 0.5 * fs * (1.0 - 1e-9)),
+        ] {
+            let d = LowPassDesign::Butterworth {
+                order,
+                cutoff_hz: fc,
+            };
+            let e = sections(d, fs).expect_err(&format!("order {order} fc {fc}"));
+            assert_eq!((e.stage, e.param), ("lpf", "cutoff_hz"), "{e}");
+            assert_eq!(e.value, fc.to_string());
+            assert!(e.rule.contains("fs_hz = 1000000"), "{e}");
+        }
+        // Healthy narrow and wide designs stay accepted.
+        for fc in [1.0, 10.0, 0.49 * fs, 0.5 * fs * (1.0 - 1e-6)] {
+            for order in 1..=MAX_ORDER {
+                let d = LowPassDesign::Butterworth {
+                    order,
+                    cutoff_hz: fc,
+                };
+                assert!(sections(d, fs).is_ok(), "order {order} fc {fc}");
+            }
+        }
+    }
+
+    #[test]
+    fn pole_radius_matches_the_quadratic_formula() {
+        for (a1, a2) in [
+            (-1.9, 0.95),
+            (-1.5, 0.5),
+            (0.3, -0.2),
+            (1.99, 0.99),
+            (-2.0, 1.0),
+        ] {
+            let truth = poles(a1, a2).iter().map(|p| p.norm()).fold(0.0, f64::max);
+            assert!((pole_radius(a1, a2) - truth).abs() < 1e-12, "{a1} {a2}");
         }
     }
 }

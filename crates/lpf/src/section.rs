@@ -53,6 +53,16 @@ impl Coefs {
         }
     }
 
+    /// `A(1) = 1 + a1 + a2` (exact near DC, see [`Coefs::biquad`]).
+    pub fn a_sum(&self) -> f64 {
+        self.a_sum
+    }
+
+    /// DC gain `B(1) / A(1)`.
+    pub fn dc_gain(&self) -> f64 {
+        self.b_sum / self.a_sum
+    }
+
     /// Complex gain at `z^-1 = 1 + u`.
     pub fn response(&self, u: Complex64) -> Complex64 {
         let num = u * (u * self.b2 + self.b_slope) + self.b_sum;

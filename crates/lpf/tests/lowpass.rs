@@ -223,3 +223,28 @@ fn bad_parameters_are_named_errors() {
     let e = Decimator::<f64>::new(DecimateMode::IntegrateDump, 4, f64::NAN).unwrap_err();
     assert_eq!(e.param, "fs_in_hz");
 }
+
+#[test]
+fn lowpass_new_refuses_cutoffs_whose_poles_round_onto_the_unit_circle() {
+    let fs = 240_000.0;
+    // cos(2 pi fc/fs) rounds to 1: the biquad's pole lands on z = 1 and its numerator on 0.
+    for (order, fc) in [(4, 1e-6), (1, 1e-14), (8, 0.5 * fs * (1.0 - 1e-12))] {
+        let e = LowPass::<f64>::new(bw(order, fc), fs).expect_err("unrealisable design");
+        assert_eq!((e.stage, e.param), ("lpf", "cutoff_hz"), "{e}");
+        assert!(e.to_string().contains(&fc.to_string()), "{e}");
+    }
+    // The accepted neighbours are stable: the impulse response decays.
+    for (order, fc) in [(4, 1.0), (8, 0.5 * fs * (1.0 - 1e-6))] {
+        let mut lp = LowPass::<f64>::new(bw(order, fc), fs).unwrap();
+        let mut h = vec![lp.tick(1.0)];
+        h.extend((0..1 << 22).map(|_| lp.tick(0.0)));
+        let tail = h[h.len() - 1000..]
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let peak = h.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(
+            tail.is_finite() && tail < 1e-3 * peak,
+            "{order} {fc}: {tail} vs {peak}"
+        );
+    }
+}

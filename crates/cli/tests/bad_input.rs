@@ -1,0 +1,171 @@
+//! `gyroemu run` on input it must refuse: each case exits with code 2, prints one `error:`
+//! line naming the problem, and writes nothing into `--out` (the folder stays absent).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A valid, fast config (used where the config is not the bad input).
+const GOOD: &str = r#"
+[device]
+f0_hz = 15000.0
+q = 1000.0
+angular_gain = 1.0
+[drive]
+f1 = 1.0
+f2 = 1.0
+[board]
+fs_hz = 240000.0
+lpf_cutoff_hz = 200.0
+decimation = 100
+[experiment]
+kind = "coriolis"
+rates_dps = [50.0]
+average_s = 0.1
+"#;
+
+fn run(config: &Path, out: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gyroemu"))
+        .arg("run")
+        .arg(config)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .expect("binary runs")
+}
+
+/// Runs the case and checks exit code 2, a single `error:` line holding every needle, and
+/// that `out` was not created.
+fn refused(what: &str, config: &Path, out: &Path, needles: &[&str]) {
+    let o = run(config, out);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{what}: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "{what}: one message expected: {err}");
+    assert!(lines[0].starts_with("error: "), "{what}: {err}");
+    for n in needles {
+        assert!(lines[0].contains(n), "{what}: `{n}` missing from: {err}");
+    }
+    assert!(o.stdout.is_empty(), "{what}: stdout not empty");
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+#[test]
+fn unreadable_configs_exit_2_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("out");
+    let cases: Vec<(&str, PathBuf, Vec<&str>)> = vec![
+        (
+            "empty file",
+            write(d, "empty.toml", b""),
+            vec!["empty.toml", "empty"],
+        ),
+        (
+            "whitespace only",
+            write(d, "blank.toml", b"  \n\n\t"),
+            vec!["blank.toml", "empty"],
+        ),
+        (
+            "non-UTF-8 file",
+            write(d, "latin1.toml", b"[device]\nf0_hz = 15000.0 # \xe9t\xe9\n"),
+            vec!["latin1.toml", "not UTF-8"],
+        ),
+        (
+            "missing file",
+            d.join("nope.toml"),
+            vec!["nope.toml", "cannot read config"],
+        ),
+        ("a directory", d.to_path_buf(), vec!["cannot read config"]),
+        (
+            "bad value",
+            write(
+                d,
+                "q.toml",
+                GOOD.replace("q = 1000.0", "q = -1.0").as_bytes(),
+            ),
+            vec!["q.toml", "device.q", "-1", "> 0"],
+        ),
+        (
+            "wrong type",
+            write(
+                d,
+                "t.toml",
+                GOOD.replace("q = 1000.0", "q = \"x\"").as_bytes(),
+            ),
+            vec!["t.toml", "line 4, column 5", "device.q", "expected f64"],
+        ),
+        (
+            "misspelt key",
+            write(
+                d,
+                "k.toml",
+                GOOD.replace("decimation", "decimaton").as_bytes(),
+            ),
+            vec!["k.toml", "board.decimaton", "unknown field", "`decimation`"],
+        ),
+        (
+            "output-rate Nyquist",
+            write(
+                d,
+                "c.toml",
+                GOOD.replace("lpf_cutoff_hz = 200.0", "lpf_cutoff_hz = 1200.0")
+                    .as_bytes(),
+            ),
+            vec!["c.toml", "board.lpf_cutoff_hz", "1200", "Nyquist"],
+        ),
+    ];
+    for (what, config, needles) in cases {
+        refused(what, &config, &out, &needles);
+        assert!(!out.exists(), "{what}: --out was created");
+    }
+}
+
+#[test]
+fn an_output_folder_that_cannot_be_created_exits_2_before_any_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let config = write(d, "good.toml", GOOD.as_bytes());
+    // A path under a regular file: no permission bits involved, so it fails as root too.
+    let file = write(d, "plain", b"keep");
+    let out = file.join("out");
+    refused(
+        "out under a file",
+        &config,
+        &out,
+        &["output folder", "cannot be created"],
+    );
+    assert_eq!(std::fs::read(&file).unwrap(), b"keep");
+    // Nothing else appeared beside the inputs.
+    let mut names: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["good.toml", "plain"]);
+}
+
+#[test]
+fn a_bad_config_leaves_an_existing_output_folder_empty() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("out");
+    std::fs::create_dir(&out).unwrap();
+    let config = write(
+        d,
+        "z.toml",
+        GOOD.replace("decimation = 100", "decimation = 0")
+            .as_bytes(),
+    );
+    refused(
+        "decimation 0",
+        &config,
+        &out,
+        &["board.decimation", "= 0", ">= 1"],
+    );
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 0);
+}
