@@ -3,9 +3,13 @@
 //! (MEMS 2012).
 
 mod commands;
+mod merge;
 mod progress;
 mod report;
 mod reproduce;
+mod resume;
+mod selfcal;
+mod shard;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -39,6 +43,33 @@ enum Command {
     /// Run one experiment described by a TOML config.
     Run {
         /// The config file (see `gyroemu config`).
+        config: PathBuf,
+        /// Output folder. Points already computed there for the same config are reused, so
+        /// rerunning an interrupted command resumes it.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Run only shard I of N (0-based) of the operating points: point p belongs to shard
+        /// p % N; then `gyroemu merge OUT`. Default: from SLURM_ARRAY_TASK_ID or
+        /// JOB_COMPLETION_INDEX when set (see docs/cluster.md).
+        #[arg(long, value_name = "I/N")]
+        shard: Option<String>,
+        /// The shard count N beside JOB_COMPLETION_INDEX (or GYROEMU_SHARD_COUNT).
+        #[arg(long, value_name = "N")]
+        shard_count: Option<usize>,
+        /// Delete results of another config found in the output folder instead of refusing.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Check the shards in DIR (all present, one config, every point once) and write the
+    /// results a one-machine run would have written.
+    Merge {
+        /// The output folder the shards wrote into.
+        dir: PathBuf,
+    },
+    /// Self-calibrate: the scale factor from the rotating excitation alone, checked against
+    /// the virtual rate table on the same board (plus the analyses of the [selfcal] section).
+    Selfcal {
+        /// The config file (the same as `run` takes; its rates are used for both sweeps).
         config: PathBuf,
         /// Output folder.
         #[arg(long, default_value = "out")]
@@ -117,7 +148,21 @@ fn run_cli() -> ExitCode {
     }
     let result = match cli.command {
         Command::Reproduce { out, quick } => reproduce::reproduce(&out, quick),
-        Command::Run { config, out } => commands::run(&config, &out),
+        Command::Run {
+            config,
+            out,
+            shard,
+            shard_count,
+            force,
+        } => commands::run(&commands::RunArgs {
+            config: &config,
+            out: &out,
+            shard: shard.as_deref(),
+            shard_count,
+            force,
+        }),
+        Command::Merge { dir } => merge::merge(&dir),
+        Command::Selfcal { config, out } => selfcal::selfcal(&config, &out),
         Command::Config { preset, list } => commands::config(preset.as_deref(), list),
         Command::Bench { preset, samples } => commands::bench(&preset, samples),
     };
@@ -126,6 +171,9 @@ fn run_cli() -> ExitCode {
         Err(e) => {
             eprintln!("error: {e:#}");
             let bad_input = e.downcast_ref::<commands::BadInput>().is_some();
+            if e.downcast_ref::<resume::Interrupted>().is_some() {
+                return ExitCode::from(resume::EXIT_INTERRUPTED);
+            }
             ExitCode::from(if bad_input { EXIT_BAD_INPUT } else { 1 })
         }
     }

@@ -69,4 +69,16 @@ impl Progress {
             point_samples as f64 / s.max(1e-9) / 1e6
         );
     }
+
+    /// Closes the bar and prints the elapsed time (for runs whose size is not in point-samples).
+    pub fn finish_elapsed(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+        eprintln!(
+            "{}: done in {:.1} s",
+            self.label,
+            self.start.elapsed().as_secs_f64()
+        );
+    }
 }

@@ -120,9 +120,17 @@ impl Sample for f64x4 {
     }
     #[inline(always)]
     fn round_away(self) -> Self {
-        // f64x4::round rounds half to even; match f64::round (half away from zero).
-        let a = self.to_array();
-        Self::from_fn(|i| a[i].round())
+        // f64x4::round rounds half to even; match f64::round (half away from zero) without a
+        // libm call per lane, on the magnitude: with t = trunc(|x|) and d = |x| - t (exact,
+        // d < 1), trunc(2 d) is 1 exactly when d >= 1/2; then x's sign bit goes back on (so
+        // -0.3 gives -0.0 as f64::round does). From 2^52 up every f64 is an integer (and inf
+        // stays inf), so those pass through.
+        let a = self.abs();
+        let t = a.trunc();
+        let mag = t + ((a - t) * f64x4::splat(2.0)).trunc();
+        let r = mag | (self & f64x4::splat(-0.0));
+        a.simd_ge(f64x4::splat(4_503_599_627_370_496.0))
+            .bitselect(self, r)
     }
     #[inline(always)]
     fn all_finite(self) -> bool {
@@ -170,6 +178,50 @@ mod tests {
             assert_eq!(c.lane(i), xs[i].clamp_to(-1.0, 1.0));
         }
         assert!(!f64x4::from_fn(|i| if i == 2 { f64::NAN } else { 0.0 }).all_finite());
+    }
+
+    #[test]
+    fn vector_round_away_is_f64_round_on_ties_edges_and_a_seeded_sweep() {
+        let mut xs = vec![
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            -0.0,
+            0.0,
+            -0.3,
+            4503599627370495.5,
+            -4503599627370495.5,
+            4503599627370496.0,
+            9.0e18,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MAX,
+            f64::MIN,
+            f64::MIN_POSITIVE,
+            1e-310,
+        ];
+        // Splitmix-style generator: halves, near-halves and wide magnitudes.
+        let mut s = 0x1234_5678_9abc_def0u64;
+        for _ in 0..100_000 {
+            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let z = (s ^ (s >> 31)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            let scale = 2f64.powi((z % 60) as i32 - 5);
+            let u = (z >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            xs.push(u * scale);
+            xs.push((u * scale).trunc() + 0.5 * u.signum());
+        }
+        for c in xs.chunks(4) {
+            let v = f64x4::from_fn(|i| c[i % c.len()]);
+            let r = v.round_away();
+            for i in 0..4 {
+                let x = c[i % c.len()];
+                assert_eq!(r.lane(i).to_bits(), x.round().to_bits(), "x = {x:e}");
+            }
+        }
+        let n = f64x4::splat(f64::NAN).round_away();
+        assert!(n.lane(0).is_nan());
     }
 
     #[test]

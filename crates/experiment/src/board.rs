@@ -12,6 +12,7 @@ use gyroemu_mixer::{Iq, Stage1Mixer, Stage2Mixer};
 use gyroemu_nco::{Nco, PhaseShifter, RotatingNco};
 use gyroemu_resonator::{thermomechanical_accel_psd, ModeParams, Resonator, ResonatorParams};
 use gyroemu_tia::{input_referred_noise_a_per_rthz, Tia, TiaParams};
+use std::sync::atomic::Ordering;
 
 /// At most this many lanes (the width of `f64x4`).
 pub const MAX_LANES: usize = 4;
@@ -191,6 +192,8 @@ pub struct Board<S: Sample> {
     imperfect: bool,
     /// The board as built, for locating a non-finite value by replay.
     pristine: Option<Box<Board<S>>>,
+    /// Raised: the run stops at its next progress report (see [`Board::set_cancel`]).
+    cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl<S: Sample> Board<S> {
@@ -324,9 +327,17 @@ impl<S: Sample> Board<S> {
             adc,
             imperfect,
             pristine: None,
+            cancel: None,
         };
         board.pristine = Some(Box::new(board.clone()));
         Ok(board)
+    }
+
+    /// A flag that, once raised, makes a run stop at its next progress report (every 65 536
+    /// input samples or so) and return at once: its averages are then meaningless, so the
+    /// caller must test the flag after the run and discard them (Ctrl-C of a sweep).
+    pub fn set_cancel(&mut self, flag: std::sync::Arc<std::sync::atomic::AtomicBool>) {
+        self.cancel = Some(flag);
     }
 
     /// Runs `n_settle` decimated samples of settling, then averages each lane over its window.
@@ -457,6 +468,13 @@ impl<S: Sample> Board<S> {
             }
             if k % report_every == 0 {
                 progress(n0 + m);
+                if self
+                    .cancel
+                    .as_ref()
+                    .is_some_and(|c| c.load(Ordering::Relaxed))
+                {
+                    break;
+                }
             }
             if k < n_settle {
                 prev_z = z;

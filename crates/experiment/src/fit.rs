@@ -2,12 +2,14 @@
 
 use serde::Serialize;
 
-/// y = slope * x + intercept, with the coefficient of determination.
+/// y = slope * x + intercept, with the coefficient of determination and the standard error
+/// of the slope (from the residual scatter, n - 2 degrees of freedom; NaN with 2 points).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct LineFit {
     pub slope: f64,
     pub intercept: f64,
     pub r2: f64,
+    pub slope_std_err: f64,
 }
 
 /// Ordinary least squares (centred sums, so large offsets do not cancel digits). Needs at
@@ -29,10 +31,36 @@ pub fn fit_line(x: &[f64], y: &[f64]) -> LineFit {
     } else {
         sxy * sxy / (sxx * syy)
     };
+    let rss: f64 = x
+        .iter()
+        .zip(y)
+        .map(|(&a, &b)| (b - intercept - slope * a).powi(2))
+        .sum();
+    let slope_std_err = if n > 2.0 {
+        (rss / (n - 2.0) / sxx).sqrt()
+    } else {
+        f64::NAN
+    };
     LineFit {
         slope,
         intercept,
         r2,
+        slope_std_err,
+    }
+}
+
+/// Two-sided 95 % quantile of Student's t with `dof` degrees of freedom (the half-width of a
+/// 95 % confidence interval in standard errors); the normal 1.96 beyond 30.
+pub fn t95(dof: usize) -> f64 {
+    const T: [f64; 30] = [
+        12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
+        2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
+        2.052, 2.048, 2.045, 2.042,
+    ];
+    match dof {
+        0 => f64::INFINITY,
+        d if d <= 30 => T[d - 1],
+        _ => 1.96,
     }
 }
 
@@ -53,5 +81,38 @@ mod tests {
             .map(|(i, v)| v + if i % 2 == 0 { 0.5 } else { -0.5 })
             .collect();
         assert!(fit_line(&x, &y2).r2 < 0.999);
+    }
+
+    #[test]
+    fn slope_std_err_equals_the_normal_equations_covariance() {
+        // Var(slope) = s^2 [(X'X)^-1]_11 with X = [x 1], s^2 = RSS/(n-2): solved here by
+        // the explicit 2x2 inverse, independently of the centred sums of fit_line.
+        let x: Vec<f64> = (0..9).map(|k| 10.0 + 7.0 * k as f64).collect();
+        let y: Vec<f64> = x
+            .iter()
+            .enumerate()
+            .map(|(i, v)| 0.3 * v + 2.0 + [0.4, -0.1, 0.7, -0.9, 0.2, 0.0, -0.3, 0.5, -0.6][i])
+            .collect();
+        let f = fit_line(&x, &y);
+        let n = x.len() as f64;
+        let (sx, sxx) = (x.iter().sum::<f64>(), x.iter().map(|v| v * v).sum::<f64>());
+        let det = n * sxx - sx * sx;
+        let rss: f64 = x
+            .iter()
+            .zip(&y)
+            .map(|(a, b)| (b - f.slope * a - f.intercept).powi(2))
+            .sum();
+        let var = rss / (n - 2.0) * n / det;
+        assert!((f.slope_std_err / var.sqrt() - 1.0).abs() < 1e-12);
+        assert!(fit_line(&x[..2], &y[..2]).slope_std_err.is_nan());
+    }
+
+    #[test]
+    fn t95_matches_known_quantiles() {
+        // t(0.975; 1) = 12.706, t(0.975; 10) = 2.228, normal limit 1.96.
+        assert_eq!(t95(1), 12.706);
+        assert_eq!(t95(10), 2.228);
+        assert_eq!(t95(1000), 1.96);
+        assert!(t95(0).is_infinite());
     }
 }

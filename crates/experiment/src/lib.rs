@@ -2,12 +2,16 @@
 //! run sample by sample, the Coriolis and rotating-excitation sweeps, and the exact theory
 //! that the figures overlay.
 
+pub mod allan;
 pub mod bench;
 pub mod board;
+pub mod checkpoint;
 pub mod config;
 pub mod fit;
 pub mod presets;
 pub mod probe;
+pub mod selfcal;
+pub mod selfcal_analyses;
 pub mod sweep;
 pub mod theory;
 pub mod validate;

@@ -5,7 +5,7 @@ use crate::config::Config;
 use crate::validate::{parse_config, ConfigError};
 
 /// (name, what it reproduces, TOML text).
-pub const PRESETS: [(&str, &str, &str); 5] = [
+pub const PRESETS: [(&str, &str, &str); 6] = [
     (
         "m2tfg-coriolis",
         "Fig. 8: Coriolis run on an M^2-TFG-like gyroscope (default)",
@@ -30,6 +30,11 @@ pub const PRESETS: [(&str, &str, &str); 5] = [
         "m2tfg-ratetable",
         "Mechanical bandwidth: sinusoidal rate table at Q = 36 000",
         include_str!("../presets/m2tfg-ratetable.toml"),
+    ),
+    (
+        "m2tfg-selfcal",
+        "`gyroemu selfcal` example: imperfect, noisy device, Allan deviation, drift",
+        include_str!("../presets/m2tfg-selfcal.toml"),
     ),
 ];
 

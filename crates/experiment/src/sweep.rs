@@ -19,7 +19,9 @@ use gyroemu_resonator::continuous_steady_state;
 use gyroemu_tia::Tia;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::Arc;
 
 const DEG: f64 = core::f64::consts::PI / 180.0;
 
@@ -152,48 +154,128 @@ pub fn run_sweep(
     progress: Progress,
     dump_dir: Option<&std::path::Path>,
 ) -> Result<SweepResult, SweepError> {
-    let rates = emulated_rates_dps(cfg);
-    let points: Vec<Point> = rates.iter().map(|&r| plan_point(cfg, r)).collect();
-    let fs_out = cfg.fs_out_hz();
-    let settle_s = cfg.settle_s();
+    let run = run_sweep_with(cfg, progress, dump_dir, SweepOptions::default())?;
+    finish_sweep(cfg, &run.lanes)
+}
+
+/// Called from the worker threads with each finished lane group's points, `(index in
+/// emulated_rates_dps, lane result)`, after the group's dump (if any) is written. An error
+/// stops the sweep (groups not started are skipped) and is returned.
+pub type OnGroup<'a> = &'a (dyn Fn(&[(usize, LaneResult)]) -> Result<(), String> + Sync);
+
+/// What [`run_sweep_with`] runs and what it does with the points it finishes.
+#[derive(Default)]
+pub struct SweepOptions<'a> {
+    /// Points already computed (by index): not run again (a resumed sweep).
+    pub done: BTreeMap<usize, LaneResult>,
+    /// The point indices this run is responsible for (a shard); `None`: all.
+    pub only: Option<Vec<usize>>,
+    /// Raised (Ctrl-C): groups not started are skipped, running ones stop within about
+    /// 65 536 samples, and the points of every group that did not finish are left out.
+    pub cancel: Option<Arc<AtomicBool>>,
+    /// Receives each finished group (e.g. to write its point files).
+    pub on_group: Option<OnGroup<'a>>,
+}
+
+/// The points a [`run_sweep_with`] call has, and whether it was cancelled.
+#[derive(Clone, Debug, Default)]
+pub struct SweepRun {
+    /// Every point available: the given `done` plus those computed now, by index.
+    pub lanes: BTreeMap<usize, LaneResult>,
+    /// Indices computed by this call, ascending.
+    pub computed: Vec<usize>,
+    /// The cancel flag stopped the run before every point it was given finished.
+    pub cancelled: bool,
+    /// Operating-point samples emulated by the groups that finished.
+    pub point_samples: u64,
+}
+
+/// The canonical lane grouping of a sweep (all points in index order, four per group) and
+/// its work: (input samples per lane group summed, operating-point samples). Reported in the
+/// results, so they are the same whichever subset, order or shard actually ran the points.
+fn canonical_work(cfg: &Config, points: &[Point]) -> (u64, u64) {
     let n_settle = cfg.n_settle_out();
     let m = cfg.board.decimation as u64;
-    let groups: Vec<&[Point]> = points.chunks(MAX_LANES).collect();
     let group_samples =
         |g: &[Point]| (n_settle + g.iter().map(|p| p.n_avg + 1).max().unwrap_or(1)) * m;
+    points.chunks(MAX_LANES).fold((0, 0), |(s, ps), g| {
+        let n = group_samples(g);
+        (s + n, ps + n * g.len() as u64)
+    })
+}
+
+/// Runs the points of a sweep that `opts` assigns and that are not done yet, four per lane
+/// group in index order, groups in parallel. Each point draws the noise stream of its index,
+/// and lanes do not interact, so any subset or grouping gives every point the same bits.
+pub fn run_sweep_with(
+    cfg: &Config,
+    progress: Progress,
+    dump_dir: Option<&std::path::Path>,
+    opts: SweepOptions,
+) -> Result<SweepRun, SweepError> {
+    let rates = emulated_rates_dps(cfg);
+    let todo: Vec<usize> = match &opts.only {
+        Some(only) => {
+            let mut v: Vec<usize> = only.iter().copied().filter(|&i| i < rates.len()).collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        }
+        None => (0..rates.len()).collect(),
+    }
+    .into_iter()
+    .filter(|i| !opts.done.contains_key(i))
+    .collect();
+    let plan = |i: usize| plan_point(cfg, rates[i]);
+    let n_settle = cfg.n_settle_out();
+    let m = cfg.board.decimation as u64;
+    let groups: Vec<&[usize]> = todo.chunks(MAX_LANES).collect();
+    let group_samples =
+        |g: &[usize]| (n_settle + g.iter().map(|&i| plan(i).n_avg + 1).max().unwrap_or(1)) * m;
     let total: u64 = groups.iter().map(|g| group_samples(g)).sum();
-    let point_samples: u64 = groups
-        .iter()
-        .map(|g| group_samples(g) * g.len() as u64)
-        .sum();
     let done = AtomicU64::new(0);
     let dump = cfg.dump.as_ref().map(|d| {
         let idx = rates.iter().position(|&r| r == d.rate_dps).unwrap_or(0);
         (idx, d)
     });
+    // Raised by the caller's flag (copied at each progress report) or by a failed group.
+    let stop = Arc::new(AtomicBool::new(false));
+    let user_cancel = || {
+        opts.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    };
     // Build every board first, so a bad parameter fails before any sample is computed.
     let mut boards = Vec::with_capacity(groups.len());
-    for (gi, g) in groups.iter().enumerate() {
-        let r: Vec<f64> = g.iter().map(|p| p.rate_rad_s).collect();
+    for g in &groups {
+        let r: Vec<f64> = g.iter().map(|&i| plan(i).rate_rad_s).collect();
         // Each point draws the noise stream of its index in the emulated rates.
-        let streams: Vec<u64> = (0..g.len()).map(|i| (gi * MAX_LANES + i) as u64).collect();
-        boards.push(Board::<f64x4>::with_streams(cfg, &r, &streams)?);
+        let streams: Vec<u64> = g.iter().map(|&i| i as u64).collect();
+        let mut board = Board::<f64x4>::with_streams(cfg, &r, &streams)?;
+        board.set_cancel(stop.clone());
+        boards.push(board);
     }
-    type Outcome = (Result<Vec<LaneResult>, NonFinite>, Option<Probe>);
+    type Outcome = Option<Result<(Vec<(usize, LaneResult)>, u64), SweepError>>;
     let outcomes: Vec<Outcome> = boards
         .into_par_iter()
         .zip(groups.par_iter())
-        .enumerate()
-        .map(|(gi, (mut board, g))| {
+        .map(|(mut board, g)| {
+            if user_cancel() {
+                stop.store(true, Ordering::Relaxed);
+            }
+            if stop.load(Ordering::Relaxed) {
+                return None;
+            }
+            let points: Vec<Point> = g.iter().map(|&i| plan(i)).collect();
             let mut probe = dump.and_then(|(idx, d)| {
-                (idx / MAX_LANES == gi).then(|| {
+                g.iter().position(|&i| i == idx).map(|lane| {
                     Probe::new(
                         &d.nodes,
                         cfg.board.fs_hz,
                         cfg.board.decimation,
                         d.start_s,
                         d.duration_s,
-                        idx % MAX_LANES,
+                        lane,
                     )
                 })
             });
@@ -202,27 +284,84 @@ pub fn run_sweep(
                 let prev = last.swap(n, Ordering::Relaxed);
                 let all = done.fetch_add(n - prev, Ordering::Relaxed) + n - prev;
                 progress(all, total);
+                if user_cancel() {
+                    stop.store(true, Ordering::Relaxed);
+                }
             };
-            let res = board.run(n_settle, g, probe.as_mut(), &report);
-            (res, probe)
+            let res = board.run(n_settle, &points, probe.as_mut(), &report);
+            // A raised flag may have cut the run short: its averages are not the point's.
+            if stop.load(Ordering::Relaxed) {
+                return None;
+            }
+            let finished = (|| {
+                let lanes = res?;
+                if let (Some(p), Some(dir)) = (probe, dump_dir) {
+                    p.write(dir, "dump")
+                        .map_err(|e| SweepError::Output(e.to_string()))?;
+                }
+                let pts: Vec<(usize, LaneResult)> = g.iter().copied().zip(lanes).collect();
+                if let Some(f) = opts.on_group {
+                    f(&pts).map_err(SweepError::Output)?;
+                }
+                Ok((pts, group_samples(g) * g.len() as u64))
+            })();
+            if finished.is_err() {
+                stop.store(true, Ordering::Relaxed);
+            }
+            Some(finished)
         })
         .collect();
-    let mut lane_results = Vec::with_capacity(points.len());
-    for (res, probe) in outcomes {
-        let res = res?;
-        if let (Some(p), Some(dir)) = (probe, dump_dir) {
-            p.write(dir, "dump")
-                .map_err(|e| SweepError::Output(e.to_string()))?;
+    let mut run = SweepRun {
+        lanes: opts.done,
+        computed: Vec::new(),
+        cancelled: false,
+        point_samples: 0,
+    };
+    let mut first_err = None;
+    for o in outcomes {
+        match o {
+            None => run.cancelled = true,
+            Some(Err(e)) => {
+                first_err.get_or_insert(e);
+            }
+            Some(Ok((pts, work))) => {
+                run.point_samples += work;
+                for (i, lane) in pts {
+                    run.computed.push(i);
+                    run.lanes.insert(i, lane);
+                }
+            }
         }
-        lane_results.extend(res);
     }
-    lane_results.truncate(points.len());
+    if let Some(e) = first_err {
+        return Err(e);
+    }
+    run.computed.sort_unstable();
+    Ok(run)
+}
+
+/// Turns the lane results of every point of a sweep (by index in `emulated_rates_dps`) into
+/// the sweep's result, the same bits whichever runs computed them.
+pub fn finish_sweep(
+    cfg: &Config,
+    lanes: &BTreeMap<usize, LaneResult>,
+) -> Result<SweepResult, SweepError> {
+    let rates = emulated_rates_dps(cfg);
+    let missing: Vec<usize> = (0..rates.len())
+        .filter(|i| !lanes.contains_key(i))
+        .collect();
+    if !missing.is_empty() {
+        return Err(SweepError::Missing(missing));
+    }
+    let points: Vec<Point> = rates.iter().map(|&r| plan_point(cfg, r)).collect();
+    let lane_results: Vec<LaneResult> = (0..rates.len()).map(|i| lanes[&i]).collect();
+    let (samples, point_samples) = canonical_work(cfg, &points);
     let res = post_process(cfg, &rates, &points, &lane_results)?;
     Ok(SweepResult {
-        settle_s,
+        settle_s: cfg.settle_s(),
         fs_hz: cfg.board.fs_hz,
-        fs_out_hz: fs_out,
-        samples: total,
+        fs_out_hz: cfg.fs_out_hz(),
+        samples,
         point_samples,
         ..res
     })
@@ -237,6 +376,9 @@ pub enum SweepError {
     Output(String),
     #[error(transparent)]
     NonFinite(#[from] NonFinite),
+    /// Points without a result (indices in `emulated_rates_dps`).
+    #[error("the sweep is missing the results of points {0:?}")]
+    Missing(Vec<usize>),
 }
 
 fn is_ideal(cfg: &Config) -> bool {
@@ -453,4 +595,96 @@ pub fn post_process(
         samples: 0,
         point_samples: 0,
     })
+}
+
+#[cfg(test)]
+mod resume_tests {
+    use super::*;
+    use std::sync::Mutex;
+
+    fn small() -> Config {
+        let mut cfg = crate::presets::preset("m2tfg-coriolis").unwrap();
+        cfg.experiment.average_s = 0.1;
+        cfg.experiment.settle_s = Some(0.02);
+        cfg.experiment.rates_dps = vec![25.0, 50.0, 75.0, 100.0, 125.0, 150.0];
+        cfg
+    }
+
+    #[test]
+    fn subsets_in_any_grouping_give_the_whole_sweeps_bits() {
+        let cfg = small();
+        let whole = run_sweep(&cfg, &|_, _| {}, None).unwrap();
+        let n = emulated_rates_dps(&cfg).len();
+        // Odd points first (other lane groups than the whole run's), then the rest resumed.
+        let seen = Mutex::new(Vec::new());
+        let on_group = |pts: &[(usize, LaneResult)]| {
+            seen.lock().unwrap().extend(pts.iter().map(|p| p.0));
+            Ok(())
+        };
+        let odd = run_sweep_with(
+            &cfg,
+            &|_, _| {},
+            None,
+            SweepOptions {
+                only: Some((1..n).step_by(2).collect()),
+                on_group: Some(&on_group),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(!odd.cancelled);
+        assert_eq!(odd.computed, (1..n).step_by(2).collect::<Vec<_>>());
+        assert!(matches!(
+            finish_sweep(&cfg, &odd.lanes),
+            Err(SweepError::Missing(_))
+        ));
+        let rest = run_sweep_with(
+            &cfg,
+            &|_, _| {},
+            None,
+            SweepOptions {
+                done: odd.lanes,
+                on_group: Some(&on_group),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(rest.computed, (0..n).step_by(2).collect::<Vec<_>>());
+        let mut s = seen.into_inner().unwrap();
+        s.sort_unstable();
+        assert_eq!(s, (0..n).collect::<Vec<_>>());
+        assert_eq!(finish_sweep(&cfg, &rest.lanes).unwrap(), whole);
+    }
+
+    #[test]
+    fn a_raised_cancel_flag_runs_nothing() {
+        let cfg = small();
+        let run = run_sweep_with(
+            &cfg,
+            &|_, _| {},
+            None,
+            SweepOptions {
+                cancel: Some(Arc::new(AtomicBool::new(true))),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(run.cancelled && run.lanes.is_empty() && run.computed.is_empty());
+    }
+
+    #[test]
+    fn a_failing_point_writer_stops_the_sweep_with_its_error() {
+        let cfg = small();
+        let fail = |_: &[(usize, LaneResult)]| Err("disk full".to_string());
+        let r = run_sweep_with(
+            &cfg,
+            &|_, _| {},
+            None,
+            SweepOptions {
+                on_group: Some(&fail),
+                ..Default::default()
+            },
+        );
+        assert!(matches!(r, Err(SweepError::Output(e)) if e == "disk full"));
+    }
 }

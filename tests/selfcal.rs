@@ -1,0 +1,138 @@
+//! Self-calibration: the Coriolis scale factor predicted from the rotating excitation
+//! (lambda times its phase slope) against the one measured on the virtual rate table, on
+//! the same emulated board; its drift behaviour against the closed form (scale factor
+//! 2 Q lambda / w0); the averaging-time reading against the sweep; and noisy runs whose
+//! spread matches the confidence they report.
+
+mod common;
+
+use gyroemu::experiment::config::{Config, NoiseConfig, SelfcalConfig};
+use gyroemu::experiment::presets::preset;
+use gyroemu::experiment::selfcal::{run_selfcal_core, validate_selfcal};
+use gyroemu::experiment::selfcal_analyses::{drift_analysis, tau_analysis};
+
+fn quiet(_: u64, _: u64) {}
+
+fn fast_cfg(rates: &[f64], average_s: f64) -> Config {
+    let mut c = preset("m2tfg-rotating").unwrap();
+    c.experiment.rates_dps = rates.to_vec();
+    c.experiment.average_s = average_s;
+    c.experiment.settle_s = Some(0.8);
+    c
+}
+
+#[test]
+fn ideal_noiseless_selfcal_error_is_below_1e_4_for_lambda_1_and_0_6() {
+    for lambda in [1.0, 0.6] {
+        let mut c = fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2);
+        c.device.angular_gain = lambda;
+        validate_selfcal(&c).unwrap();
+        let r = run_selfcal_core(&c, &quiet, &quiet).unwrap();
+        for m in r.modes {
+            assert!(
+                m.relative_error.abs() < 1e-4,
+                "lambda {lambda}: relative error {:e}",
+                m.relative_error
+            );
+            // The predicted slope is also the small-angle theory 2 Q lambda / w0.
+            let w0 = 2.0 * std::f64::consts::PI * c.device.f0_hz;
+            // deg per deg/s is the same number as rad per rad/s.
+            let theory = 2.0 * c.device.q * lambda / w0;
+            assert!((m.predicted_deg_per_dps / theory - 1.0).abs() < 1e-4);
+        }
+    }
+}
+
+#[test]
+fn drift_selfcal_tracks_the_scale_factor_and_a_stale_one_misses_by_the_q_over_f0_ratio() {
+    let mut c = fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2);
+    c.selfcal = Some(SelfcalConfig {
+        f0_tc_ppm_per_k: -30.0,
+        q_tc_ppm_per_k: -3000.0,
+        ..Default::default()
+    });
+    let nominal = run_selfcal_core(&c, &quiet, &quiet).unwrap().modes[0]
+        .coriolis
+        .slope_deg_per_dps;
+    let deltas = [-30.0, 40.0];
+    let d = drift_analysis(&c, &deltas, nominal, &quiet).unwrap();
+    for (p, dt) in d.iter().zip(deltas) {
+        assert!(p.selfcal_relative_error.abs() < 1e-4, "{p:?}");
+        // Scale factor 2 Q lambda / w0: the stale calibration is off by (Q/f0)/(Q'/f0') - 1.
+        let ratio = (1.0 - 30e-6 * dt) / (1.0 - 3000e-6 * dt);
+        assert!(
+            (p.stale_relative_error - (ratio - 1.0)).abs() < 1e-4,
+            "{p:?}, expected stale error {}",
+            ratio - 1.0
+        );
+    }
+}
+
+#[test]
+fn averaging_time_reading_at_the_sweep_time_equals_the_sweep() {
+    let c = fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2);
+    let core = run_selfcal_core(&c, &quiet, &quiet).unwrap();
+    let m = core.modes[0];
+    let t = tau_analysis(
+        &c,
+        14.4,
+        m.coriolis.slope_deg_per_dps,
+        m.theory_coriolis_deg_per_dps,
+        &quiet,
+    )
+    .unwrap();
+    let at = t
+        .iter()
+        .find(|p| p.tau_s == 7.2)
+        .expect("7.2 s is on the grid");
+    assert!((at.predicted_deg_per_dps / m.predicted_deg_per_dps - 1.0).abs() < 1e-12);
+    // At 1 s (under half a period of the slowest rate) the truncated window leaks.
+    let one = t.iter().find(|p| p.tau_s == 1.0).unwrap();
+    assert!(one.relative_error.abs() > 10.0 * at.relative_error.abs());
+}
+
+#[test]
+fn noisy_selfcal_errors_scatter_as_their_reported_confidence() {
+    // Ideal device, TIA noise raised so noise dominates: 8 seeds. The errors must centre on
+    // zero and scatter like the standard error each run reports (from its fit residuals).
+    let mut errs = Vec::new();
+    let mut reported = Vec::new();
+    for seed in 0..8 {
+        let mut c = fast_cfg(&[100.0, 125.0, 150.0, 175.0], 3.6);
+        c.noise = Some(NoiseConfig {
+            seed,
+            temperature_k: 300.0,
+            effective_mass_kg: None,
+            tia_current_noise_a_per_rthz: 3e-11,
+            tia_voltage_noise_v_per_rthz: 0.0,
+        });
+        let m = run_selfcal_core(&c, &quiet, &quiet).unwrap().modes[0];
+        errs.push(m.relative_error);
+        let rel = |s: &gyroemu::experiment::selfcal::SlopeFit| {
+            s.std_err_deg_per_dps / s.slope_deg_per_dps
+        };
+        reported.push(rel(&m.rotating).hypot(rel(&m.coriolis)));
+    }
+    let n = errs.len() as f64;
+    let mean = errs.iter().sum::<f64>() / n;
+    let sd = (errs.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let typical = (reported.iter().map(|r| r * r).sum::<f64>() / n).sqrt();
+    assert!(sd > 0.0 && typical > 0.0);
+    assert!(mean.abs() < 4.0 * sd / n.sqrt(), "mean {mean:e}, sd {sd:e}");
+    // Two-point fits per sweep (dof 2) make each reported error rough: a factor 3 either way.
+    assert!(
+        sd / typical > 1.0 / 3.0 && sd / typical < 3.0,
+        "scatter {sd:e}, reported {typical:e}"
+    );
+    // Same seed, same bits.
+    let mut c = fast_cfg(&[100.0, 125.0, 150.0, 175.0], 3.6);
+    c.noise = Some(NoiseConfig {
+        seed: 0,
+        temperature_k: 300.0,
+        effective_mass_kg: None,
+        tia_current_noise_a_per_rthz: 3e-11,
+        tia_voltage_noise_v_per_rthz: 0.0,
+    });
+    let again = run_selfcal_core(&c, &quiet, &quiet).unwrap().modes[0].relative_error;
+    assert_eq!(again.to_bits(), errs[0].to_bits());
+}
