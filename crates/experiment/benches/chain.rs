@@ -1,0 +1,82 @@
+//! divan benchmarks of the board (`cargo bench -p gyroemu-experiment`): the whole fused chain
+//! in f64x4 lanes (four operating points per group) on one lane group and on one group per
+//! core, noiseless and with every noise source, DAC and ADC on. Throughput is reported in
+//! point-samples (one input sample of one operating point). `gyroemu bench` prints the same
+//! chain figure and each stage alone.
+
+use divan::counter::ItemsCount;
+use divan::{black_box, Bencher};
+use gyroemu_core::f64x4;
+use gyroemu_experiment::board::{Board, Point, PointWindow};
+use gyroemu_experiment::config::{Config, NoiseConfig};
+use gyroemu_experiment::presets::preset;
+
+/// Input samples per lane group per iteration (2^20: 10 486 decimated blocks).
+const N_IN: u64 = 1 << 20;
+
+fn main() {
+    divan::main();
+}
+
+fn rotating(noise: bool) -> Config {
+    let mut c = preset("m2tfg-rotating").expect("embedded preset");
+    if noise {
+        c.noise = Some(NoiseConfig {
+            seed: 1,
+            temperature_k: 300.0,
+            effective_mass_kg: Some(1e-9),
+            tia_current_noise_a_per_rthz: 5e-14,
+            tia_voltage_noise_v_per_rthz: 2e-8,
+        });
+        c.board.dac_bits = Some(16);
+        c.board.dac_full_scale = 1.5;
+        c.board.adc_bits = Some(16);
+        c.board.adc_full_scale_v = 0.05;
+    }
+    c
+}
+
+/// Runs `groups` lane groups of N_IN samples each, one per rayon worker.
+fn run_groups(b: Bencher, noise: bool, groups: usize) {
+    let cfg = rotating(noise);
+    let rates: Vec<f64> = cfg.experiment.rates_dps[..4]
+        .iter()
+        .map(|r| r.to_radians())
+        .collect();
+    let m = cfg.board.decimation as u64;
+    let n_out = N_IN / m;
+    let point = |r: f64| Point {
+        rate_rad_s: r,
+        n_avg: n_out / 2,
+        window: PointWindow::Boxcar { frac: 0.0 },
+    };
+    let points: Vec<Point> = rates.iter().map(|&r| point(r)).collect();
+    let n_settle = n_out - n_out / 2 - 1;
+    b.counter(ItemsCount::new(n_out * m * 4 * groups as u64))
+        .with_inputs(|| {
+            (0..groups)
+                .map(|_| Board::<f64x4>::new(&cfg, &rates).expect("valid preset"))
+                .collect::<Vec<_>>()
+        })
+        .bench_local_values(|boards| {
+            use rayon::prelude::*;
+            boards.into_par_iter().for_each(|mut board| {
+                black_box(board.run(n_settle, &points, None, &|_| {}).ok());
+            });
+        });
+}
+
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn chain_1_group(b: Bencher) {
+    run_groups(b, false, 1);
+}
+
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn chain_group_per_core(b: Bencher) {
+    run_groups(b, false, rayon::current_num_threads());
+}
+
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn chain_with_noise_dac_adc_1_group(b: Bencher) {
+    run_groups(b, true, 1);
+}
