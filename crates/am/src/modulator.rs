@@ -35,6 +35,9 @@ pub struct AmModulator<S> {
     pattern: DrivePattern,
     gain1: S,
     gain2: S,
+    /// Every lane of both gains is exactly 1: the products by the gains are skipped
+    /// (multiplying by 1 changes no bit), which saves two lane multiplies per sample.
+    unit_gains: bool,
 }
 
 impl<S: Sample> AmModulator<S> {
@@ -47,6 +50,7 @@ impl<S: Sample> AmModulator<S> {
             pattern,
             gain1: S::splat(g1),
             gain2: S::splat(g2),
+            unit_gains: g1 == 1.0 && g2 == 1.0,
         })
     }
 
@@ -56,10 +60,14 @@ impl<S: Sample> AmModulator<S> {
     /// slice gives a Coriolis modulator with zero gains.
     pub fn from_lanes(lanes: &[AmModulator<f64>]) -> Self {
         let pick = |i: usize| lanes.get(i.min(lanes.len().saturating_sub(1)));
+        let gain1 = S::from_fn(|i| pick(i).map_or(0.0, |m| m.gain1));
+        let gain2 = S::from_fn(|i| pick(i).map_or(0.0, |m| m.gain2));
+        let unit = |g: S| (0..S::LANES).all(|i| g.lane(i) == 1.0);
         Self {
             pattern: lanes.first().map_or(DrivePattern::Coriolis, |m| m.pattern),
-            gain1: S::from_fn(|i| pick(i).map_or(0.0, |m| m.gain1)),
-            gain2: S::from_fn(|i| pick(i).map_or(0.0, |m| m.gain2)),
+            gain1,
+            gain2,
+            unit_gains: unit(gain1) && unit(gain2),
         }
     }
 
@@ -82,12 +90,14 @@ impl<S: Sample> Stage for AmModulator<S> {
     /// rotating: `[gain1 * mod_cos * carrier_i, gain2 * mod_sin * carrier_i]`.
     #[inline]
     fn tick(&mut self, x: AmInput<S>) -> [S; 2] {
-        match self.pattern {
-            DrivePattern::Coriolis => [self.gain1 * x.carrier_i, self.gain2 * x.carrier_q],
-            DrivePattern::Rotating => [
+        match (self.pattern, self.unit_gains) {
+            (DrivePattern::Coriolis, false) => [self.gain1 * x.carrier_i, self.gain2 * x.carrier_q],
+            (DrivePattern::Coriolis, true) => [x.carrier_i, x.carrier_q],
+            (DrivePattern::Rotating, false) => [
                 self.gain1 * x.mod_cos * x.carrier_i,
                 self.gain2 * x.mod_sin * x.carrier_i,
             ],
+            (DrivePattern::Rotating, true) => [x.mod_cos * x.carrier_i, x.mod_sin * x.carrier_i],
         }
     }
 

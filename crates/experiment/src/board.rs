@@ -177,6 +177,8 @@ pub struct Board<S: Sample> {
     plant: Resonator<S>,
     tia: [Tia<S>; 2],
     mix1: [Stage1Mixer<S>; 2],
+    /// The two stage-1 mixers have the same reference phase (their carrier factors agree).
+    mix1_same_ref: bool,
     /// Stage-1 low-pass of I1, Q1, I2, Q2.
     lp: [LowPass<S>; 4],
     decimation: usize,
@@ -257,6 +259,7 @@ impl<S: Sample> Board<S> {
         let tp = tia_params(cfg);
         let design = lowpass_design(cfg);
         let lp = || LowPass::new(design, fs);
+        let mix1 = [Stage1Mixer::new(0.0)?, Stage1Mixer::new(0.0)?];
         if cfg.board.decimation == 0 {
             return Err(ParamError::new(
                 "decimator",
@@ -312,7 +315,8 @@ impl<S: Sample> Board<S> {
             dac,
             plant: Resonator::<S>::from_lanes(&scalar),
             tia: [Tia::new(&tp)?, Tia::new(&tp)?],
-            mix1: [Stage1Mixer::new(0.0)?, Stage1Mixer::new(0.0)?],
+            mix1_same_ref: mix1[0].ref_phase_rad() == mix1[1].ref_phase_rad(),
+            mix1,
             lp: [lp()?, lp()?, lp()?, lp()?],
             decimation: cfg.board.decimation,
             mix2: Stage2Mixer::default(),
@@ -581,7 +585,12 @@ impl<S: Sample> Board<S> {
         let mut out = ([Iq::<S>::default(); 2], [zero; 2]);
         for j in 0..self.decimation as u64 {
             let (c_re, c_im) = self.carrier.tick(());
-            let cq = self.shifter.apply(Complex64::new(c_re, c_im)).re;
+            // The rotating drive uses only the in-phase carrier.
+            let cq = if K == ROTATING {
+                0.0
+            } else {
+                self.shifter.apply(Complex64::new(c_re, c_im)).re
+            };
             let (mod_cos, mod_sin) = if K == ROTATING {
                 self.modulation.tick(())
             } else {
@@ -627,11 +636,16 @@ impl<S: Sample> Board<S> {
                     y = [adc[0].quantize(y[0]), adc[1].quantize(y[1])];
                 }
             }
+            // Both stage-1 mixers see the same carrier: when their reference phases agree
+            // (always, as built) they share one set of carrier factors.
             let carrier = Complex64::new(c_re, c_im);
-            let z = [
-                self.mix1[0].tick((y[0], carrier)),
-                self.mix1[1].tick((y[1], carrier)),
-            ];
+            let f0 = self.mix1[0].factors(carrier);
+            let f1 = if self.mix1_same_ref {
+                f0
+            } else {
+                self.mix1[1].factors(carrier)
+            };
+            let z = [Stage1Mixer::mix(y[0], f0), Stage1Mixer::mix(y[1], f1)];
             if let Some(pr) = probe.as_deref_mut() {
                 pr.record_full(n0 + j, &u, &p, &y, &z);
             }

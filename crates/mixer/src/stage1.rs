@@ -27,6 +27,8 @@ pub struct Stage1Mixer<S> {
     /// scalar phasor for all lanes, so the rotation is done in scalar and broadcast once.
     cos_ref: f64,
     sin_ref: f64,
+    /// `phi` is exactly 0 (`cos_ref == 1`, `sin_ref == 0`): the rotation is the identity.
+    zero_ref: bool,
     _s: PhantomData<S>,
 }
 
@@ -41,6 +43,7 @@ impl<S: Sample> Stage1Mixer<S> {
             ref_phase_rad: phi,
             cos_ref: c,
             sin_ref: s,
+            zero_ref: c == 1.0 && s == 0.0,
             _s: PhantomData,
         })
     }
@@ -48,6 +51,36 @@ impl<S: Sample> Stage1Mixer<S> {
     /// The reference phase `phi` this mixer was built with, in radians.
     pub fn ref_phase_rad(&self) -> f64 {
         self.ref_phase_rad
+    }
+
+    /// The factors `(2 cos(w0 t + phi), -2 sin(w0 t + phi))` that [`Stage::tick`] multiplies
+    /// `y` by at carrier phasor `e^{j w0 t}`, broadcast to every lane. Split from the product
+    /// ([`Stage1Mixer::mix`]) so that mixers with the same `phi` on the same carrier can share
+    /// them (the board's two channels do: this scalar work is then done once per sample).
+    #[inline(always)]
+    pub fn factors(&self, carrier: Complex64) -> (S, S) {
+        let (pc, ps) = (carrier.re, carrier.im);
+        // e^{j(w0 t + phi)} = (pc + j ps)(cos phi + j sin phi); for phi = 0 that is the
+        // carrier itself (the products by 1 and 0 change no bit of a nonzero value), so the
+        // rotation is skipped (a predictable branch instead of four multiplies).
+        let (cos_th, sin_th) = if self.zero_ref {
+            (pc, ps)
+        } else {
+            (
+                pc * self.cos_ref - ps * self.sin_ref,
+                ps * self.cos_ref + pc * self.sin_ref,
+            )
+        };
+        // 2y cos = y (2 cos) and -(2y sin) = y (-2 sin) exactly: doubling (as an add, which
+        // is the same bits as the product by 2) and negation do not round.
+        (S::splat(cos_th + cos_th), S::splat(-(sin_th + sin_th)))
+    }
+
+    /// `y` times the factors of [`Stage1Mixer::factors`]: `tick((y, c)) == mix(y, factors(c))`
+    /// bit for bit.
+    #[inline(always)]
+    pub fn mix(y: S, (f_i, f_q): (S, S)) -> Iq<S> {
+        Iq::new(y * f_i, y * f_q)
     }
 }
 
@@ -58,13 +91,7 @@ impl<S: Sample> Stage for Stage1Mixer<S> {
 
     #[inline]
     fn tick(&mut self, (y, carrier): (S, Complex64)) -> Iq<S> {
-        let (pc, ps) = (carrier.re, carrier.im);
-        // e^{j(w0 t + phi)} = (pc + j ps)(cos phi + j sin phi).
-        let cos_th = pc * self.cos_ref - ps * self.sin_ref;
-        let sin_th = ps * self.cos_ref + pc * self.sin_ref;
-        // 2y cos = y (2 cos) and -(2y sin) = y (-2 sin) exactly: scaling by 2 and negation
-        // do not round.
-        Iq::new(y * S::splat(2.0 * cos_th), y * S::splat(-2.0 * sin_th))
+        Self::mix(y, self.factors(carrier))
     }
 
     fn reset(&mut self) {}
