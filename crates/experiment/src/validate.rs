@@ -130,7 +130,7 @@ fn key_at(text: &str, offset: usize, message: &str) -> String {
 /// is exact as an f64.
 pub const MAX_RUN_SAMPLES: f64 = 9_007_199_254_740_992.0;
 
-fn check(
+pub(crate) fn check(
     ok: bool,
     key: &str,
     value: impl std::fmt::Display,
@@ -143,7 +143,7 @@ fn check(
     }
 }
 
-fn positive(key: &str, v: f64) -> Result<(), ConfigError> {
+pub(crate) fn positive(key: &str, v: f64) -> Result<(), ConfigError> {
     check(
         v.is_finite() && v > 0.0,
         key,
@@ -154,6 +154,15 @@ fn positive(key: &str, v: f64) -> Result<(), ConfigError> {
 
 fn finite(key: &str, v: f64) -> Result<(), ConfigError> {
     check(v.is_finite(), key, v, "must be a finite number")
+}
+
+pub(crate) fn non_negative(key: &str, v: f64) -> Result<(), ConfigError> {
+    check(
+        v.is_finite() && v >= 0.0,
+        key,
+        v,
+        "must be a finite number >= 0",
+    )
 }
 
 impl Config {
@@ -314,12 +323,7 @@ impl Config {
             }
         }
         if let Some(s) = e.settle_s {
-            check(
-                s.is_finite() && s >= 0.0,
-                "experiment.settle_s",
-                s,
-                "must be a finite number >= 0",
-            )?;
+            non_negative("experiment.settle_s", s)?;
             let tau = mechanical_tau_s(d.f0_hz, d.q.max(d.q_mode2.unwrap_or(0.0)));
             if s < 10.6 * tau {
                 warnings.push(format!(
@@ -443,12 +447,7 @@ impl Config {
                 dump.rate_dps,
                 &format!("must be one of the emulated rates {emulated:?}"),
             )?;
-            check(
-                dump.start_s.is_finite() && dump.start_s >= 0.0,
-                "dump.start_s",
-                dump.start_s,
-                "must be a finite number >= 0",
-            )?;
+            non_negative("dump.start_s", dump.start_s)?;
             positive("dump.duration_s", dump.duration_s)?;
             // The point runs settling plus its own averaging window (whole half periods).
             let p = crate::sweep::plan_point(self, dump.rate_dps);

@@ -2,33 +2,7 @@
 //! `validate.rs`; same error form: key, value, rule).
 
 use crate::config::Config;
-use crate::validate::{ConfigError, MAX_RUN_SAMPLES};
-
-fn rule(ok: bool, key: &str, v: impl std::fmt::Display, r: &str) -> Result<(), ConfigError> {
-    if ok {
-        Ok(())
-    } else {
-        Err(ConfigError::key(key, v, r))
-    }
-}
-
-fn non_negative(key: &str, v: f64) -> Result<(), ConfigError> {
-    rule(
-        v.is_finite() && v >= 0.0,
-        key,
-        v,
-        "must be a finite number >= 0",
-    )
-}
-
-fn positive(key: &str, v: f64) -> Result<(), ConfigError> {
-    rule(
-        v.is_finite() && v > 0.0,
-        key,
-        v,
-        "must be a finite number > 0",
-    )
-}
+use crate::validate::{check, non_negative, positive, ConfigError, MAX_RUN_SAMPLES};
 
 impl Config {
     /// The rules of the `[noise]` and `[selfcal]` sections and of the ADC keys.
@@ -38,7 +12,7 @@ impl Config {
     ) -> Result<(), ConfigError> {
         let b = &self.board;
         if let Some(bits) = b.adc_bits {
-            rule(
+            check(
                 (2..=32).contains(&bits),
                 "board.adc_bits",
                 bits,
@@ -73,7 +47,7 @@ impl Config {
             let max_s = MAX_RUN_SAMPLES / b.fs_hz;
             if let Some(t) = s.allan_record_s {
                 let min = (10.0 / self.fs_out_hz()).max(10.0);
-                rule(
+                check(
                     t.is_finite() && t >= min && t <= max_s,
                     "selfcal.allan_record_s",
                     t,
@@ -83,7 +57,7 @@ impl Config {
                 )?;
             }
             if let Some(t) = s.tau_max_s {
-                rule(
+                check(
                     t.is_finite() && t >= 2.0 && t <= max_s,
                     "selfcal.tau_max_s",
                     t,
@@ -93,20 +67,20 @@ impl Config {
                 )?;
             }
             for (i, &dt) in s.drift_delta_t_k.iter().enumerate() {
-                rule(
+                check(
                     dt.is_finite() && dt.abs() <= 200.0,
                     &format!("selfcal.drift_delta_t_k[{i}]"),
                     dt,
                     "must be finite and within -200..200 K",
                 )?;
             }
-            rule(
+            check(
                 s.f0_tc_ppm_per_k.is_finite() && s.f0_tc_ppm_per_k.abs() < 1e4,
                 "selfcal.f0_tc_ppm_per_k",
                 s.f0_tc_ppm_per_k,
                 "must be finite and within -1e4..1e4 ppm/K",
             )?;
-            rule(
+            check(
                 s.q_tc_ppm_per_k.is_finite() && s.q_tc_ppm_per_k.abs() < 1e5,
                 "selfcal.q_tc_ppm_per_k",
                 s.q_tc_ppm_per_k,
@@ -115,7 +89,7 @@ impl Config {
             for (i, &dt) in s.drift_delta_t_k.iter().enumerate() {
                 let q_scale = 1.0 + s.q_tc_ppm_per_k * 1e-6 * dt;
                 let f_scale = 1.0 + s.f0_tc_ppm_per_k * 1e-6 * dt;
-                rule(
+                check(
                     q_scale > 0.0 && f_scale > 0.0,
                     &format!("selfcal.drift_delta_t_k[{i}]"),
                     dt,
