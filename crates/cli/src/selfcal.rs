@@ -7,7 +7,7 @@ use crate::progress::Progress;
 use anyhow::{Context, Result};
 use gyroemu_experiment::allan::AllanPoint;
 use gyroemu_experiment::run_sweep;
-use gyroemu_experiment::selfcal::{mode_selfcal, sweep_configs, validate_selfcal, SelfcalCore};
+use gyroemu_experiment::selfcal::{sweep_configs, validate_selfcal, SelfcalCore};
 use gyroemu_experiment::selfcal_analyses::{
     allan_analysis, drift_analysis, tau_analysis, AllanResult, DriftPoint, TauPoint,
 };
@@ -20,10 +20,10 @@ use std::path::Path;
 /// `gyroemu selfcal CONFIG --out DIR`.
 pub fn selfcal(config: &Path, out: &Path) -> Result<()> {
     let cfg = load_config(config)?;
-    let base = cfg.validate().unwrap_or_default();
+    // load_config printed the config's own warnings; these are the derived sweeps' extra ones.
     let warnings =
         validate_selfcal(&cfg).map_err(|e| BadInput(format!("{}: {e}", config.display())))?;
-    for w in warnings.iter().filter(|w| !base.contains(w)) {
+    for w in &warnings {
         eprintln!("warning: {}: {w}", config.display());
     }
     prepare_out(out)?;
@@ -35,12 +35,7 @@ pub fn selfcal(config: &Path, out: &Path) -> Result<()> {
     let p = Progress::new("rate-table sweep");
     let coriolis = run_sweep(&cor_cfg, &|d, t| p.update(d, t), None).context("emulation failed")?;
     p.finish(coriolis.point_samples);
-    let core = SelfcalCore {
-        angular_gain: cfg.device.angular_gain,
-        modes: [0, 1].map(|k| mode_selfcal(&cfg, &rotating, &coriolis, k)),
-        rotating,
-        coriolis,
-    };
+    let core = SelfcalCore::from_sweeps(&cfg, rotating, coriolis);
     let m = core.modes[0];
     let sc = cfg.selfcal.clone().unwrap_or_default();
     let allan = match sc.allan_record_s {

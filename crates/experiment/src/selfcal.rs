@@ -128,9 +128,10 @@ pub fn drifted(cfg: &Config, delta_t_k: f64) -> Config {
 }
 
 /// Validates every config `selfcal` will run (both sweeps, and each drifted device) before
-/// any sample is computed; returns the warnings.
+/// any sample is computed; returns the warnings they add to those of `cfg.validate()`.
 pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
-    let mut warnings = cfg.validate()?;
+    let base = cfg.validate()?;
+    let mut warnings = Vec::new();
     let (rot, cor) = sweep_configs(cfg);
     let tag = |what: &str, e: ConfigError| ConfigError {
         detail: format!("{} (in the {what} of selfcal)", e.detail),
@@ -138,7 +139,7 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
     };
     let mut add = |w: Vec<String>| {
         for x in w {
-            if !warnings.contains(&x) {
+            if !base.contains(&x) && !warnings.contains(&x) {
                 warnings.push(x);
             }
         }
@@ -182,11 +183,17 @@ pub fn run_selfcal_core(
     let (rot_cfg, cor_cfg) = sweep_configs(cfg);
     let rotating = run_sweep(&rot_cfg, rot_progress, None)?;
     let coriolis = run_sweep(&cor_cfg, cor_progress, None)?;
-    let modes = [0, 1].map(|k| mode_selfcal(cfg, &rotating, &coriolis, k));
-    Ok(SelfcalCore {
-        angular_gain: cfg.device.angular_gain,
-        modes,
-        rotating,
-        coriolis,
-    })
+    Ok(SelfcalCore::from_sweeps(cfg, rotating, coriolis))
+}
+
+impl SelfcalCore {
+    /// Compares the rotating and the rate-table sweeps of `cfg` (from [`sweep_configs`]).
+    pub fn from_sweeps(cfg: &Config, rotating: SweepResult, coriolis: SweepResult) -> Self {
+        Self {
+            angular_gain: cfg.device.angular_gain,
+            modes: [0, 1].map(|k| mode_selfcal(cfg, &rotating, &coriolis, k)),
+            rotating,
+            coriolis,
+        }
+    }
 }

@@ -6,11 +6,15 @@ use crate::allan::{noise_readings, overlapping_adev, AllanPoint, NoiseReadings};
 use crate::board::{Board, LaneResult, Point, PointWindow, RunExtras, MAX_LANES};
 use crate::config::Config;
 use crate::selfcal::{drifted, linearised_slope, run_selfcal_core, sweep_configs};
-use crate::sweep::{emulated_rates_dps, plan_point, post_process, Progress, SweepError};
+use crate::sweep::{
+    add_group_progress, canonical_work, emulated_rates_dps, plan_point, post_process, Progress,
+    SweepError,
+};
 use gyroemu_core::f64x4;
+use gyroemu_mixer::wrap_pi;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 
 /// Noise streams of the analyses start here, apart from the sweep points' streams (0..).
 pub const ANALYSIS_STREAM_BASE: u64 = 1 << 32;
@@ -73,9 +77,7 @@ pub fn allan_analysis(
                 .map(|(i, r)| {
                     let p = -r[1].atan2(r[0]);
                     if i > 0 {
-                        let mut d = p - prev;
-                        d -= core::f64::consts::TAU * (d / core::f64::consts::TAU).round();
-                        acc += d;
+                        acc += wrap_pi(p - prev);
                     } else {
                         acc = p;
                     }
@@ -188,16 +190,12 @@ pub fn tau_analysis(
         })
         .collect();
     let n_settle = rot.n_settle_out();
-    let m = rot.board.decimation as u64;
     let groups: Vec<(usize, &[Point])> = points
         .chunks(MAX_LANES)
         .enumerate()
         .map(|(g, c)| (g * MAX_LANES, c))
         .collect();
-    let total: u64 = groups
-        .iter()
-        .map(|(_, g)| (n_settle + g.iter().map(|p| p.n_avg + 1).max().unwrap_or(1)) * m)
-        .sum();
+    let (total, _) = canonical_work(&rot, &points);
     let done = AtomicU64::new(0);
     let mut boards = Vec::new();
     for (first, g) in &groups {
@@ -225,11 +223,7 @@ pub fn tau_analysis(
                 series_block: 0,
             };
             let last = AtomicU64::new(0);
-            let report = |n: u64| {
-                let prev = last.swap(n, Ordering::Relaxed);
-                let all = done.fetch_add(n - prev, Ordering::Relaxed) + n - prev;
-                progress(all, total);
-            };
+            let report = |n: u64| add_group_progress(&done, &last, n, total, progress);
             Ok(board
                 .run_with(n_settle, g, None, &extras, &report)?
                 .checkpoints)

@@ -193,7 +193,7 @@ pub struct SweepRun {
 /// The canonical lane grouping of a sweep (all points in index order, four per group) and
 /// its work: (input samples per lane group summed, operating-point samples). Reported in the
 /// results, so they are the same whichever subset, order or shard actually ran the points.
-fn canonical_work(cfg: &Config, points: &[Point]) -> (u64, u64) {
+pub(crate) fn canonical_work(cfg: &Config, points: &[Point]) -> (u64, u64) {
     let n_settle = cfg.n_settle_out();
     let m = cfg.board.decimation as u64;
     let group_samples =
@@ -202,6 +202,21 @@ fn canonical_work(cfg: &Config, points: &[Point]) -> (u64, u64) {
         let n = group_samples(g);
         (s + n, ps + n * g.len() as u64)
     })
+}
+
+/// A lane group reports the input samples it has done (`n`, its own count): adds the increase
+/// since its previous report (`last`) to the count shared by all groups (`done`) and reports
+/// that against `total`.
+pub(crate) fn add_group_progress(
+    done: &AtomicU64,
+    last: &AtomicU64,
+    n: u64,
+    total: u64,
+    progress: Progress,
+) {
+    let prev = last.swap(n, Ordering::Relaxed);
+    let all = done.fetch_add(n - prev, Ordering::Relaxed) + n - prev;
+    progress(all, total);
 }
 
 /// Runs the points of a sweep that `opts` assigns and that are not done yet, four per lane
@@ -281,9 +296,7 @@ pub fn run_sweep_with(
             });
             let last = AtomicU64::new(0);
             let report = |n: u64| {
-                let prev = last.swap(n, Ordering::Relaxed);
-                let all = done.fetch_add(n - prev, Ordering::Relaxed) + n - prev;
-                progress(all, total);
+                add_group_progress(&done, &last, n, total, progress);
                 if user_cancel() {
                     stop.store(true, Ordering::Relaxed);
                 }
