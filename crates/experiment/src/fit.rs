@@ -108,11 +108,19 @@ mod tests {
     }
 
     #[test]
-    fn t95_matches_known_quantiles() {
-        // t(0.975; 1) = 12.706, t(0.975; 10) = 2.228, normal limit 1.96.
-        assert_eq!(t95(1), 12.706);
-        assert_eq!(t95(10), 2.228);
-        assert_eq!(t95(1000), 1.96);
+    fn t95_matches_the_closed_forms_and_tends_to_the_normal_quantile() {
+        // dof 1 is Cauchy: t = tan(pi (p - 1/2)); dof 2: t = (2p - 1) / sqrt(2 p (1 - p)).
+        let p = 0.975f64;
+        let t1 = (std::f64::consts::PI * (p - 0.5)).tan();
+        let t2 = (2.0 * p - 1.0) / (2.0 * p * (1.0 - p)).sqrt();
+        assert!((t95(1) - t1).abs() < 5e-4, "{} vs {t1}", t95(1));
+        assert!((t95(2) - t2).abs() < 5e-4, "{} vs {t2}", t95(2));
+        // Decreasing in dof, above the normal 1.959964 and close to it by dof 30.
+        for d in 1..30 {
+            assert!(t95(d) > t95(d + 1));
+        }
+        assert!(t95(30) > 1.959_964 && t95(30) - 1.959_964 < 0.1);
+        assert!((t95(1000) - 1.959_964).abs() < 1e-3);
         assert!(t95(0).is_infinite());
     }
 }
