@@ -129,7 +129,9 @@ fn raw_sections(
                 // t = tan(pi fc/fs): exactly the prewarped bilinear first-order section.
                 let c = Coefficients::from_params(Type::SinglePoleLowPass, fs_h, fc_h, 1.0)
                     .map_err(map)?;
-                out[k] = Coefs::biquad(c.b0, c.b1, 0.0, c.a1, 0.0);
+                // Its b1 is b0 bit for bit; the cascade runs the numerator as 1 + z^-1 and
+                // applies b0 once, so record exactly that.
+                out[k] = Coefs::biquad(c.b0, c.b0, 0.0, c.a1, 0.0);
                 k += 1;
             }
             // Pole pairs at angle psi_m = pi (N - 2m + 1) / (2N) from the negative real axis,
@@ -138,7 +140,10 @@ fn raw_sections(
                 let psi = core::f64::consts::PI * (n - 2 * m + 1) as f64 / (2 * n) as f64;
                 let q = 1.0 / (2.0 * psi.cos());
                 let c = Coefficients::from_params(Type::LowPass, fs_h, fc_h, q).map_err(map)?;
-                out[k] = Coefs::biquad(c.b0, c.b1, c.b2, c.a1, c.a2);
+                // Its b1 is 2 b0 and b2 is b0 bit for bit ((1 - cos w)/2 and 1 - cos w scaled
+                // by the same 1/a0); the cascade runs the numerator as (1 + z^-1)^2 and
+                // applies b0 once, so record exactly that.
+                out[k] = Coefs::biquad(c.b0, 2.0 * c.b0, c.b0, c.a1, c.a2);
                 k += 1;
             }
             Ok((false, k, out))

@@ -14,13 +14,22 @@ pub(crate) fn u_of(turns: f64) -> Complex64 {
 /// Cascade of up to 8 sections with fixed capacity (no allocation): Butterworth biquads in
 /// transposed direct form II, or lock-in RC one-poles.
 ///
+/// The Butterworth sections run with unit numerators `(1 + z^-1)^2` and the product of their
+/// gains `g` is applied once, to the input: two fused steps per section instead of five
+/// multiplies. At the input (not the output) every intermediate value stays at or below the
+/// size it has in a cascade of scaled sections, so the filter keeps its full range.
+///
 /// Precision note: direct-form sections with poles near `z = 1` lose relative accuracy of
 /// order `eps / (2 pi fc/fs)^2` in their DC gain; [`Response`] uses the stored coefficients,
 /// so it stays the exact response of the filter as built.
 #[derive(Clone, Debug)]
 pub struct LowPass<S> {
     one_pole: bool,
+    /// Section 0 is the first-order section of an odd Butterworth order.
+    first_order: bool,
     n: usize,
+    /// Product of the Butterworth sections' numerator gains.
+    gain: S,
     sec: [Section<S>; MAX_ORDER],
     coefs: [Coefs; MAX_ORDER],
     fs_hz: f64,
@@ -34,9 +43,16 @@ impl<S: Sample> LowPass<S> {
         for (s, c) in sec.iter_mut().zip(&coefs).take(n) {
             *s = Section::new(c);
         }
+        let gain = if one_pole {
+            1.0
+        } else {
+            coefs[..n].iter().map(|c| c.b0).product()
+        };
         Ok(Self {
             one_pole,
+            first_order: !one_pole && coefs[0].a2 == 0.0 && coefs[0].b2 == 0.0,
             n,
+            gain: S::splat(gain),
             sec,
             coefs,
             fs_hz,
@@ -59,17 +75,23 @@ impl<S: Sample> Stage for LowPass<S> {
     type Input = S;
     type Output = S;
 
-    #[inline]
+    #[inline(always)]
     fn tick(&mut self, x: S) -> S {
-        let mut y = x;
         if self.one_pole {
+            let mut y = x;
             for s in &mut self.sec[..self.n] {
                 y = s.tick_one_pole(y);
             }
-        } else {
-            for s in &mut self.sec[..self.n] {
-                y = s.tick_df2t(y);
-            }
+            return y;
+        }
+        let mut y = self.gain * x;
+        let mut rest = &mut self.sec[..self.n];
+        if self.first_order {
+            y = rest[0].tick_unit1(y);
+            rest = &mut rest[1..];
+        }
+        for s in rest {
+            y = s.tick_unit2(y);
         }
         y
     }

@@ -77,12 +77,17 @@ impl Coefs {
     }
 }
 
-/// A section's coefficients as samples and its two state variables.
+/// A section's recursion coefficients as samples and its two state variables.
+///
+/// Butterworth sections are run without their numerator gain: biquad designs them as
+/// `g (1 + z^-1)^2 / A(z)` (first order: `g (1 + z^-1) / A(z)`), exactly (its `b1` is `2 b0`
+/// and `b2` is `b0` bit for bit), so a section needs two multiply-adds and three adds instead
+/// of five multiplies, and the cascade applies the product of the gains once (see
+/// [`crate::LowPass`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Section<S> {
-    b0: S,
-    b1: S,
-    b2: S,
+    /// Lock-in one-pole: its `k`.
+    k: S,
     /// -a1 and -a2, stored negated so the recursion is pure multiply-adds.
     neg_a1: S,
     neg_a2: S,
@@ -93,9 +98,7 @@ pub(crate) struct Section<S> {
 impl<S: Sample> Section<S> {
     pub fn new(c: &Coefs) -> Self {
         Self {
-            b0: S::splat(c.b0),
-            b1: S::splat(c.b1),
-            b2: S::splat(c.b2),
+            k: S::splat(c.b0),
             neg_a1: S::splat(-c.a1),
             neg_a2: S::splat(-c.a2),
             s1: S::default(),
@@ -103,22 +106,30 @@ impl<S: Sample> Section<S> {
         }
     }
 
-    /// Transposed direct form II: fewest states, and each state is a sum of scaled signals
-    /// (no large internal gain for low-pass sections).
+    /// `(1 + z^-1)^2 / (1 + a1 z^-1 + a2 z^-2)` in transposed direct form II (fewest states).
     #[inline(always)]
-    pub fn tick_df2t(&mut self, x: S) -> S {
-        // Multiply-adds ordered so the recursion through y is two fused steps long.
-        let y = self.b0.mul_add(x, self.s1);
-        self.s1 = self.neg_a1.mul_add(y, self.b1.mul_add(x, self.s2));
-        self.s2 = self.neg_a2.mul_add(y, self.b2 * x);
+    pub fn tick_unit2(&mut self, x: S) -> S {
+        // The recursion through y is one add and one multiply-add long; `2x + s2` waits on
+        // nothing of this sample.
+        let y = x + self.s1;
+        self.s1 = self.neg_a1.mul_add(y, (x + x) + self.s2);
+        self.s2 = self.neg_a2.mul_add(y, x);
         y
     }
 
-    /// Lock-in RC one-pole `y += k (x - y)` with `k = b0` (state in `s1`): a held input is
-    /// reached exactly, whatever the rounding of `k`.
+    /// `(1 + z^-1) / (1 + a1 z^-1)` in transposed direct form II.
+    #[inline(always)]
+    pub fn tick_unit1(&mut self, x: S) -> S {
+        let y = x + self.s1;
+        self.s1 = self.neg_a1.mul_add(y, x);
+        y
+    }
+
+    /// Lock-in RC one-pole `y += k (x - y)` (state in `s1`): a held input is reached
+    /// exactly, whatever the rounding of `k`.
     #[inline(always)]
     pub fn tick_one_pole(&mut self, x: S) -> S {
-        let y = self.s1 + self.b0 * (x - self.s1);
+        let y = self.s1 + self.k * (x - self.s1);
         self.s1 = y;
         y
     }

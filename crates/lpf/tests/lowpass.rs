@@ -248,3 +248,58 @@ fn lowpass_new_refuses_cutoffs_whose_poles_round_onto_the_unit_circle() {
         );
     }
 }
+
+/// The cascade runs biquad's sections with unit numerators and one gain, which relies on
+/// biquad designing `b1 = 2 b0`, `b2 = b0` (first order: `b1 = b0`) bit for bit. Check the
+/// claim on a sweep of cutoffs and Q, then the cascade against biquad's own transposed
+/// direct form II cascade (an independent implementation) on random input.
+#[test]
+fn unit_numerator_cascade_equals_biquads_own_sections() {
+    use biquad::{Biquad, Coefficients, DirectForm2Transposed, ToHertz, Type};
+    use rand::{RngExt, SeedableRng};
+    let fs = 48_000.0;
+    for fc in [0.05, 1.0, 37.0, 480.0, 4_000.0, 17_000.0, 23_900.0] {
+        for q in [0.5001, 0.54, 0.7, 1.3, 2.56] {
+            let c = Coefficients::<f64>::from_params(Type::LowPass, fs.hz(), fc.hz(), q).unwrap();
+            assert_eq!((c.b1, c.b2), (2.0 * c.b0, c.b0), "fc {fc} q {q}");
+        }
+        let c = Coefficients::<f64>::from_params(Type::SinglePoleLowPass, fs.hz(), fc.hz(), 1.0)
+            .unwrap();
+        assert_eq!((c.b1, c.b2), (c.b0, 0.0), "first order fc {fc}");
+    }
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    for order in 1..=8 {
+        for fc in [120.0, 2_400.0, 15_000.0] {
+            let mut lp = LowPass::<f64>::new(bw(order, fc), fs).unwrap();
+            // The same sections from biquad: the first-order one first, then Q ascending.
+            let mut secs = Vec::new();
+            if order % 2 == 1 {
+                let c = Coefficients::from_params(Type::SinglePoleLowPass, fs.hz(), fc.hz(), 1.0)
+                    .unwrap();
+                secs.push(DirectForm2Transposed::<f64>::new(c));
+            }
+            for m in (1..=order / 2).rev() {
+                let psi = PI * (order - 2 * m + 1) as f64 / (2 * order) as f64;
+                let q = 1.0 / (2.0 * psi.cos());
+                let c = Coefficients::from_params(Type::LowPass, fs.hz(), fc.hz(), q).unwrap();
+                secs.push(DirectForm2Transposed::<f64>::new(c));
+            }
+            let (mut worst, mut scale) = (0.0f64, 0.0f64);
+            for _ in 0..4_000 {
+                let x: f64 = rng.random_range(-1.0..1.0);
+                let want = secs.iter_mut().fold(x, |v, s| s.run(v));
+                worst = worst.max((lp.tick(x) - want).abs());
+                scale = scale.max(want.abs());
+            }
+            // Rounding of two orderings of the same recursion: a few eps per section,
+            // amplified by the poles' closeness to z = 1 (w = 2 pi fc/fs).
+            let w = TAU * fc / fs;
+            let tol = 64.0 * f64::EPSILON * order as f64 / (w * w).min(1.0);
+            assert!(
+                worst <= tol * scale,
+                "N={order} fc={fc}: {worst:e} vs {:e}",
+                tol * scale
+            );
+        }
+    }
+}
