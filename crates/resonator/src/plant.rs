@@ -122,6 +122,38 @@ impl<S: Sample> Resonator<S> {
         y
     }
 
+    /// Whether every cross-mode entry of `[Phi | Gamma]` is exactly zero in every lane (no
+    /// Coriolis term and no quadrature coupling): the two modes are then independent
+    /// two-state plants and [`Resonator::tick_decoupled`] applies.
+    pub fn decoupled(&self) -> bool {
+        // Mode 1 is state 0, 2 and force 4; mode 2 is state 1, 3 and force 5.
+        let mode = |j: usize| j % 2;
+        (0..4).all(|i| {
+            (0..6)
+                .filter(|&j| mode(j) != mode(i))
+                .all(|j| (0..S::LANES).all(|l| self.e0[i][j].lane(l) == 0.0))
+        })
+    }
+
+    /// [`Stage::tick`] of a [`Resonator::decoupled`] plant: the same multiply-adds in the
+    /// same order with the products by exact zeros left out (three per row instead of six),
+    /// so the result is bit-identical but for the sign of an exact zero.
+    #[inline(always)]
+    pub fn tick_decoupled(&mut self, force: [S; 2]) -> PlantOutput<S> {
+        debug_assert!(self.decoupled());
+        let y = self.output();
+        let x = self.x;
+        for i in 0..4 {
+            let (m, e) = (i % 2, &self.e0[i]);
+            // `row` with e[1 - m], e[3 - m], e[5 - m] zero: f = e[4+m] u[m]; a = fma(e[m],
+            // x[m], f); b = e[2+m] x[2+m]; a + b.
+            let f = e[4 + m] * force[m];
+            let a = e[m].mul_add(x[m], f);
+            self.x[i] = a + e[2 + m] * x[2 + m];
+        }
+        y
+    }
+
     /// The current state `[q1, q2, v1, v2]` (m, m/s).
     pub fn state(&self) -> [S; 4] {
         self.x

@@ -137,3 +137,41 @@ fn bad_parameters_are_refused_with_named_errors() {
     check(ok, f64::NAN, "omega_z_rad_s");
     assert!(ok.validate().is_ok());
 }
+
+/// With no Coriolis term and no quadrature coupling the step matrix has exact zeros across
+/// the modes, and the decoupled step (three products per row) equals the full step bit for
+/// bit; any coupling makes the plant refuse the shortcut.
+#[test]
+fn decoupled_step_equals_full_step_and_is_only_offered_without_coupling() {
+    let mut p = lane_params(2).0;
+    p.quadrature_coupling_rad2_s2 = 0.0;
+    let mut full = Resonator::<f64x4>::new(&p, 0.0).unwrap();
+    assert!(full.decoupled());
+    full.set_state([1e-6, -2e-7, 3e-4, 1e-5].map(f64x4::splat));
+    let mut dec = full.clone();
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    for n in 0..20_000 {
+        let force: [f64x4; 2] =
+            core::array::from_fn(|_| f64x4::from_fn(|_| rng.random_range(-1.0..1.0)));
+        let (a, b) = (full.tick(force), dec.tick_decoupled(force));
+        for k in 0..2 {
+            for (u, v) in [
+                (a.q[k], b.q[k]),
+                (a.v[k], b.v[k]),
+                (a.current[k], b.current[k]),
+            ] {
+                let (u, v) = (u.to_array(), v.to_array());
+                assert_eq!(u.map(f64::to_bits), v.map(f64::to_bits), "sample {n}");
+            }
+        }
+    }
+    // A rotation rate, a coupling, or one coupled lane among four: not decoupled.
+    assert!(!Resonator::<f64>::new(&p, 0.5).unwrap().decoupled());
+    let mut pk = p;
+    pk.quadrature_coupling_rad2_s2 = 1e-3;
+    assert!(!Resonator::<f64>::new(&pk, 0.0).unwrap().decoupled());
+    let plain = Resonator::<f64>::new(&p, 0.0).unwrap();
+    let coupled = Resonator::<f64>::new(&p, 0.5).unwrap();
+    let mixed = [plain.clone(), plain.clone(), coupled, plain];
+    assert!(!Resonator::<f64x4>::from_lanes(&mixed).decoupled());
+}
