@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 mod averager;
+mod bank;
 mod decimator;
 mod design;
 mod kahan;
@@ -13,8 +14,9 @@ mod lowpass;
 mod section;
 
 pub use averager::{whole_half_periods, Averager, Window};
+pub use bank::LowPassBank;
 pub use decimator::{DecimateMode, Decimator};
-pub use design::LowPassDesign;
+pub use design::{LowPassDesign, MAX_ORDER};
 pub use kahan::KahanSum;
 pub use lowpass::LowPass;
 

@@ -24,13 +24,13 @@ pub(crate) fn u_of(turns: f64) -> Complex64 {
 /// so it stays the exact response of the filter as built.
 #[derive(Clone, Debug)]
 pub struct LowPass<S> {
-    one_pole: bool,
+    pub(crate) one_pole: bool,
     /// Section 0 is the first-order section of an odd Butterworth order.
-    first_order: bool,
-    n: usize,
+    pub(crate) first_order: bool,
+    pub(crate) n: usize,
     /// Product of the Butterworth sections' numerator gains.
-    gain: S,
-    sec: [Section<S>; MAX_ORDER],
+    pub(crate) gain: S,
+    pub(crate) sec: [Section<S>; MAX_ORDER],
     coefs: [Coefs; MAX_ORDER],
     fs_hz: f64,
 }

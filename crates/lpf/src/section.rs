@@ -77,7 +77,9 @@ impl Coefs {
     }
 }
 
-/// A section's recursion coefficients as samples and its two state variables.
+/// A section's recursion coefficients as samples; the state lives with the caller (one
+/// [`Section`], or one per channel of a [`crate::LowPassBank`]), so every channel runs the
+/// very same arithmetic.
 ///
 /// Butterworth sections are run without their numerator gain: biquad designs them as
 /// `g (1 + z^-1)^2 / A(z)` (first order: `g (1 + z^-1) / A(z)`), exactly (its `b1` is `2 b0`
@@ -85,12 +87,56 @@ impl Coefs {
 /// of five multiplies, and the cascade applies the product of the gains once (see
 /// [`crate::LowPass`]).
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Section<S> {
+pub(crate) struct SectionCoefs<S> {
     /// Lock-in one-pole: its `k`.
     k: S,
     /// -a1 and -a2, stored negated so the recursion is pure multiply-adds.
     neg_a1: S,
     neg_a2: S,
+}
+
+impl<S: Sample> SectionCoefs<S> {
+    pub fn new(c: &Coefs) -> Self {
+        Self {
+            k: S::splat(c.b0),
+            neg_a1: S::splat(-c.a1),
+            neg_a2: S::splat(-c.a2),
+        }
+    }
+
+    /// `(1 + z^-1)^2 / (1 + a1 z^-1 + a2 z^-2)` in transposed direct form II (fewest states).
+    #[inline(always)]
+    pub fn unit2(&self, s1: &mut S, s2: &mut S, x: S) -> S {
+        // The recursion through y is one add and one multiply-add long; `2x + s2` waits on
+        // nothing of this sample.
+        let y = x + *s1;
+        *s1 = self.neg_a1.mul_add(y, (x + x) + *s2);
+        *s2 = self.neg_a2.mul_add(y, x);
+        y
+    }
+
+    /// `(1 + z^-1) / (1 + a1 z^-1)` in transposed direct form II.
+    #[inline(always)]
+    pub fn unit1(&self, s1: &mut S, x: S) -> S {
+        let y = x + *s1;
+        *s1 = self.neg_a1.mul_add(y, x);
+        y
+    }
+
+    /// Lock-in RC one-pole `y += k (x - y)` (state `s1`): a held input is reached exactly,
+    /// whatever the rounding of `k`.
+    #[inline(always)]
+    pub fn one_pole(&self, s1: &mut S, x: S) -> S {
+        let y = *s1 + self.k * (x - *s1);
+        *s1 = y;
+        y
+    }
+}
+
+/// A section's coefficients and its two state variables.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Section<S> {
+    c: SectionCoefs<S>,
     s1: S,
     s2: S,
 }
@@ -98,40 +144,35 @@ pub(crate) struct Section<S> {
 impl<S: Sample> Section<S> {
     pub fn new(c: &Coefs) -> Self {
         Self {
-            k: S::splat(c.b0),
-            neg_a1: S::splat(-c.a1),
-            neg_a2: S::splat(-c.a2),
+            c: SectionCoefs::new(c),
             s1: S::default(),
             s2: S::default(),
         }
     }
 
-    /// `(1 + z^-1)^2 / (1 + a1 z^-1 + a2 z^-2)` in transposed direct form II (fewest states).
+    /// The coefficients alone.
+    pub fn coefs(&self) -> &SectionCoefs<S> {
+        &self.c
+    }
+
     #[inline(always)]
     pub fn tick_unit2(&mut self, x: S) -> S {
-        // The recursion through y is one add and one multiply-add long; `2x + s2` waits on
-        // nothing of this sample.
-        let y = x + self.s1;
-        self.s1 = self.neg_a1.mul_add(y, (x + x) + self.s2);
-        self.s2 = self.neg_a2.mul_add(y, x);
-        y
+        self.c.unit2(&mut self.s1, &mut self.s2, x)
     }
 
-    /// `(1 + z^-1) / (1 + a1 z^-1)` in transposed direct form II.
     #[inline(always)]
     pub fn tick_unit1(&mut self, x: S) -> S {
-        let y = x + self.s1;
-        self.s1 = self.neg_a1.mul_add(y, x);
-        y
+        self.c.unit1(&mut self.s1, x)
     }
 
-    /// Lock-in RC one-pole `y += k (x - y)` (state in `s1`): a held input is reached
-    /// exactly, whatever the rounding of `k`.
     #[inline(always)]
     pub fn tick_one_pole(&mut self, x: S) -> S {
-        let y = self.s1 + self.k * (x - self.s1);
-        self.s1 = y;
-        y
+        self.c.one_pole(&mut self.s1, x)
+    }
+
+    /// The state `(s1, s2)`.
+    pub fn state(&self) -> (S, S) {
+        (self.s1, self.s2)
     }
 
     pub fn reset(&mut self) {

@@ -1,9 +1,11 @@
-//! LowPass invariants: block processing equals ticking, reset reproduces, lanes equal scalar.
+//! LowPass invariants: block processing equals ticking, reset reproduces, lanes equal scalar,
+//! a bank of channels equals one filter per channel.
 
 mod common;
 
+use gyroemu_core::Response;
 use gyroemu_core::{f64x4, Sample, Stage};
-use gyroemu_lpf::{LowPass, LowPassDesign};
+use gyroemu_lpf::{LowPass, LowPassBank, LowPassDesign};
 
 fn designs() -> Vec<LowPassDesign> {
     let mut d: Vec<LowPassDesign> = (1..=8)
@@ -58,6 +60,36 @@ fn f64x4_lanes_equal_scalar_bit_for_bit() {
                 );
             }
         }
+    }
+}
+
+#[test]
+fn bank_channels_equal_one_filter_each_bit_for_bit_and_reset_reproduces() {
+    let xs: Vec<Vec<f64>> = (0..3)
+        .map(|c| common::noise(3000, 1.0 + c as f64, 40 + c as u64))
+        .collect();
+    for design in designs() {
+        let proto = LowPass::<f64x4>::new(design, 1e5).unwrap();
+        let mut bank = LowPassBank::<f64x4, 3>::new(&proto);
+        let input = |i: usize| -> [f64x4; 3] {
+            core::array::from_fn(|c| f64x4::from_fn(|l| xs[c][i] * (l + 1) as f64))
+        };
+        let out: Vec<[f64x4; 3]> = (0..3000).map(|i| bank.tick(input(i))).collect();
+        for c in 0..3 {
+            let mut one = proto.clone();
+            for (i, o) in out.iter().enumerate() {
+                let want = one.tick(input(i)[c]).to_array().map(f64::to_bits);
+                assert_eq!(
+                    o[c].to_array().map(f64::to_bits),
+                    want,
+                    "{design:?} ch {c} at {i}"
+                );
+            }
+        }
+        bank.reset();
+        assert_eq!(bank.tick(input(0))[2].to_array(), out[0][2].to_array());
+        assert_eq!(bank.response(900.0), proto.response(900.0));
+        assert_eq!(bank.latency_samples(), proto.latency_samples());
     }
 }
 
