@@ -257,9 +257,12 @@ pub fn config(preset: Option<&str>, list: bool) -> Result<()> {
 }
 
 /// `gyroemu bench`: prints point-samples per second for the chain and each stage.
-pub fn bench(preset_name: &str, samples: u64) -> Result<()> {
+pub fn bench(preset_name: &str, samples: u64, repeats: usize) -> Result<()> {
     let cfg =
         gyroemu_experiment::presets::preset(preset_name).map_err(|e| BadInput(e.to_string()))?;
+    if repeats == 0 {
+        return Err(BadInput("--repeats = 0: must be at least 1".into()).into());
+    }
     if samples < 100 * cfg.board.decimation as u64 {
         return Err(BadInput(format!(
             "--samples = {samples}: must be at least 100 decimation blocks ({})",
@@ -268,19 +271,20 @@ pub fn bench(preset_name: &str, samples: u64) -> Result<()> {
         .into());
     }
     eprintln!(
-        "bench: preset {preset_name}, fs = {} Hz, {samples} input samples per lane group, 4 operating points per group",
+        "bench: preset {preset_name}, fs = {} Hz, {samples} input samples per lane group, 4 operating points per group, best and median of {repeats} runs",
         cfg.board.fs_hz
     );
     println!(
-        "{:<48} {:>7} {:>14}",
-        "what", "threads", "M point-samples/s"
+        "{:<48} {:>7} {:>10} {:>10}",
+        "what (M point-samples/s)", "threads", "best", "median"
     );
-    for t in gyroemu_experiment::bench::all(&cfg, samples) {
+    for t in gyroemu_experiment::bench::all(&cfg, samples, repeats) {
         println!(
-            "{:<48} {:>7} {:>14.1}",
+            "{:<48} {:>7} {:>10.1} {:>10.1}",
             t.name,
             t.threads,
-            t.point_samples_per_s / 1e6
+            t.point_samples_per_s / 1e6,
+            t.median_point_samples_per_s / 1e6
         );
     }
     Ok(())

@@ -83,6 +83,10 @@ enum Command {
         /// Input samples per lane group.
         #[arg(long, default_value_t = 1 << 24)]
         samples: u64,
+        /// Runs of each measurement; the best and the median are printed (a shared machine
+        /// varies by 10 % or more from run to run).
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
     },
     /// Print a complete, commented config that `run` accepts.
     Config {
@@ -164,7 +168,11 @@ fn run_cli() -> ExitCode {
         Command::Merge { dir } => merge::merge(&dir),
         Command::Selfcal { config, out } => selfcal::selfcal(&config, &out),
         Command::Config { preset, list } => commands::config(preset.as_deref(), list),
-        Command::Bench { preset, samples } => commands::bench(&preset, samples),
+        Command::Bench {
+            preset,
+            samples,
+            repeats,
+        } => commands::bench(&preset, samples, repeats),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

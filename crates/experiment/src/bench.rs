@@ -9,15 +9,30 @@ use rayon::prelude::*;
 use std::hint::black_box;
 use std::time::Instant;
 
-/// One measured figure.
+/// One measured figure, over repeated runs.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Throughput {
     /// What was measured.
     pub name: String,
     /// Threads used.
     pub threads: usize,
-    /// Operating-point samples per second.
+    /// Operating-point samples per second, best run (the machine undisturbed).
     pub point_samples_per_s: f64,
+    /// The same, median run (what a run on a shared machine typically gets).
+    pub median_point_samples_per_s: f64,
+}
+
+/// Best and median of `repeats` (at least 1) measurements.
+fn best_and_median(repeats: usize, mut measure: impl FnMut() -> f64) -> (f64, f64) {
+    let mut v: Vec<f64> = (0..repeats.max(1)).map(|_| measure()).collect();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    let median = if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    };
+    (v[n - 1], median)
 }
 
 /// Four operating points of `cfg` (its first rates, padded) for one lane group.
@@ -63,8 +78,25 @@ fn stage<T: Stage>(mut st: T, n: u64, lanes: usize, input: impl Fn(u64) -> T::In
     (n as f64 * lanes as f64) / t.elapsed().as_secs_f64()
 }
 
-/// Every figure: the chain on 1 thread and on all threads, then each stage on 1 thread.
-pub fn all(cfg: &Config, n_in: u64) -> Vec<Throughput> {
+/// A plant driven through its decoupled step (what the board runs when the modes are
+/// uncoupled), as a stage.
+struct DecoupledPlant(gyroemu_resonator::Resonator<f64x4>);
+
+impl Stage for DecoupledPlant {
+    type Input = [f64x4; 2];
+    type Output = gyroemu_resonator::PlantOutput<f64x4>;
+    #[inline]
+    fn tick(&mut self, force: [f64x4; 2]) -> Self::Output {
+        self.0.tick_decoupled(force)
+    }
+    fn reset(&mut self) {
+        self.0.reset();
+    }
+}
+
+/// Every figure, each the best and the median of `repeats` runs: the chain on 1 thread and
+/// on all threads, then each stage on 1 thread.
+pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     use crate::board::{resonator_params, tia_params};
     use gyroemu_am::{AmInput, AmModulator, DrivePattern};
     use gyroemu_lpf::{LowPass, LowPassDesign};
@@ -73,82 +105,102 @@ pub fn all(cfg: &Config, n_in: u64) -> Vec<Throughput> {
     use gyroemu_resonator::Resonator;
     use gyroemu_tia::Tia;
     let threads = rayon::current_num_threads();
-    let mut out = vec![Throughput {
-        name: "whole chain".into(),
-        threads: 1,
-        point_samples_per_s: chain(cfg, n_in, 1),
-    }];
-    if threads > 1 {
+    let mut out = Vec::new();
+    let mut push_n = |name: &str, threads: usize, measure: &mut dyn FnMut() -> f64| {
+        let (best, median) = best_and_median(repeats, measure);
         out.push(Throughput {
-            name: "whole chain".into(),
+            name: name.into(),
             threads,
-            point_samples_per_s: chain(cfg, n_in, threads),
-        });
+            point_samples_per_s: best,
+            median_point_samples_per_s: median,
+        })
+    };
+    push_n("whole chain", 1, &mut || chain(cfg, n_in, 1));
+    if threads > 1 {
+        push_n("whole chain", threads, &mut || chain(cfg, n_in, threads));
     }
     let x = |i: u64| f64x4::splat((i & 1023) as f64 * 1e-3);
     let fs = cfg.board.fs_hz;
-    let mut push = |name: &str, v: f64| {
-        out.push(Throughput {
-            name: name.into(),
-            threads: 1,
-            point_samples_per_s: v,
-        })
-    };
+    let mut push =
+        |name: &str, mut measure: Box<dyn FnMut() -> f64 + '_>| push_n(name, 1, &mut *measure);
     let nco = Nco::new(cfg.device.f0_hz, fs, 0.0).expect("valid");
     let carrier = RotatingNco::<f64>::new(std::slice::from_ref(&nco));
     push(
         "carrier RotatingNco (scalar, 4 lanes share it)",
-        stage(carrier, n_in, 4, |_| ()),
+        Box::new(|| stage(carrier.clone(), n_in, 4, |_| ())),
     );
     let mods: Vec<Nco> = lane_rates(cfg)
         .iter()
         .map(|r| Nco::new(r / std::f64::consts::TAU, fs, 0.0).expect("valid"))
         .collect();
+    let modulation = RotatingNco::<f64x4>::new(&mods);
     push(
         "modulation RotatingNco (f64x4)",
-        stage(RotatingNco::<f64x4>::new(&mods), n_in, 4, |_| ()),
+        Box::new(|| stage(modulation.clone(), n_in, 4, |_| ())),
     );
     push(
         "table Nco (exact re-sets only)",
-        stage(nco, n_in, 4, |_| ()),
+        Box::new(|| stage(nco.clone(), n_in, 4, |_| ())),
     );
     let c = |i: u64| gyroemu_core::Complex64::new(x(i).lane(0), 0.5);
     push(
         "phase shifter (scalar)",
-        stage(PhaseShifter::quadrature(), n_in, 4, c),
+        Box::new(|| stage(PhaseShifter::quadrature(), n_in, 4, c)),
     );
     let am = AmModulator::<f64x4>::new(DrivePattern::Rotating, 1.0, 1.0).expect("valid");
     push(
         "am modulator",
-        stage(am, n_in, 4, |i| AmInput {
-            carrier_i: x(i),
-            carrier_q: x(i + 1),
-            mod_cos: x(i + 2),
-            mod_sin: x(i + 3),
+        Box::new(|| {
+            stage(am, n_in, 4, |i| AmInput {
+                carrier_i: x(i),
+                carrier_q: x(i + 1),
+                mod_cos: x(i + 2),
+                mod_sin: x(i + 3),
+            })
         }),
     );
+    let params = resonator_params(cfg);
     let scalar: Vec<Resonator<f64>> = lane_rates(cfg)
         .iter()
-        .map(|&r| Resonator::new(&resonator_params(cfg), r).expect("valid"))
+        .map(|&r| Resonator::new(&params, r).expect("valid"))
         .collect();
     let plant = Resonator::<f64x4>::from_lanes(&scalar);
-    push("resonator", stage(plant, n_in, 4, |i| [x(i), x(i + 7)]));
+    let force = |i: u64| [x(i), x(i + 7)];
+    push(
+        "resonator (full 4x6 step)",
+        Box::new(|| stage(plant.clone(), n_in, 4, force)),
+    );
+    // Uncoupled modes at rest (a rotating run without k12): the decoupled step.
+    let mut uncoupled = params;
+    uncoupled.quadrature_coupling_rad2_s2 = 0.0;
+    let rest = Resonator::<f64x4>::new(&uncoupled, 0.0).expect("valid");
+    push(
+        "resonator (decoupled step)",
+        Box::new(|| stage(DecoupledPlant(rest.clone()), n_in, 4, force)),
+    );
     let tia = Tia::<f64x4>::new(&tia_params(cfg)).expect("valid");
-    push("tia", stage(tia, n_in, 4, x));
+    push("tia", Box::new(|| stage(tia.clone(), n_in, 4, x)));
     let mix = Stage1Mixer::<f64x4>::new(0.0).expect("valid");
     let c = gyroemu_core::Complex64::new(0.6, 0.8);
-    push("stage-1 mixer", stage(mix, n_in, 4, |i| (x(i), c)));
+    push(
+        "stage-1 mixer",
+        Box::new(|| stage(mix.clone(), n_in, 4, |i| (x(i), c))),
+    );
     let design = LowPassDesign::Butterworth {
         order: cfg.board.lpf_order,
         cutoff_hz: cfg.board.lpf_cutoff_hz,
     };
     let lp = LowPass::<f64x4>::new(design, fs).expect("valid");
-    push("low-pass (one channel)", stage(lp, n_in, 4, x));
-    let s2 = Stage2Mixer::<f64x4>::default();
+    push(
+        "low-pass (one channel)",
+        Box::new(|| stage(lp.clone(), n_in, 4, x)),
+    );
     push(
         "stage-2 mixer (per decimated sample)",
-        stage(s2, n_in, 4, |i| {
-            (Iq::new(x(i), x(i + 1)), [x(i + 2), x(i + 3)])
+        Box::new(|| {
+            stage(Stage2Mixer::<f64x4>::default(), n_in, 4, |i| {
+                (Iq::new(x(i), x(i + 1)), [x(i + 2), x(i + 3)])
+            })
         }),
     );
     out
