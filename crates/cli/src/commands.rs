@@ -274,18 +274,19 @@ pub fn bench(preset_name: &str, samples: u64, repeats: usize) -> Result<()> {
         "bench: preset {preset_name}, fs = {} Hz, {samples} input samples per lane group, 4 operating points per group, best and median of {repeats} runs",
         cfg.board.fs_hz
     );
-    println!(
-        "{:<48} {:>7} {:>10} {:>10}",
+    // A closed pipe (`| head`) ends the output quietly.
+    print_out(&format!(
+        "{:<48} {:>7} {:>10} {:>10}\n",
         "what (M point-samples/s)", "threads", "best", "median"
-    );
+    ))?;
     for t in gyroemu_experiment::bench::all(&cfg, samples, repeats) {
-        println!(
-            "{:<48} {:>7} {:>10.1} {:>10.1}",
+        print_out(&format!(
+            "{:<48} {:>7} {:>10.1} {:>10.1}\n",
             t.name,
             t.threads,
             t.point_samples_per_s / 1e6,
             t.median_point_samples_per_s / 1e6
-        );
+        ))?;
     }
     Ok(())
 }

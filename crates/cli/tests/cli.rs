@@ -205,3 +205,44 @@ fn reproduce_quick_writes_every_figure_and_the_slope_ratio() {
         );
     }
 }
+
+/// `bench` measures the whole chain and every stage on 1 and on all threads (the figures are
+/// timing, so only their presence and sign are checked), and refuses zero repeats.
+#[test]
+fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
+    let o = gyroemu(&[
+        "--threads",
+        "2",
+        "bench",
+        "--samples",
+        "20000",
+        "--repeats",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for name in [
+        "whole chain",
+        "resonator (decoupled step)",
+        "low-pass bank",
+        "tia",
+    ] {
+        for threads in ["1", "2"] {
+            let row = text
+                .lines()
+                .find(|l| l.starts_with(name) && l.split_whitespace().rev().nth(2) == Some(threads))
+                .unwrap_or_else(|| panic!("no `{name}` row on {threads} threads:\n{text}"));
+            let v: Vec<f64> = row
+                .split_whitespace()
+                .rev()
+                .take(2)
+                .map(|x| x.parse().unwrap())
+                .collect();
+            // Best (second from the right) is at least the median (rightmost), both positive.
+            assert!(v[0] > 0.0 && v[1] >= v[0], "{row}");
+        }
+    }
+    let bad = gyroemu(&["bench", "--repeats", "0"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(stderr(&bad).contains("--repeats = 0"), "{}", stderr(&bad));
+}

@@ -68,18 +68,33 @@ pub fn chain(cfg: &Config, n_in: u64, groups: usize) -> f64 {
     (n_out * m * 4 * groups as u64) as f64 / s
 }
 
-/// Times `n` ticks of a stage fed by `input(i)`; returns point-samples per second
-/// (`lanes` operating points per tick).
-fn stage<T: Stage>(mut st: T, n: u64, lanes: usize, input: impl Fn(u64) -> T::Input) -> f64 {
+/// Times `n` ticks of a copy of `st` fed by `input(i)` on each of `threads` threads; returns
+/// point-samples per second over all of them (`lanes` operating points per tick).
+fn stage<T: Stage + Clone + Send + Sync>(
+    st: &T,
+    n: u64,
+    lanes: usize,
+    threads: usize,
+    input: impl Fn(u64) -> T::Input + Sync,
+) -> f64 {
+    let one = || {
+        let mut st = st.clone();
+        for i in 0..n {
+            black_box(st.tick(black_box(input(i))));
+        }
+    };
     let t = Instant::now();
-    for i in 0..n {
-        black_box(st.tick(black_box(input(i))));
+    if threads == 1 {
+        one();
+    } else {
+        (0..threads).into_par_iter().for_each(|_| one());
     }
-    (n as f64 * lanes as f64) / t.elapsed().as_secs_f64()
+    (n as f64 * lanes as f64 * threads as f64) / t.elapsed().as_secs_f64()
 }
 
 /// A plant driven through its decoupled step (what the board runs when the modes are
 /// uncoupled), as a stage.
+#[derive(Clone)]
 struct DecoupledPlant(gyroemu_resonator::Resonator<f64x4>);
 
 impl Stage for DecoupledPlant {
@@ -94,12 +109,12 @@ impl Stage for DecoupledPlant {
     }
 }
 
-/// Every figure, each the best and the median of `repeats` runs: the chain on 1 thread and
-/// on all threads, then each stage on 1 thread.
+/// Every figure, each the best and the median of `repeats` runs: the chain, then each stage,
+/// on 1 thread and on all threads.
 pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     use crate::board::{resonator_params, tia_params};
     use gyroemu_am::{AmInput, AmModulator, DrivePattern};
-    use gyroemu_lpf::{LowPass, LowPassDesign};
+    use gyroemu_lpf::{LowPass, LowPassBank, LowPassDesign};
     use gyroemu_mixer::{Iq, Stage1Mixer, Stage2Mixer};
     use gyroemu_nco::{Nco, PhaseShifter, RotatingNco};
     use gyroemu_resonator::Resonator;
@@ -121,13 +136,17 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     }
     let x = |i: u64| f64x4::splat((i & 1023) as f64 * 1e-3);
     let fs = cfg.board.fs_hz;
-    let mut push =
-        |name: &str, mut measure: Box<dyn FnMut() -> f64 + '_>| push_n(name, 1, &mut *measure);
+    let mut push = |name: &str, measure: Box<dyn Fn(usize) -> f64 + '_>| {
+        push_n(name, 1, &mut || measure(1));
+        if threads > 1 {
+            push_n(name, threads, &mut || measure(threads));
+        }
+    };
     let nco = Nco::new(cfg.device.f0_hz, fs, 0.0).expect("valid");
     let carrier = RotatingNco::<f64>::new(std::slice::from_ref(&nco));
     push(
         "carrier RotatingNco (scalar, 4 lanes share it)",
-        Box::new(|| stage(carrier.clone(), n_in, 4, |_| ())),
+        Box::new(|t| stage(&carrier, n_in, 4, t, |_| ())),
     );
     let mods: Vec<Nco> = lane_rates(cfg)
         .iter()
@@ -136,22 +155,22 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     let modulation = RotatingNco::<f64x4>::new(&mods);
     push(
         "modulation RotatingNco (f64x4)",
-        Box::new(|| stage(modulation.clone(), n_in, 4, |_| ())),
+        Box::new(|t| stage(&modulation, n_in, 4, t, |_| ())),
     );
     push(
         "table Nco (exact re-sets only)",
-        Box::new(|| stage(nco.clone(), n_in, 4, |_| ())),
+        Box::new(|t| stage(&nco, n_in, 4, t, |_| ())),
     );
     let c = |i: u64| gyroemu_core::Complex64::new(x(i).lane(0), 0.5);
     push(
         "phase shifter (scalar)",
-        Box::new(|| stage(PhaseShifter::quadrature(), n_in, 4, c)),
+        Box::new(|t| stage(&PhaseShifter::quadrature(), n_in, 4, t, c)),
     );
     let am = AmModulator::<f64x4>::new(DrivePattern::Rotating, 1.0, 1.0).expect("valid");
     push(
         "am modulator",
-        Box::new(|| {
-            stage(am, n_in, 4, |i| AmInput {
+        Box::new(|t| {
+            stage(&am, n_in, 4, t, |i| AmInput {
                 carrier_i: x(i),
                 carrier_q: x(i + 1),
                 mod_cos: x(i + 2),
@@ -168,23 +187,23 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     let force = |i: u64| [x(i), x(i + 7)];
     push(
         "resonator (full 4x6 step)",
-        Box::new(|| stage(plant.clone(), n_in, 4, force)),
+        Box::new(|t| stage(&plant, n_in, 4, t, force)),
     );
     // Uncoupled modes at rest (a rotating run without k12): the decoupled step.
     let mut uncoupled = params;
     uncoupled.quadrature_coupling_rad2_s2 = 0.0;
-    let rest = Resonator::<f64x4>::new(&uncoupled, 0.0).expect("valid");
+    let rest = DecoupledPlant(Resonator::<f64x4>::new(&uncoupled, 0.0).expect("valid"));
     push(
         "resonator (decoupled step)",
-        Box::new(|| stage(DecoupledPlant(rest.clone()), n_in, 4, force)),
+        Box::new(|t| stage(&rest, n_in, 4, t, force)),
     );
     let tia = Tia::<f64x4>::new(&tia_params(cfg)).expect("valid");
-    push("tia", Box::new(|| stage(tia.clone(), n_in, 4, x)));
+    push("tia", Box::new(|t| stage(&tia, n_in, 4, t, x)));
     let mix = Stage1Mixer::<f64x4>::new(0.0).expect("valid");
     let c = gyroemu_core::Complex64::new(0.6, 0.8);
     push(
         "stage-1 mixer",
-        Box::new(|| stage(mix.clone(), n_in, 4, |i| (x(i), c))),
+        Box::new(|t| stage(&mix, n_in, 4, t, |i| (x(i), c))),
     );
     let design = LowPassDesign::Butterworth {
         order: cfg.board.lpf_order,
@@ -193,15 +212,37 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     let lp = LowPass::<f64x4>::new(design, fs).expect("valid");
     push(
         "low-pass (one channel)",
-        Box::new(|| stage(lp.clone(), n_in, 4, x)),
+        Box::new(|t| stage(&lp, n_in, 4, t, x)),
+    );
+    // What the board runs: I1, Q1, I2, Q2 of each point through one bank.
+    let bank = LowPassBank::<f64x4, 4>::new(&lp);
+    push(
+        "low-pass bank (I1, Q1, I2, Q2)",
+        Box::new(|t| stage(&bank, n_in, 4, t, |i| [x(i), x(i + 1), x(i + 2), x(i + 3)])),
     );
     push(
         "stage-2 mixer (per decimated sample)",
-        Box::new(|| {
-            stage(Stage2Mixer::<f64x4>::default(), n_in, 4, |i| {
+        Box::new(|t| {
+            stage(&Stage2Mixer::<f64x4>::default(), n_in, 4, t, |i| {
                 (Iq::new(x(i), x(i + 1)), [x(i + 2), x(i + 3)])
             })
         }),
     );
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::best_and_median;
+
+    #[test]
+    fn best_is_the_largest_and_median_the_middle_run() {
+        let runs = |v: &[f64]| {
+            let mut it = v.iter().copied();
+            best_and_median(v.len(), move || it.next().unwrap())
+        };
+        assert_eq!(runs(&[3.0, 1.0, 2.0]), (3.0, 2.0));
+        assert_eq!(runs(&[4.0, 1.0, 2.0, 8.0]), (8.0, 3.0));
+        assert_eq!(runs(&[5.0]), (5.0, 5.0));
+    }
 }
