@@ -11,8 +11,9 @@ use gyroemu_experiment::board::{Board, Point, PointWindow};
 use gyroemu_experiment::config::{Config, NoiseConfig};
 use gyroemu_experiment::presets::preset;
 
-/// Input samples per lane group per iteration (2^20: 10 486 decimated blocks).
-const N_IN: u64 = 1 << 20;
+/// Input samples per lane group per iteration (2^22: 41 943 decimated blocks; shorter runs
+/// let the thread pool's start-up show in the per-core figure).
+const N_IN: u64 = 1 << 22;
 
 fn main() {
     divan::main();
