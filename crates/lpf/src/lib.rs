@@ -7,6 +7,7 @@
 
 mod averager;
 mod bank;
+mod cascade;
 mod decimator;
 mod design;
 mod kahan;

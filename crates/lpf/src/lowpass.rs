@@ -1,7 +1,8 @@
 //! A fixed-capacity cascade of low-pass sections.
 
+use crate::cascade::{Cascade, CascadeState};
 use crate::design::{sections, LowPassDesign, MAX_ORDER};
-use crate::section::{Coefs, Section};
+use crate::section::Coefs;
 use gyroemu_core::detmath::sin_cos_turns;
 use gyroemu_core::{Complex64, ParamResult, Response, Sample, Stage};
 
@@ -24,13 +25,8 @@ pub(crate) fn u_of(turns: f64) -> Complex64 {
 /// so it stays the exact response of the filter as built.
 #[derive(Clone, Debug)]
 pub struct LowPass<S> {
-    pub(crate) one_pole: bool,
-    /// Section 0 is the first-order section of an odd Butterworth order.
-    pub(crate) first_order: bool,
-    pub(crate) n: usize,
-    /// Product of the Butterworth sections' numerator gains.
-    pub(crate) gain: S,
-    pub(crate) sec: [Section<S>; MAX_ORDER],
+    pub(crate) cascade: Cascade<S>,
+    pub(crate) state: CascadeState<S, 1>,
     coefs: [Coefs; MAX_ORDER],
     fs_hz: f64,
 }
@@ -39,21 +35,9 @@ impl<S: Sample> LowPass<S> {
     /// Builds the filter at sample rate `fs_hz`; parameter errors name stage `"lpf"`.
     pub fn new(design: LowPassDesign, fs_hz: f64) -> ParamResult<Self> {
         let (one_pole, n, coefs) = sections(design, fs_hz)?;
-        let mut sec = [Section::<S>::default(); MAX_ORDER];
-        for (s, c) in sec.iter_mut().zip(&coefs).take(n) {
-            *s = Section::new(c);
-        }
-        let gain = if one_pole {
-            1.0
-        } else {
-            coefs[..n].iter().map(|c| c.b0).product()
-        };
         Ok(Self {
-            one_pole,
-            first_order: !one_pole && coefs[0].a2 == 0.0 && coefs[0].b2 == 0.0,
-            n,
-            gain: S::splat(gain),
-            sec,
+            cascade: Cascade::new(one_pole, n, &coefs),
+            state: CascadeState::default(),
             coefs,
             fs_hz,
         })
@@ -62,7 +46,7 @@ impl<S: Sample> LowPass<S> {
     /// Number of sections in use (biquads plus one first-order section for odd Butterworth
     /// orders; N one-poles for a lock-in filter).
     pub fn sections(&self) -> usize {
-        self.n
+        self.cascade.sections()
     }
 
     /// Sample rate the filter was designed for, in Hz.
@@ -77,34 +61,20 @@ impl<S: Sample> Stage for LowPass<S> {
 
     #[inline(always)]
     fn tick(&mut self, x: S) -> S {
-        if self.one_pole {
-            let mut y = x;
-            for s in &mut self.sec[..self.n] {
-                y = s.tick_one_pole(y);
-            }
-            return y;
-        }
-        let mut y = self.gain * x;
-        let mut rest = &mut self.sec[..self.n];
-        if self.first_order {
-            y = rest[0].tick_unit1(y);
-            rest = &mut rest[1..];
-        }
-        for s in rest {
-            y = s.tick_unit2(y);
-        }
+        let [y] = self.cascade.tick(&mut self.state, [x]);
         y
     }
 
     fn reset(&mut self) {
-        for s in &mut self.sec {
-            s.reset();
-        }
+        self.state = CascadeState::default();
     }
 
     /// DC group delay in samples, the sum of the sections'.
     fn latency_samples(&self) -> f64 {
-        self.coefs[..self.n].iter().map(Coefs::dc_group_delay).sum()
+        self.coefs[..self.sections()]
+            .iter()
+            .map(Coefs::dc_group_delay)
+            .sum()
     }
 }
 
@@ -113,7 +83,7 @@ impl<S: Sample> Response for LowPass<S> {
     /// coefficients (exact for the filter as built).
     fn response(&self, f_hz: f64) -> Complex64 {
         let u = u_of(f_hz / self.fs_hz);
-        self.coefs[..self.n]
+        self.coefs[..self.sections()]
             .iter()
             .fold(Complex64::new(1.0, 0.0), |h, c| h * c.response(u))
     }

@@ -77,9 +77,9 @@ impl Coefs {
     }
 }
 
-/// A section's recursion coefficients as samples; the state lives with the caller (one
-/// [`Section`], or one per channel of a [`crate::LowPassBank`]), so every channel runs the
-/// very same arithmetic.
+/// A section's recursion coefficients as samples; the state lives with the caller (one set
+/// per channel, see [`crate::cascade::Cascade`]), so every channel runs the very same
+/// arithmetic.
 ///
 /// Butterworth sections are run without their numerator gain: biquad designs them as
 /// `g (1 + z^-1)^2 / A(z)` (first order: `g (1 + z^-1) / A(z)`), exactly (its `b1` is `2 b0`
@@ -130,53 +130,5 @@ impl<S: Sample> SectionCoefs<S> {
         let y = *s1 + self.k * (x - *s1);
         *s1 = y;
         y
-    }
-}
-
-/// A section's coefficients and its two state variables.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Section<S> {
-    c: SectionCoefs<S>,
-    s1: S,
-    s2: S,
-}
-
-impl<S: Sample> Section<S> {
-    pub fn new(c: &Coefs) -> Self {
-        Self {
-            c: SectionCoefs::new(c),
-            s1: S::default(),
-            s2: S::default(),
-        }
-    }
-
-    /// The coefficients alone.
-    pub fn coefs(&self) -> &SectionCoefs<S> {
-        &self.c
-    }
-
-    #[inline(always)]
-    pub fn tick_unit2(&mut self, x: S) -> S {
-        self.c.unit2(&mut self.s1, &mut self.s2, x)
-    }
-
-    #[inline(always)]
-    pub fn tick_unit1(&mut self, x: S) -> S {
-        self.c.unit1(&mut self.s1, x)
-    }
-
-    #[inline(always)]
-    pub fn tick_one_pole(&mut self, x: S) -> S {
-        self.c.one_pole(&mut self.s1, x)
-    }
-
-    /// The state `(s1, s2)`.
-    pub fn state(&self) -> (S, S) {
-        (self.s1, self.s2)
-    }
-
-    pub fn reset(&mut self) {
-        self.s1 = S::default();
-        self.s2 = S::default();
     }
 }
