@@ -4,9 +4,11 @@
 
 #![no_main]
 
-use gyroemu_experiment::parse_config;
 use gyroemu_experiment::presets::PRESETS;
 use libfuzzer_sys::fuzz_target;
+
+#[path = "common/round_trip.rs"]
+mod round_trip;
 
 fuzz_target!(|data: &[u8]| {
     let [which, line, rest @ ..] = data else {
@@ -18,13 +20,5 @@ fuzz_target!(|data: &[u8]| {
     let edit = String::from_utf8_lossy(rest);
     lines[at] = &edit;
     let text = lines.join("\n");
-    let Ok(cfg) = parse_config(&text) else {
-        return;
-    };
-    if cfg.validate().is_ok() {
-        let again = toml::to_string(&cfg).expect("a valid config serialises");
-        let back = parse_config(&again)
-            .unwrap_or_else(|e| panic!("its own TOML does not parse: {e}\n{again}"));
-        assert_eq!(back, cfg, "round trip changed the config:\n{again}");
-    }
+    round_trip::check(&text);
 });
