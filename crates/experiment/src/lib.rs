@@ -13,7 +13,7 @@ pub mod probe;
 pub mod selfcal;
 pub mod selfcal_analyses;
 pub mod sweep;
-pub mod theory;
+pub use gyroemu_theory as theory;
 pub mod validate;
 mod validate_noise;
 

@@ -2,7 +2,7 @@
 //! the value and the rule (and the line and column when TOML parsing located it).
 
 use crate::config::{Config, ExperimentKind, RateTable, WindowKind, DUMP_NODES};
-use crate::theory::mechanical_tau_s;
+use gyroemu_theory::mechanical_tau_s;
 use thiserror::Error;
 
 /// A config the emulator refuses.
