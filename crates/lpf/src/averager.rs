@@ -1,107 +1,169 @@
-//! Long weighted averages with compensated summation, and whole-period lengths.
+//! The board's final average: weighted means of several channels over long windows, one window
+//! per lane, with compensated sums (THEORY section 7: 5e8 samples keep f64 accuracy).
 
 use crate::{KahanSum, STAGE};
 use gyroemu_core::detmath::sin_cos_turns;
 use gyroemu_core::{ParamError, ParamResult, Sample};
 
-/// Averaging window.
+/// Most lanes an [`Averager`] serves (the widest sample type).
+pub const MAX_LANES: usize = 8;
+
+/// The weights of one lane's averaging window over samples `j = 0, 1, ...`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Window {
-    /// Equal weights: exact over a whole number of periods, leaks ~1/(2 Omega T) otherwise.
-    Boxcar,
-    /// `w[n] = 0.5 - 0.5 cos(2 pi (n + 0.5)/n_total)`: sidelobes fall as 1/m^3, so a
-    /// non-whole number of periods leaks little (THEORY section 7).
-    Hann,
+    /// Weight 1 on samples `0 .. n` and `frac` (in [0, 1)) on sample `n`: a window of exactly
+    /// `n + frac` samples, the fractional end of a whole number of half periods (a boxcar over
+    /// whole periods is exact; a non-whole number leaks about 1/(2 Omega T)).
+    Boxcar {
+        /// Whole samples of weight 1.
+        n: u64,
+        /// Weight of sample `n`.
+        frac: f64,
+    },
+    /// Hann weights `sin^2(pi (j + 1/2) / n)` on samples `0 .. n`: sidelobes fall as 1/m^3, so
+    /// a non-whole number of periods leaks little.
+    Hann {
+        /// Samples in the window.
+        n: u64,
+    },
 }
 
-/// Weighted mean `sum(w x) / sum(w)` of a long stream, with Kahan-compensated sums so that
-/// 5e8 samples keep f64 accuracy.
-#[derive(Clone, Debug)]
-pub struct Averager<S> {
-    window: Window,
-    n_total: u64,
-    count: u64,
-    sum: KahanSum<S>,
-    wsum: KahanSum<f64>,
-}
-
-impl<S: Sample> Averager<S> {
-    /// `n_total`: the number of samples that will be averaged (sets the Hann weights; pushes
-    /// beyond it continue the weights periodically). Must be >= 1.
-    pub fn new(window: Window, n_total: u64) -> ParamResult<Self> {
-        if n_total == 0 {
-            return Err(ParamError::new(STAGE, "n_total", n_total, "must be >= 1"));
+impl Window {
+    /// Weight of sample `j` (0 outside the window).
+    #[inline]
+    pub fn weight(&self, j: u64) -> f64 {
+        match *self {
+            Window::Boxcar { n, .. } | Window::Hann { n } if j > n => 0.0,
+            Window::Hann { n } if j == n => 0.0,
+            Window::Hann { n } => {
+                let (s, _) = sin_cos_turns(0.5 * (j as f64 + 0.5) / n as f64);
+                s * s
+            }
+            Window::Boxcar { n, frac } if j == n => frac,
+            Window::Boxcar { .. } => 1.0,
         }
+    }
+
+    /// Samples after which every weight is zero: `n + 1` (the fractional sample of a boxcar,
+    /// or the zero end of a Hann window, is pushed too).
+    pub fn samples(&self) -> u64 {
+        match *self {
+            Window::Boxcar { n, .. } | Window::Hann { n } => n + 1,
+        }
+    }
+
+    /// The averaged span in samples (`n + frac` for a boxcar, `n` for Hann).
+    pub fn span(&self) -> f64 {
+        match *self {
+            Window::Boxcar { n, frac } => n as f64 + frac,
+            Window::Hann { n } => n as f64,
+        }
+    }
+
+    fn check(&self) -> ParamResult<()> {
+        match *self {
+            Window::Boxcar { frac, .. } if !(0.0..1.0).contains(&frac) => Err(ParamError::new(
+                STAGE,
+                "window.frac",
+                frac,
+                "must be in [0, 1)",
+            )),
+            Window::Hann { n: 0 } => Err(ParamError::new(STAGE, "window.n", 0, "must be >= 1")),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Weighted means `sum(w x) / sum(w)` of up to `C` channels, each lane with its own
+/// [`Window`] (the board averages four or eight operating points at once, each over its own
+/// number of modulation periods). The weighted values are summed with [`KahanSum`]; the
+/// weights with a plain sum (whole ones for a boxcar, so exact; a Hann weight sum only scales
+/// every channel of a lane alike). Every lane of `f64x4` gives the bits of an `f64` averager
+/// fed that lane alone.
+#[derive(Clone, Debug)]
+pub struct Averager<S, const C: usize> {
+    windows: [Window; MAX_LANES],
+    lanes: usize,
+    channels: usize,
+    j: u64,
+    acc: [KahanSum<S>; C],
+    wsum: [f64; MAX_LANES],
+}
+
+impl<S: Sample, const C: usize> Averager<S, C> {
+    /// An averager of the first `channels` (at most `C`) channels, lane `i` weighted by
+    /// `windows[i]` (lanes beyond `windows.len()` repeat its last window). Needs 1 to
+    /// `S::LANES` windows, each valid.
+    pub fn new(windows: &[Window], channels: usize) -> ParamResult<Self> {
+        if windows.is_empty() || windows.len() > S::LANES.min(MAX_LANES) {
+            return Err(ParamError::new(
+                STAGE,
+                "windows",
+                windows.len(),
+                format!("must list 1 to {} lane windows", S::LANES.min(MAX_LANES)),
+            ));
+        }
+        if channels > C {
+            return Err(ParamError::new(
+                STAGE,
+                "channels",
+                channels,
+                format!("must be at most {C}"),
+            ));
+        }
+        windows.iter().try_for_each(Window::check)?;
+        let last = windows[windows.len() - 1];
         Ok(Self {
-            window,
-            n_total,
-            count: 0,
-            sum: KahanSum::new(),
-            wsum: KahanSum::new(),
+            windows: core::array::from_fn(|i| windows.get(i).copied().unwrap_or(last)),
+            lanes: windows.len(),
+            channels,
+            j: 0,
+            acc: core::array::from_fn(|_| KahanSum::default()),
+            wsum: [0.0; MAX_LANES],
         })
     }
 
-    /// Adds the next sample with its window weight.
-    #[inline]
-    pub fn push(&mut self, x: S) {
-        match self.window {
-            Window::Boxcar => self.sum.add(x),
-            Window::Hann => {
-                let n = self.count % self.n_total;
-                // (n + 0.5)/N is exact enough: n < 2^53; detmath gives the same bits anywhere.
-                let (_, c) = sin_cos_turns((n as f64 + 0.5) / self.n_total as f64);
-                let w = 0.5 - 0.5 * c;
-                self.sum.add(x * S::splat(w));
-                self.wsum.add(w);
-            }
-        }
-        self.count += 1;
-    }
-
-    /// Number of samples pushed since `new`/`reset`.
+    /// Samples pushed so far (the index `j` of the next one).
     pub fn count(&self) -> u64 {
-        self.count
+        self.j
     }
 
-    /// The weighted mean so far (zero before the first push).
-    pub fn mean(&self) -> S {
-        if self.count == 0 {
-            return S::default();
+    /// Adds the next sample of every channel with each lane's weight.
+    #[inline]
+    pub fn push(&mut self, x: &[S; C]) {
+        let (j, w) = (self.j, &self.windows);
+        let weight = S::from_fn(|i| w[i].weight(j));
+        for i in 0..self.lanes {
+            self.wsum[i] += weight.lane(i);
         }
-        let wsum = match self.window {
-            Window::Boxcar => self.count as f64,
-            Window::Hann => self.wsum.value(),
-        };
-        self.sum.value() / S::splat(wsum)
+        for (acc, &x) in self.acc.iter_mut().zip(x).take(self.channels) {
+            acc.add(weight * x);
+        }
+        self.j += 1;
     }
 
-    /// Forgets every sample.
+    /// The weighted mean of every channel of `lane` so far (NaN before any weight).
+    pub fn mean(&self, lane: usize) -> [f64; C] {
+        core::array::from_fn(|c| self.acc[c].value().lane(lane) / self.wsum[lane])
+    }
+
+    /// The boxcar mean of `lane` as if its window had been `n` whole samples and `frac` of
+    /// the next, where `n` is [`Averager::count`] (the samples pushed) and `x` the next
+    /// sample: the same average over a shorter time, read on the way to the full window (the
+    /// averaging-time analysis). Meaningful for boxcar lanes only.
+    pub fn mean_if_ended(&self, lane: usize, frac: f64, x: &[S; C]) -> [f64; C] {
+        let n = self.j as f64;
+        core::array::from_fn(|c| {
+            (self.acc[c].value().lane(lane) + frac * x[c].lane(lane)) / (n + frac)
+        })
+    }
+
+    /// Forgets every sample (the windows stay).
     pub fn reset(&mut self) {
-        self.count = 0;
-        self.sum.reset();
-        self.wsum.reset();
+        self.j = 0;
+        self.acc = core::array::from_fn(|_| KahanSum::default());
+        self.wsum = [0.0; MAX_LANES];
     }
-}
-
-/// Number of samples in the largest whole number of half-periods of `f_hz` that fits in
-/// `duration_s` at `fs_hz` (a half-period of the modulation is a whole period of the `2 f`
-/// products stage 2 averages out). The count is `round(k fs/(2f))` with
-/// `k = floor(floor(duration fs) 2f/fs)`; it is exactly whole only when `k fs/(2f)` is an
-/// integer (choose `fs/(2f)` integer), otherwise within half a sample of it.
-/// If not even one half-period fits, returns every sample of the duration
-/// (`floor(duration fs)`, not leak-free); returns 0 for non-finite or non-positive inputs.
-pub fn whole_half_periods(f_hz: f64, fs_hz: f64, duration_s: f64) -> u64 {
-    let ok = |v: f64| v.is_finite() && v > 0.0;
-    if !(ok(f_hz) && ok(fs_hz) && ok(duration_s)) {
-        return 0;
-    }
-    let n_dur = (duration_s * fs_hz).floor();
-    let half = fs_hz / (2.0 * f_hz);
-    let k = (n_dur / half).floor();
-    if k < 1.0 {
-        return n_dur as u64;
-    }
-    ((k * half).round()).min(n_dur) as u64
 }
 
 #[cfg(test)]
@@ -109,23 +171,27 @@ mod tests {
     use super::*;
 
     #[test]
-    fn whole_half_periods_counts() {
-        // 125 Hz at 1 MS/s: half period 4000 samples; 0.1037 s = 103700 samples -> 25 halves.
-        assert_eq!(whole_half_periods(125.0, 1e6, 0.1037), 100_000);
-        assert_eq!(whole_half_periods(125.0, 1e6, 0.004), 4000);
-        assert_eq!(whole_half_periods(125.0, 1e6, 0.0039), 3900);
-        assert_eq!(whole_half_periods(0.1, 1e6, 500.0), 500_000_000);
-        assert_eq!(whole_half_periods(f64::NAN, 1e6, 1.0), 0);
-        assert_eq!(whole_half_periods(1.0, 0.0, 1.0), 0);
+    fn bad_windows_are_refused_with_the_rule() {
+        let e = Averager::<f64, 2>::new(&[Window::Hann { n: 0 }], 2).unwrap_err();
+        assert_eq!((e.stage, e.param), ("lpf", "window.n"));
+        let e = Averager::<f64, 2>::new(&[Window::Boxcar { n: 3, frac: 1.0 }], 2).unwrap_err();
+        assert_eq!(e.param, "window.frac");
+        assert!(Averager::<f64, 2>::new(&[], 2).is_err());
+        let two = [Window::Hann { n: 4 }; 2];
+        assert!(
+            Averager::<f64, 2>::new(&two, 2).is_err(),
+            "f64 has one lane"
+        );
+        assert!(Averager::<f64, 2>::new(&two[..1], 3).is_err());
     }
 
     #[test]
-    fn n_total_zero_is_an_error() {
-        let e = Averager::<f64>::new(Window::Hann, 0).unwrap_err();
-        assert_eq!((e.stage, e.param), ("lpf", "n_total"));
-        let mut a = Averager::<f64>::new(Window::Hann, 1).unwrap();
-        assert_eq!(a.mean(), 0.0);
-        a.push(3.0);
-        assert_eq!(a.mean(), 3.0); // single sample: weight 1
+    fn single_sample_windows() {
+        let mut a = Averager::<f64, 1>::new(&[Window::Boxcar { n: 1, frac: 0.0 }], 1).unwrap();
+        assert!(a.mean(0)[0].is_nan());
+        a.push(&[3.0]);
+        a.push(&[5.0]); // weight frac = 0
+        assert_eq!(a.mean(0), [3.0]);
+        assert_eq!(a.count(), 2);
     }
 }

@@ -14,7 +14,7 @@ mod kahan;
 mod lowpass;
 mod section;
 
-pub use averager::{whole_half_periods, Averager, Window};
+pub use averager::{Averager, Window, MAX_LANES};
 pub use bank::LowPassBank;
 pub use decimator::{DecimateMode, Decimator};
 pub use design::{LowPassDesign, MAX_ORDER};

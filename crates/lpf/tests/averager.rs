@@ -1,10 +1,11 @@
-//! The compensated averager: long-sum accuracy, whole-period exactness, window leakage.
+//! The compensated averager: long-sum accuracy, whole-period exactness, window leakage, lanes
+//! and early reads.
 
 mod common;
 
 use gyroemu_core::detmath::sin_cos_turns;
 use gyroemu_core::{f64x4, Complex64, Sample};
-use gyroemu_lpf::{whole_half_periods, Averager, KahanSum, Window};
+use gyroemu_lpf::{Averager, KahanSum, Window};
 use std::f64::consts::{PI, TAU};
 use std::hint::black_box;
 
@@ -13,13 +14,13 @@ fn mean_of_5e8_samples_of_0_1_is_exact_where_a_naive_sum_is_not() {
     let n: u64 = 500_000_000;
     let x = black_box(0.1);
     let t0 = std::time::Instant::now();
-    let mut avg = Averager::<f64>::new(Window::Boxcar, n).unwrap();
+    let mut avg = Averager::<f64, 1>::new(&[Window::Boxcar { n, frac: 0.0 }], 1).unwrap();
     for _ in 0..n {
-        avg.push(black_box(x));
+        avg.push(&[black_box(x)]);
     }
     let dt = t0.elapsed();
     assert_eq!(avg.count(), n);
-    let rel = (avg.mean() - 0.1).abs() / 0.1;
+    let rel = (avg.mean(0)[0] - 0.1).abs() / 0.1;
     let mut naive = 0.0;
     for _ in 0..n {
         naive += black_box(x);
@@ -41,34 +42,27 @@ fn turns(f: f64, fs: f64, n: u64) -> f64 {
 #[test]
 fn boxcar_over_whole_half_periods_is_exact_for_the_stage_2_products() {
     let (f, fs) = (125.0, 1e6); // half period 4000 samples
-    let n = whole_half_periods(f, fs, 0.1037);
-    assert_eq!(n, 100_000); // 25 half periods
+    let n = 100_000; // 25 half periods
     let psi: f64 = 0.3;
     let amp = 0.7;
-    let mut prod = Averager::<f64>::new(Window::Boxcar, n).unwrap();
-    let mut sq = Averager::<f64>::new(Window::Boxcar, n).unwrap();
-    let mut c = Averager::<f64>::new(Window::Boxcar, n).unwrap();
-    let mut s = Averager::<f64>::new(Window::Boxcar, n).unwrap();
+    // Channels: sin cos, cos^2, and the stage-2 products C and S.
+    let mut avg = Averager::<f64, 4>::new(&[Window::Boxcar { n, frac: 0.0 }], 4).unwrap();
     for i in 0..n {
         let (sn, cs) = sin_cos_turns(turns(f, fs, i));
         let z = amp * (cs * psi.cos() + sn * psi.sin()); // A cos(W t - psi)
-        prod.push(sn * cs);
-        sq.push(cs * cs);
-        c.push(2.0 * z * cs);
-        s.push(2.0 * z * sn);
+        avg.push(&[sn * cs, cs * cs, 2.0 * z * cs, 2.0 * z * sn]);
     }
+    let [prod, sq, c, s] = avg.mean(0);
     eprintln!(
         "whole half periods: <sin cos> = {:e}, <cos^2> - 1/2 = {:e}",
-        prod.mean(),
-        sq.mean() - 0.5
+        prod,
+        sq - 0.5
     );
-    assert!(prod.mean().abs() < 1e-12);
-    assert!((sq.mean() - 0.5).abs() < 1e-12);
+    assert!(prod.abs() < 1e-12);
+    assert!((sq - 0.5).abs() < 1e-12);
     // stage 2: C = A cos psi, S = A sin psi exactly, so atan2 gives psi back
-    assert!(
-        (c.mean() - amp * psi.cos()).abs() < 1e-12 && (s.mean() - amp * psi.sin()).abs() < 1e-12
-    );
-    assert!((s.mean().atan2(c.mean()) - psi).abs() < 1e-12);
+    assert!((c - amp * psi.cos()).abs() < 1e-12 && (s - amp * psi.sin()).abs() < 1e-12);
+    assert!((s.atan2(c) - psi).abs() < 1e-12);
 }
 
 /// `sum_{n<N} e^{j theta n}` in closed form (Dirichlet kernel).
@@ -105,28 +99,27 @@ fn hann_over_10_3_modulation_periods_leaks_below_1e_4_and_less_than_boxcar() {
     let mut worst_hann: f64 = 0.0;
     let mut worst_box: f64 = 0.0;
     for phi in [0.0, 0.4, 1.1, 2.0, 2.9] {
-        let mut bx = Averager::<f64>::new(Window::Boxcar, n).unwrap();
-        let mut hn = Averager::<f64>::new(Window::Hann, n).unwrap();
+        let mut bx = Averager::<f64, 1>::new(&[Window::Boxcar { n, frac: 0.0 }], 1).unwrap();
+        let mut hn = Averager::<f64, 1>::new(&[Window::Hann { n }], 1).unwrap();
         let (sp, cp) = (f64::sin(phi), f64::cos(phi));
         for i in 0..n {
             let (s, c) = sin_cos_turns(turns(f, fs, i));
             let x = s * cp + c * sp; // sin(theta i + phi)
-            bx.push(x);
-            hn.push(x);
+            bx.push(&[x]);
+            hn.push(&[x]);
         }
+        let (bm, hm) = (bx.mean(0)[0], hn.mean(0)[0]);
         let (box_cf, hann_cf) = leak_closed_forms(theta, phi, n);
         assert!(
-            (bx.mean() - box_cf).abs() < 1e-12,
-            "boxcar {} vs closed form {box_cf}",
-            bx.mean()
+            (bm - box_cf).abs() < 1e-12,
+            "boxcar {bm} vs closed form {box_cf}"
         );
         assert!(
-            (hn.mean() - hann_cf).abs() < 1e-12,
-            "hann {} vs closed form {hann_cf}",
-            hn.mean()
+            (hm - hann_cf).abs() < 1e-12,
+            "hann {hm} vs closed form {hann_cf}"
         );
-        worst_hann = worst_hann.max(hn.mean().abs());
-        worst_box = worst_box.max(bx.mean().abs());
+        worst_hann = worst_hann.max(hm.abs());
+        worst_box = worst_box.max(bm.abs());
     }
     // envelopes: boxcar |sin(pi m)|/(pi m), Hann |sin(pi m)| / (pi m (m^2 - 1)) at m = 20.6
     let m = 20.6;
@@ -149,13 +142,14 @@ fn hann_leak_of_a_tone_over_10_3_of_its_own_periods_follows_its_envelope() {
     let mut worst: f64 = 0.0;
     for k in 0..16 {
         let phi = k as f64 * PI / 16.0;
-        let mut hn = Averager::<f64>::new(Window::Hann, n).unwrap();
+        let mut hn = Averager::<f64, 1>::new(&[Window::Hann { n }], 1).unwrap();
         for i in 0..n {
             let (s, c) = sin_cos_turns(turns(f, fs, i));
-            hn.push(s * phi.cos() + c * phi.sin());
+            hn.push(&[s * phi.cos() + c * phi.sin()]);
         }
-        assert!((hn.mean() - leak_closed_forms(theta, phi, n).1).abs() < 1e-12);
-        worst = worst.max(hn.mean().abs());
+        let m = hn.mean(0)[0];
+        assert!((m - leak_closed_forms(theta, phi, n).1).abs() < 1e-12);
+        worst = worst.max(m.abs());
     }
     let m = 10.3;
     let envelope = (PI * m).sin().abs() / (PI * m * (m * m - 1.0));
@@ -167,30 +161,44 @@ fn hann_leak_of_a_tone_over_10_3_of_its_own_periods_follows_its_envelope() {
 fn hann_mean_of_a_constant_is_the_constant_and_lanes_equal_scalar() {
     let n = 12_345u64;
     let xs: Vec<Vec<f64>> = (0..4)
-        .map(|l| common::noise(n as usize, 1.0 + l as f64, 40 + l as u64))
+        .map(|l| common::noise(n as usize + 1, 1.0 + l as f64, 40 + l as u64))
         .collect();
-    for window in [Window::Boxcar, Window::Hann] {
-        let mut k = Averager::<f64>::new(window, n).unwrap();
-        for _ in 0..n {
-            k.push(0.3);
+    // Each lane its own window: different lengths and kinds in one averager.
+    let windows = [
+        Window::Hann { n },
+        Window::Boxcar {
+            n: n - 7,
+            frac: 0.25,
+        },
+        Window::Hann { n: n / 3 },
+        Window::Boxcar { n, frac: 0.0 },
+    ];
+    for w in windows {
+        let mut k = Averager::<f64, 1>::new(&[w], 1).unwrap();
+        for _ in 0..w.samples() {
+            k.push(&[0.3]);
         }
-        assert!((k.mean() - 0.3).abs() < 1e-15, "{window:?}: {}", k.mean());
-        let mut v = Averager::<f64x4>::new(window, n).unwrap();
-        (0..n as usize).for_each(|i| v.push(f64x4::from_fn(|l| xs[l][i])));
-        for (l, x) in xs.iter().enumerate() {
-            let mut s = Averager::<f64>::new(window, n).unwrap();
-            for &xi in x {
-                s.push(xi);
-            }
-            assert_eq!(s.mean().to_bits(), v.mean().lane(l).to_bits());
-            let m1 = s.mean();
-            s.reset();
-            assert_eq!(s.count(), 0);
-            for &xi in x {
-                s.push(xi);
-            }
-            assert_eq!(s.mean().to_bits(), m1.to_bits());
+        assert!((k.mean(0)[0] - 0.3).abs() < 1e-15, "{w:?}: {:?}", k.mean(0));
+    }
+    let mut v = Averager::<f64x4, 2>::new(&windows, 2).unwrap();
+    for i in 0..=n as usize {
+        v.push(&[f64x4::from_fn(|l| xs[l][i]), f64x4::from_fn(|l| -xs[l][i])]);
+    }
+    for (l, x) in xs.iter().enumerate() {
+        let mut s = Averager::<f64, 2>::new(&windows[l..l + 1], 2).unwrap();
+        for &xi in x {
+            s.push(&[xi, -xi]);
         }
+        for c in 0..2 {
+            assert_eq!(s.mean(0)[c].to_bits(), v.mean(l)[c].to_bits(), "lane {l}");
+        }
+        let m1 = s.mean(0);
+        s.reset();
+        assert_eq!(s.count(), 0);
+        for &xi in x {
+            s.push(&[xi, -xi]);
+        }
+        assert_eq!(s.mean(0), m1);
     }
     let mut ks = KahanSum::<f64x4>::new();
     let mut k1 = KahanSum::<f64>::new();
@@ -199,4 +207,33 @@ fn hann_mean_of_a_constant_is_the_constant_and_lanes_equal_scalar() {
         k1.add(x);
     }
     assert_eq!(ks.value().lane(3).to_bits(), k1.value().to_bits());
+}
+
+#[test]
+fn an_early_read_equals_the_mean_of_a_shorter_window() {
+    // Reading a long boxcar at (n, frac) on the way gives the mean a window of exactly n + frac
+    // samples would give: sum of the first n plus frac times the next, over n + frac.
+    let x = common::noise(5000, 1.0, 7);
+    let mut long = Averager::<f64, 1>::new(&[Window::Boxcar { n: 4000, frac: 0.0 }], 1).unwrap();
+    for (j, &xj) in x.iter().enumerate() {
+        if j == 1234 {
+            let early = long.mean_if_ended(0, 0.375, &[xj])[0];
+            let want = (x[..1234].iter().sum::<f64>() + 0.375 * xj) / 1234.375;
+            assert!(
+                (early - want).abs() < 1e-14 * want.abs().max(1.0),
+                "{early} vs {want}"
+            );
+            let mut short = Averager::<f64, 1>::new(
+                &[Window::Boxcar {
+                    n: 1234,
+                    frac: 0.375,
+                }],
+                1,
+            )
+            .unwrap();
+            x[..=1234].iter().for_each(|&v| short.push(&[v]));
+            assert!((short.mean(0)[0] - early).abs() < 1e-15 * early.abs().max(1.0));
+        }
+        long.push(&[xj]);
+    }
 }

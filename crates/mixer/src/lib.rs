@@ -3,13 +3,13 @@
 //! * [`Stage1Mixer`]: complex demodulation by the carrier, `z = 2 y e^{-j(w0 t + phi)}`, to be
 //!   low-passed (the low-pass lives in `gyroemu-lpf`). For `y = A cos(w0 t - theta)` the DC of `z`
 //!   is `A e^{-j(theta + phi)}`: a lag `theta` shows as a *negative* phase of `z`.
-//! * [`SingleMixer`]: the paper's single real mixer `2 y r`, DC `A cos(theta - phi)`.
+//!   Its I channel is the paper's single real mixer `2 y cos(w0 t + phi)` (DC
+//!   `A cos(theta + phi)`), so that reading needs no mixer of its own.
 //! * [`Stage2Mixer`]: demodulation of `z` at the modulation rate Omega, giving the C and S terms.
 //! * [`sideband_estimate`], [`paper_i_channel_psi_rad`], [`phase_lag_rad`]: the read-outs.
 
 mod estimate;
 mod iq;
-mod single;
 mod stage1;
 mod stage2;
 
@@ -17,7 +17,6 @@ pub use estimate::{
     paper_i_channel_psi_rad, phase_lag_rad, sideband_estimate, Mode, SidebandEstimate,
 };
 pub use iq::Iq;
-pub use single::SingleMixer;
 pub use stage1::Stage1Mixer;
 pub use stage2::{Stage2Mixer, Stage2Out};
 

@@ -6,7 +6,7 @@ mod common;
 use common::{carrier, exact_phase, mean};
 use core::f64::consts::{FRAC_PI_2, PI};
 use gyroemu_core::{Complex64, Stage};
-use gyroemu_mixer::{phase_lag_rad, SingleMixer, Stage1Mixer};
+use gyroemu_mixer::{phase_lag_rad, Stage1Mixer};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -57,6 +57,8 @@ fn stage1_mode2_with_minus_half_pi_reference_reads_own_sin_drive() {
     }
 }
 
+/// The paper's single real mixer, `2 y cos(w0 t - phi)`, is the I channel of a stage-1 mixer
+/// with reference phase `-phi`.
 #[test]
 fn single_mixer_dc_is_a_cos_theta_minus_phi() {
     let mut rng = ChaCha8Rng::seed_from_u64(2);
@@ -66,11 +68,12 @@ fn single_mixer_dc_is_a_cos_theta_minus_phi() {
         let theta = rng.random_range(-PI..PI);
         let phi = rng.random_range(-PI..PI);
         for (k, m) in TONES {
-            let mut mix = SingleMixer::<f64>::new();
+            let mut mix = Stage1Mixer::<f64>::new(-phi).unwrap();
             let out: Vec<f64> = (0..3 * m)
                 .map(|n| {
                     let wt = exact_phase(n, k, m);
-                    mix.tick((a * (wt - theta).cos(), (wt - phi).cos()))
+                    let carrier = Complex64::from_polar(1.0, wt);
+                    mix.tick((a * (wt - theta).cos(), carrier)).i
                 })
                 .collect();
             let want = a * (theta - phi).cos();
@@ -86,14 +89,16 @@ fn single_mixer_dc_is_a_cos_theta_minus_phi() {
 
 #[test]
 fn single_mixer_mode2_sin_reference_is_even_in_theta() {
-    // y = A sin(w0 t - theta), r = sin w0 t: DC = A cos theta (even: no sign of the rate).
+    // y = A sin(w0 t - theta), r = sin w0 t = cos(w0 t - pi/2): DC = A cos theta (even: no
+    // sign of the rate).
     let (a, k, m) = (1.5, 7, 1000);
     for theta in [-0.7, 0.2, 0.7, 2.0] {
-        let mut mix = SingleMixer::<f64>::new();
+        let mut mix = Stage1Mixer::<f64>::new(-PI / 2.0).unwrap();
         let dc = (0..m)
             .map(|n| {
                 let wt = exact_phase(n, k, m);
-                mix.tick((a * (wt - theta).sin(), wt.sin()))
+                mix.tick((a * (wt - theta).sin(), Complex64::from_polar(1.0, wt)))
+                    .i
             })
             .sum::<f64>()
             / m as f64;
