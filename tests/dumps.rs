@@ -2,7 +2,8 @@
 //! its closed form F1 cos(w0 t), F2 sin(w0 t) at the sample instants.
 
 mod common;
-use gyroemu::experiment::{parse_config, run_sweep};
+use gyroemu::config::parse_config;
+use gyroemu::experiment::run_sweep;
 use std::f64::consts::PI;
 
 fn read_csv(path: &std::path::Path) -> (Vec<String>, Vec<Vec<f64>>) {

@@ -3,7 +3,8 @@
 //! by solving (j w I - A) X = B F for the 2-DOF model of THEORY.md section 2.
 #![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
-use gyroemu::experiment::{parse_config, run_sweep};
+use gyroemu::config::parse_config;
+use gyroemu::experiment::run_sweep;
 use gyroemu::Complex64;
 use std::f64::consts::PI;
 

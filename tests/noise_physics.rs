@@ -5,11 +5,11 @@
 
 mod common;
 
+use gyroemu::board::{Board, Point, Probe, RunOptions};
+use gyroemu::config::presets::preset;
+use gyroemu::config::{Config, NoiseConfig};
 use gyroemu::core::f64x4;
-use gyroemu::experiment::board::{Board, Point, PointWindow};
-use gyroemu::experiment::config::{Config, NoiseConfig};
-use gyroemu::experiment::presets::preset;
-use gyroemu::experiment::probe::Probe;
+use gyroemu::lpf::Window;
 use std::f64::consts::PI;
 
 const K_B: f64 = 1.380_649e-23;
@@ -51,12 +51,18 @@ fn brownian_motion_obeys_equipartition() {
     let fs_out = cfg.fs_out_hz();
     let p = Point {
         rate_rad_s: 0.0,
-        n_avg: ((start_s + dur_s) * fs_out) as u64,
-        window: PointWindow::Boxcar { frac: 0.0 },
+        window: Window::Boxcar {
+            n: ((start_s + dur_s) * fs_out) as u64,
+            frac: 0.0,
+        },
     };
-    Board::<f64>::new(&cfg, &[0.0])
+    let opts = RunOptions {
+        probe: Some(&mut probe),
+        ..Default::default()
+    };
+    Board::<f64>::new(&cfg.board_params(), &[0.0], &[0])
         .unwrap()
-        .run(0, &[p], Some(&mut probe), &|_| {})
+        .run(0, &[p], opts, &|_| {})
         .unwrap();
     let dir = tempfile::tempdir().unwrap();
     probe.write(dir.path(), "eq").unwrap();
@@ -89,17 +95,19 @@ fn zero_rate_phases(cfg: &Config, average_s: f64) -> (Vec<f64>, f64) {
     let t = n_avg as f64 / fs_out;
     let p = Point {
         rate_rad_s: 0.0,
-        n_avg,
-        window: PointWindow::Boxcar { frac: 0.0 },
+        window: Window::Boxcar {
+            n: n_avg,
+            frac: 0.0,
+        },
     };
     let mut phases = Vec::new();
     for g in 0..16u64 {
         let streams: Vec<u64> = (0..4).map(|i| 4 * g + i).collect();
-        let r = Board::<f64x4>::with_streams(cfg, &[0.0; 4], &streams)
+        let r = Board::<f64x4>::new(&cfg.board_params(), &[0.0; 4], &streams)
             .unwrap()
-            .run(cfg.n_settle_out(), &[p; 4], None, &|_| {})
+            .run(cfg.n_settle_out(), &[p; 4], RunOptions::default(), &|_| {})
             .unwrap();
-        phases.extend(r.iter().map(|l| l.z[0].arg()));
+        phases.extend(r.lanes.iter().map(|l| l.z[0].arg()));
     }
     (phases, t)
 }

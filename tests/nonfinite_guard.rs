@@ -5,7 +5,7 @@
 //! overflow is the mixer's once 2 y passes f64::MAX, or the TIA's once y does: the reported
 //! time must lie between those two instants.
 
-use gyroemu::experiment::presets::preset;
+use gyroemu::config::presets::preset;
 use gyroemu::experiment::{run_sweep, SweepError};
 use std::f64::consts::PI;
 

@@ -5,7 +5,7 @@
 
 mod common;
 use common::*;
-use gyroemu::experiment::parse_config;
+use gyroemu::config::parse_config;
 use std::f64::consts::PI;
 
 #[test]

@@ -6,10 +6,10 @@
 
 mod common;
 
-use gyroemu::experiment::config::{Config, NoiseConfig, SelfcalConfig};
-use gyroemu::experiment::presets::preset;
-use gyroemu::experiment::selfcal::{run_selfcal_core, validate_selfcal};
-use gyroemu::experiment::selfcal_analyses::{drift_analysis, tau_analysis};
+use gyroemu::analysis::selfcal::{run_selfcal_core, validate_selfcal};
+use gyroemu::analysis::selfcal_analyses::{drift_analysis, tau_analysis};
+use gyroemu::config::presets::preset;
+use gyroemu::config::{Config, NoiseConfig, SelfcalConfig};
 
 fn quiet(_: u64, _: u64) {}
 
@@ -108,9 +108,8 @@ fn noisy_selfcal_errors_scatter_as_their_reported_confidence() {
         });
         let m = run_selfcal_core(&c, &quiet, &quiet).unwrap().modes[0];
         errs.push(m.relative_error);
-        let rel = |s: &gyroemu::experiment::selfcal::SlopeFit| {
-            s.std_err_deg_per_dps / s.slope_deg_per_dps
-        };
+        let rel =
+            |s: &gyroemu::analysis::selfcal::SlopeFit| s.std_err_deg_per_dps / s.slope_deg_per_dps;
         reported.push(rel(&m.rotating).hypot(rel(&m.coriolis)));
     }
     let n = errs.len() as f64;

@@ -4,7 +4,7 @@
 
 #![no_main]
 
-use gyroemu_experiment::presets::PRESETS;
+use gyroemu_config::presets::PRESETS;
 use libfuzzer_sys::fuzz_target;
 
 #[path = "common/round_trip.rs"]

@@ -2,7 +2,8 @@
 //! independently of `gyroemu::experiment::theory`, and small config builders.
 #![allow(dead_code)]
 
-use gyroemu::experiment::{parse_config, run_sweep, Config, SweepResult};
+use gyroemu::config::{parse_config, Config};
+use gyroemu::experiment::{run_sweep, SweepResult};
 use std::f64::consts::PI;
 
 pub const DEG: f64 = PI / 180.0;

@@ -2,14 +2,10 @@
 //! figures of Casinovi et al., "Electrostatic Self-Calibration of Vibratory Gyroscopes"
 //! (MEMS 2012).
 
-mod commands;
-mod merge;
+mod cmd;
+mod input;
 mod progress;
-mod report;
-mod reproduce;
-mod resume;
-mod selfcal;
-mod shard;
+mod signals;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -102,6 +98,22 @@ enum Command {
 /// Exit code for a config or usage the emulator refuses.
 pub const EXIT_BAD_INPUT: u8 = 2;
 
+/// The exit code of a failed command: 2 for refused input, 130 for an interrupted run, 1 for
+/// a failure while running.
+fn exit_code(e: &anyhow::Error) -> u8 {
+    use gyroemu_runs::RunError;
+    match e.downcast_ref::<RunError>() {
+        Some(RunError::BadInput(_)) => return EXIT_BAD_INPUT,
+        Some(RunError::Interrupted(_)) => return signals::EXIT_INTERRUPTED,
+        _ => {}
+    }
+    if e.downcast_ref::<input::BadInput>().is_some() {
+        EXIT_BAD_INPUT
+    } else {
+        1
+    }
+}
+
 /// The build targets x86-64-v3 (`.cargo/config.toml`); on an older CPU say so instead of
 /// dying on an illegal instruction. `is_x86_feature_detected!` cannot tell: it folds to `true`
 /// when the build enables the feature, so this asks `cpuid` directly (AVX2: leaf 7 EBX bit 5;
@@ -151,38 +163,34 @@ fn run_cli() -> ExitCode {
             .build_global();
     }
     let result = match cli.command {
-        Command::Reproduce { out, quick } => reproduce::reproduce(&out, quick),
+        Command::Reproduce { out, quick } => cmd::reproduce::reproduce_command(&out, quick),
         Command::Run {
             config,
             out,
             shard,
             shard_count,
             force,
-        } => commands::run(&commands::RunArgs {
+        } => cmd::run::run_command(&cmd::run::RunArgs {
             config: &config,
             out: &out,
             shard: shard.as_deref(),
             shard_count,
             force,
         }),
-        Command::Merge { dir } => merge::merge(&dir),
-        Command::Selfcal { config, out } => selfcal::selfcal(&config, &out),
-        Command::Config { preset, list } => commands::config(preset.as_deref(), list),
+        Command::Merge { dir } => cmd::merge::merge_command(&dir),
+        Command::Selfcal { config, out } => cmd::selfcal::selfcal_command(&config, &out),
+        Command::Config { preset, list } => cmd::config::config_command(preset.as_deref(), list),
         Command::Bench {
             preset,
             samples,
             repeats,
-        } => commands::bench(&preset, samples, repeats),
+        } => cmd::bench::bench_command(&preset, samples, repeats),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
-            let bad_input = e.downcast_ref::<commands::BadInput>().is_some();
-            if e.downcast_ref::<resume::Interrupted>().is_some() {
-                return ExitCode::from(resume::EXIT_INTERRUPTED);
-            }
-            ExitCode::from(if bad_input { EXIT_BAD_INPUT } else { 1 })
+            ExitCode::from(exit_code(&e))
         }
     }
 }

@@ -1,5 +1,6 @@
 //! Progress on long runs: a bar on a terminal, a periodic log line otherwise (CI, pipes).
 
+use gyroemu_experiment::{Reporter, Task};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::Mutex;
@@ -37,7 +38,7 @@ impl Progress {
     }
 
     /// Called from the sweep threads with (samples done, total samples).
-    pub fn update(&self, done: u64, total: u64) {
+    fn update_now(&self, done: u64, total: u64) {
         if let Some(b) = &self.bar {
             b.set_length(total);
             b.set_position(done);
@@ -58,7 +59,7 @@ impl Progress {
     }
 
     /// Closes the bar and prints the throughput.
-    pub fn finish(&self, point_samples: u64) {
+    fn finish_counted(&self, point_samples: u64) {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
         }
@@ -71,7 +72,7 @@ impl Progress {
     }
 
     /// Closes the bar and prints the elapsed time (for runs whose size is not in point-samples).
-    pub fn finish_elapsed(&self) {
+    fn finish_elapsed(&self) {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
         }
@@ -80,5 +81,32 @@ impl Progress {
             self.label,
             self.start.elapsed().as_secs_f64()
         );
+    }
+}
+
+impl Task for Progress {
+    fn update(&self, done: u64, total: u64) {
+        self.update_now(done, total);
+    }
+    fn finish(&self, point_samples: Option<u64>) {
+        match point_samples {
+            Some(n) => self.finish_counted(n),
+            None => self.finish_elapsed(),
+        }
+    }
+}
+
+/// The program's reporter: a [`Progress`] per task, notes and warnings on stderr.
+pub struct Terminal;
+
+impl Reporter for Terminal {
+    fn task(&self, label: &str) -> Box<dyn Task + '_> {
+        Box::new(Progress::new(label))
+    }
+    fn note(&self, text: &str) {
+        eprintln!("{text}");
+    }
+    fn warn(&self, text: &str) {
+        eprintln!("warning: {text}");
     }
 }

@@ -2,7 +2,7 @@
 //! writing nothing, a run writes its files, and results are byte-identical across reruns and
 //! thread counts.
 
-use gyroemu_experiment::parse_config;
+use gyroemu_config::parse_config;
 use std::path::Path;
 use std::process::{Command, Output};
 

@@ -6,10 +6,11 @@
 
 use divan::counter::ItemsCount;
 use divan::{black_box, Bencher};
+use gyroemu_board::{Board, Point, RunOptions};
+use gyroemu_config::presets::preset;
+use gyroemu_config::{Config, NoiseConfig};
 use gyroemu_core::f64x4;
-use gyroemu_experiment::board::{Board, Point, PointWindow};
-use gyroemu_experiment::config::{Config, NoiseConfig};
-use gyroemu_experiment::presets::preset;
+use gyroemu_lpf::Window;
 
 /// Input samples per lane group per iteration (2^22: 41 943 decimated blocks; shorter runs
 /// let the thread pool's start-up show in the per-core figure).
@@ -48,21 +49,30 @@ fn run_groups(b: Bencher, noise: bool, groups: usize) {
     let n_out = N_IN / m;
     let point = |r: f64| Point {
         rate_rad_s: r,
-        n_avg: n_out / 2,
-        window: PointWindow::Boxcar { frac: 0.0 },
+        window: Window::Boxcar {
+            n: n_out / 2,
+            frac: 0.0,
+        },
     };
     let points: Vec<Point> = rates.iter().map(|&r| point(r)).collect();
     let n_settle = n_out - n_out / 2 - 1;
     b.counter(ItemsCount::new(n_out * m * 4 * groups as u64))
         .with_inputs(|| {
             (0..groups)
-                .map(|_| Board::<f64x4>::new(&cfg, &rates).expect("valid preset"))
+                .map(|_| {
+                    Board::<f64x4>::new(&cfg.board_params(), &rates, &[0, 1, 2, 3])
+                        .expect("valid preset")
+                })
                 .collect::<Vec<_>>()
         })
         .bench_local_values(|boards| {
             use rayon::prelude::*;
             boards.into_par_iter().for_each(|mut board| {
-                black_box(board.run(n_settle, &points, None, &|_| {}).ok());
+                black_box(
+                    board
+                        .run(n_settle, &points, RunOptions::default(), &|_| {})
+                        .ok(),
+                );
             });
         });
 }

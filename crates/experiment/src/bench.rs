@@ -2,9 +2,10 @@
 //! and on all threads, and each stage alone. Used by `gyroemu bench` and the criterion-free
 //! benchmark; timing lives here, never in tests.
 
-use crate::board::{Board, Point};
-use crate::config::Config;
+use gyroemu_board::{Board, Point, RunOptions};
+use gyroemu_config::Config;
 use gyroemu_core::{f64x4, Sample, Stage};
+use gyroemu_lpf::Window;
 use rayon::prelude::*;
 use std::hint::black_box;
 use std::time::Instant;
@@ -46,23 +47,29 @@ fn lane_rates(cfg: &Config) -> Vec<f64> {
 /// returns point-samples per second.
 pub fn chain(cfg: &Config, n_in: u64, groups: usize) -> f64 {
     let rates = lane_rates(cfg);
+    let params = cfg.board_params();
     let m = cfg.board.decimation as u64;
     let n_out = n_in / m;
     let points: Vec<Point> = rates
         .iter()
         .map(|&r| Point {
             rate_rad_s: r,
-            n_avg: n_out / 2,
-            window: crate::board::PointWindow::Boxcar { frac: 0.0 },
+            window: Window::Boxcar {
+                n: n_out / 2,
+                frac: 0.0,
+            },
         })
         .collect();
     let n_settle = n_out - n_out / 2 - 1;
     let mut boards: Vec<Board<f64x4>> = (0..groups)
-        .map(|_| Board::new(cfg, &rates).expect("bench config is valid"))
+        .map(|_| Board::new(&params, &rates, &[0, 1, 2, 3]).expect("bench config is valid"))
         .collect();
     let t = Instant::now();
     boards.par_iter_mut().for_each(|b| {
-        black_box(b.run(n_settle, &points, None, &|_| {}).ok());
+        black_box(
+            b.run(n_settle, &points, RunOptions::default(), &|_| {})
+                .ok(),
+        );
     });
     let s = t.elapsed().as_secs_f64();
     (n_out * m * 4 * groups as u64) as f64 / s
@@ -112,7 +119,6 @@ impl Stage for DecoupledPlant {
 /// Every figure, each the best and the median of `repeats` runs: the chain, then each stage,
 /// on 1 thread and on all threads.
 pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
-    use crate::board::{resonator_params, tia_params};
     use gyroemu_am::{AmInput, AmModulator, DrivePattern};
     use gyroemu_lpf::{LowPass, LowPassBank, LowPassDesign};
     use gyroemu_mixer::{Iq, Stage1Mixer, Stage2Mixer};
@@ -178,7 +184,7 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
             })
         }),
     );
-    let params = resonator_params(cfg);
+    let params = cfg.resonator_params();
     let scalar: Vec<Resonator<f64>> = lane_rates(cfg)
         .iter()
         .map(|&r| Resonator::new(&params, r).expect("valid"))
@@ -197,7 +203,7 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
         "resonator (decoupled step)",
         Box::new(|t| stage(&rest, n_in, 4, t, force)),
     );
-    let tia = Tia::<f64x4>::new(&tia_params(cfg)).expect("valid");
+    let tia = Tia::<f64x4>::new(&cfg.board_params().tia).expect("valid");
     push("tia", Box::new(|t| stage(&tia, n_in, 4, t, x)));
     let mix = Stage1Mixer::<f64x4>::new(0.0).expect("valid");
     let c = gyroemu_core::Complex64::new(0.6, 0.8);

@@ -1,22 +1,16 @@
-//! The experiment layer of gyroemu: the config, the board assembled from the stage crates and
-//! run sample by sample, the Coriolis and rotating-excitation sweeps, and the exact theory
-//! that the figures overlay.
+//! The experiment layer of gyroemu: sweeps over operating points run on the emulated board
+//! (`gyroemu-board`) as a config (`gyroemu-config`) describes them, their read-out into phases
+//! with the chain compensated and the exact theory (`gyroemu-theory`) beside every point, the
+//! paper's line fits, and the throughput measurement.
 
-pub mod allan;
 pub mod bench;
-pub mod board;
-pub mod checkpoint;
-pub mod config;
 pub mod fit;
-pub mod presets;
-pub mod probe;
-pub mod selfcal;
-pub mod selfcal_analyses;
+pub mod progress;
+pub mod readout;
 pub mod sweep;
-pub use gyroemu_theory as theory;
-pub mod validate;
-mod validate_noise;
 
-pub use config::{Config, ExperimentKind, RateTable, WindowKind};
-pub use sweep::{run_sweep, PointResult, SweepError, SweepResult};
-pub use validate::{parse_config, ConfigError};
+pub use progress::{Progress, Quiet, Reporter, Task};
+pub use readout::{post_process, theory_deg, Compensation, PointResult, SweepResult};
+pub use sweep::{
+    finish_sweep, run_sweep, run_sweep_with, OnGroup, SweepError, SweepOptions, SweepRun,
+};

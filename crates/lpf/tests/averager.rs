@@ -181,6 +181,7 @@ fn hann_mean_of_a_constant_is_the_constant_and_lanes_equal_scalar() {
         assert!((k.mean(0)[0] - 0.3).abs() < 1e-15, "{w:?}: {:?}", k.mean(0));
     }
     let mut v = Averager::<f64x4, 2>::new(&windows, 2).unwrap();
+    #[allow(clippy::needless_range_loop)] // one sample of every lane per step
     for i in 0..=n as usize {
         v.push(&[f64x4::from_fn(|l| xs[l][i]), f64x4::from_fn(|l| -xs[l][i])]);
     }

@@ -1,8 +1,10 @@
 //! The exact theory of THEORY.md in one place: the closed forms of the two experiments, the
-//! continuous-time steady state of an imperfect plant, and the periodic steady state under a
-//! sinusoidal rate table. Used for theory overlays and tests, never in place of the emulation.
-//! Angles in radians, rates in rad/s, lag positive.
+//! theory of what each experiment measures on an ideal or imperfect device, and the periodic
+//! steady state under a sinusoidal rate table. Used for theory overlays and tests, never in
+//! place of the emulation. Angles in radians, rates in rad/s, lag positive.
 
 pub mod closed_form;
+mod device;
 
 pub use closed_form::*;
+pub use device::DrivenDevice;

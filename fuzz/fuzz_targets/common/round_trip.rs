@@ -1,7 +1,7 @@
 //! The check both targets make on a config text: parsing and validation never panic, and a
 //! config that validates survives a TOML round trip unchanged.
 
-use gyroemu_experiment::parse_config;
+use gyroemu_config::parse_config;
 
 pub fn check(text: &str) {
     let Ok(cfg) = parse_config(text) else {

@@ -1,0 +1,198 @@
+//! Self-calibration (the point of the method): the Coriolis scale factor predicted from the
+//! rotating excitation alone (phase slope times lambda), checked, as a lab would, against the
+//! virtual rate table on the same emulated board. Both sweeps run sample by sample through
+//! `run_sweep`; the analyses (averaging time, Allan deviation, drift) are in `selfcal_analyses`.
+
+use gyroemu_config::{Config, ConfigError, ExperimentKind, RateTable};
+use gyroemu_experiment::fit::{fit_line, t95, LineFit};
+use gyroemu_experiment::{run_sweep, Progress, SweepError, SweepResult};
+use serde::Serialize;
+
+/// A scale factor read from a sweep: the small-angle slope of the phase against the rate,
+/// from a line fit of tan(phase) (which undoes the atan of THEORY.md eqs. 2-3 exactly for
+/// the Coriolis phase and to O((Omega/w0)^2) for the rotating one), with its standard error.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SlopeFit {
+    /// Degrees of phase per deg/s (the same number as rad per rad/s, i.e. seconds).
+    pub slope_deg_per_dps: f64,
+    /// Standard error of that slope (fit residuals).
+    pub std_err_deg_per_dps: f64,
+    /// Degrees of freedom of the fit (points - 2).
+    pub dof: usize,
+    /// The paper's plain best linear fit of the phase itself (degrees against deg/s).
+    pub plain_fit: LineFit,
+}
+
+/// The linearised slope of `phase_deg` against `rates_dps`.
+pub fn linearised_slope(rates_dps: &[f64], phase_deg: &[f64]) -> SlopeFit {
+    let t: Vec<f64> = phase_deg.iter().map(|p| p.to_radians().tan()).collect();
+    let f = fit_line(rates_dps, &t);
+    SlopeFit {
+        slope_deg_per_dps: f.slope.to_degrees(),
+        std_err_deg_per_dps: f.slope_std_err.to_degrees(),
+        dof: rates_dps.len().saturating_sub(2),
+        plain_fit: fit_line(rates_dps, phase_deg),
+    }
+}
+
+/// Self-calibration of one mode.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ModeSelfcal {
+    /// Rotating-excitation slope (I/Q major-axis estimator), deg per deg/s.
+    pub rotating: SlopeFit,
+    /// The same from the paper's single real I channel.
+    pub rotating_paper_i: SlopeFit,
+    /// Coriolis slope measured on the virtual rate table.
+    pub coriolis: SlopeFit,
+    /// Predicted Coriolis slope: lambda times the rotating slope.
+    pub predicted_deg_per_dps: f64,
+    /// Predicted over measured, minus one.
+    pub relative_error: f64,
+    /// Half-width of the 95 % confidence interval of `relative_error`.
+    pub relative_error_ci95: f64,
+    /// The same prediction from the paper's single channel, and its error.
+    pub predicted_paper_i_deg_per_dps: f64,
+    pub relative_error_paper_i: f64,
+    /// Small-angle theory of the Coriolis slope for an ideal device: 2 Q lambda / w0 times
+    /// the drive ratio of the other mode over this one.
+    pub theory_coriolis_deg_per_dps: f64,
+}
+
+/// Combines the rotating and Coriolis sweeps of one mode.
+pub fn mode_selfcal(cfg: &Config, rot: &SweepResult, cor: &SweepResult, k: usize) -> ModeSelfcal {
+    let lambda = cfg.device.angular_gain;
+    let rates: Vec<f64> = rot.points.iter().map(|p| p.rate_dps).collect();
+    let rot_phase: Vec<f64> = rot.points.iter().map(|p| p.phase_deg[k]).collect();
+    let paper: Vec<f64> = rot
+        .points
+        .iter()
+        .map(|p| p.paper_i_deg.map_or(f64::NAN, |v| v[k]))
+        .collect();
+    let cor_rates: Vec<f64> = cor.points.iter().map(|p| p.rate_dps).collect();
+    let cor_phase: Vec<f64> = cor.points.iter().map(|p| p.phase_deg[k]).collect();
+    let rotating = linearised_slope(&rates, &rot_phase);
+    let rotating_paper_i = linearised_slope(&rates, &paper);
+    let coriolis = linearised_slope(&cor_rates, &cor_phase);
+    let predicted = lambda * rotating.slope_deg_per_dps;
+    let measured = coriolis.slope_deg_per_dps;
+    let rel = |s: &SlopeFit| s.std_err_deg_per_dps / s.slope_deg_per_dps;
+    let ratio = predicted / measured;
+    let ci = t95(rotating.dof.min(coriolis.dof)) * ratio * rel(&rotating).hypot(rel(&coriolis));
+    let predicted_paper = lambda * rotating_paper_i.slope_deg_per_dps;
+    let d = &cfg.device;
+    let (own, other) = if k == 0 {
+        (cfg.drive.f1, cfg.drive.f2)
+    } else {
+        (cfg.drive.f2, cfg.drive.f1)
+    };
+    let w0 = core::f64::consts::TAU * d.f0_hz;
+    ModeSelfcal {
+        rotating,
+        rotating_paper_i,
+        coriolis,
+        predicted_deg_per_dps: predicted,
+        relative_error: ratio - 1.0,
+        relative_error_ci95: ci.abs(),
+        predicted_paper_i_deg_per_dps: predicted_paper,
+        relative_error_paper_i: predicted_paper / measured - 1.0,
+        theory_coriolis_deg_per_dps: 2.0 * d.q * d.angular_gain / w0 * other / own,
+    }
+}
+
+/// The two sweeps' configs derived from the user's: the same board and rates, one rotating
+/// and one on a constant-rate table; dumps off.
+pub fn sweep_configs(cfg: &Config) -> (Config, Config) {
+    let mut rot = cfg.clone();
+    rot.experiment.kind = ExperimentKind::Rotating;
+    rot.experiment.rate_table = RateTable::Constant;
+    rot.experiment.table_freq_hz = None;
+    rot.dump = None;
+    let mut cor = rot.clone();
+    cor.experiment.kind = ExperimentKind::Coriolis;
+    (rot, cor)
+}
+
+/// The device at a temperature offset: f0 (and the mode-2 offset) and Q scaled by their
+/// temperature coefficients.
+pub fn drifted(cfg: &Config, delta_t_k: f64) -> Config {
+    let s = cfg.selfcal.clone().unwrap_or_default();
+    let f_scale = 1.0 + s.f0_tc_ppm_per_k * 1e-6 * delta_t_k;
+    let q_scale = 1.0 + s.q_tc_ppm_per_k * 1e-6 * delta_t_k;
+    let mut c = cfg.clone();
+    c.device.f0_hz *= f_scale;
+    c.device.mode2_f0_offset_hz *= f_scale;
+    c.device.q *= q_scale;
+    c.device.q_mode2 = c.device.q_mode2.map(|q| q * q_scale);
+    c
+}
+
+/// Validates every config `selfcal` will run (both sweeps, and each drifted device) before
+/// any sample is computed; returns the warnings they add to those of `cfg.validate()`.
+pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
+    let base = cfg.validate()?;
+    let mut warnings = Vec::new();
+    let (rot, cor) = sweep_configs(cfg);
+    let tag = |what: &str, e: ConfigError| ConfigError {
+        detail: format!("{} (in the {what} of selfcal)", e.detail),
+        ..e
+    };
+    let mut add = |w: Vec<String>| {
+        for x in w {
+            if !base.contains(&x) && !warnings.contains(&x) {
+                warnings.push(x);
+            }
+        }
+    };
+    add(rot.validate().map_err(|e| tag("rotating sweep", e))?);
+    add(cor.validate().map_err(|e| tag("rate-table sweep", e))?);
+    if let Some(s) = &cfg.selfcal {
+        for &dt in &s.drift_delta_t_k {
+            let (r, c) = sweep_configs(&drifted(cfg, dt));
+            let what = format!("drift scenario at {dt} K");
+            add(r.validate().map_err(|e| tag(&what, e))?);
+            add(c.validate().map_err(|e| tag(&what, e))?);
+        }
+        if let Some(t) = s.tau_max_s {
+            let mut r = rot.clone();
+            r.experiment.average_s = t;
+            add(r
+                .validate()
+                .map_err(|e| tag("averaging-time analysis", e))?);
+        }
+    }
+    Ok(warnings)
+}
+
+/// Both sweeps and their comparison.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SelfcalCore {
+    pub angular_gain: f64,
+    /// Per mode (mode 1 is the headline).
+    pub modes: [ModeSelfcal; 2],
+    pub rotating: SweepResult,
+    pub coriolis: SweepResult,
+}
+
+/// Runs the rotating sweep and the rate-table sweep of `cfg` and compares them.
+pub fn run_selfcal_core(
+    cfg: &Config,
+    rot_progress: Progress,
+    cor_progress: Progress,
+) -> Result<SelfcalCore, SweepError> {
+    let (rot_cfg, cor_cfg) = sweep_configs(cfg);
+    let rotating = run_sweep(&rot_cfg, rot_progress, None)?;
+    let coriolis = run_sweep(&cor_cfg, cor_progress, None)?;
+    Ok(SelfcalCore::from_sweeps(cfg, rotating, coriolis))
+}
+
+impl SelfcalCore {
+    /// Compares the rotating and the rate-table sweeps of `cfg` (from [`sweep_configs`]).
+    pub fn from_sweeps(cfg: &Config, rotating: SweepResult, coriolis: SweepResult) -> Self {
+        Self {
+            angular_gain: cfg.device.angular_gain,
+            modes: [0, 1].map(|k| mode_selfcal(cfg, &rotating, &coriolis, k)),
+            rotating,
+            coriolis,
+        }
+    }
+}

@@ -1,0 +1,310 @@
+//! The analyses of `gyroemu selfcal`, each a sample-by-sample emulation of the same board:
+//! the Allan deviation of the zero-rate phase output, the self-calibration error against the
+//! averaging time (one long rotating run read at checkpoints), and a temperature drift.
+
+use crate::allan::{noise_readings, overlapping_adev, AllanPoint, NoiseReadings};
+use crate::selfcal::{drifted, linearised_slope, run_selfcal_core, sweep_configs};
+use gyroemu_board::{Board, LaneResult, Point, RunOptions, MAX_LANES};
+use gyroemu_config::Config;
+use gyroemu_core::f64x4;
+use gyroemu_experiment::post_process;
+use gyroemu_experiment::sweep::{add_group_progress, canonical_work};
+use gyroemu_experiment::{Progress, SweepError};
+use gyroemu_lpf::Window;
+use gyroemu_mixer::wrap_pi;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::sync::atomic::AtomicU64;
+
+/// Noise streams of the analyses start here, apart from the sweep points' streams (0..).
+pub const ANALYSIS_STREAM_BASE: u64 = 1 << 32;
+
+/// Allan deviation of the zero-rate output, from four independent records (one per lane).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AllanResult {
+    /// Sample interval of the analysed series (block means of the decimated output), s.
+    pub tau0_s: f64,
+    pub record_s: f64,
+    /// Of the mode-1 phase output, degrees (records pooled: RMS over the four).
+    pub phase_deg: Vec<AllanPoint>,
+    /// Of the rate-equivalent output (phase over the measured scale factor), deg/s.
+    pub rate_dps: Vec<AllanPoint>,
+    pub readings: Option<NoiseReadings>,
+    /// The scale factor used, deg of phase per deg/s.
+    pub scale_deg_per_dps: f64,
+}
+
+/// Runs `record_s` of the board at zero rate (Coriolis drive) on four streams and reads the
+/// Allan deviation of the mode-1 phase. `scale_deg_per_dps` converts phase to rate.
+pub fn allan_analysis(
+    cfg: &Config,
+    record_s: f64,
+    scale_deg_per_dps: f64,
+    progress: Progress,
+) -> Result<AllanResult, SweepError> {
+    let (_, cor) = sweep_configs(cfg);
+    let fs_out = cor.fs_out_hz();
+    let block = ((0.01 * fs_out).round() as u64).max(1);
+    let tau0 = block as f64 / fs_out;
+    let n_avg = (record_s * fs_out).floor() as u64;
+    let point = Point {
+        rate_rad_s: 0.0,
+        window: Window::Boxcar {
+            n: n_avg,
+            frac: 0.0,
+        },
+    };
+    let streams: [u64; MAX_LANES] = core::array::from_fn(|i| ANALYSIS_STREAM_BASE + i as u64);
+    let mut board = Board::<f64x4>::new(&cor.board_params(), &[0.0; MAX_LANES], &streams)?;
+    let n_settle = cor.n_settle_out();
+    let total = (n_settle + n_avg + 1) * cor.board.decimation as u64;
+    let opts = RunOptions {
+        series_block: block,
+        ..Default::default()
+    };
+    let out = board.run(n_settle, &[point; MAX_LANES], opts, &|d| progress(d, total))?;
+    // Phase lag of mode 1, degrees, unwrapped (the record never wraps at zero rate, but a
+    // noisy low-amplitude device could).
+    let curves: Vec<Vec<AllanPoint>> = out
+        .series
+        .iter()
+        .map(|rows| {
+            let mut prev = 0.0f64;
+            let mut acc = 0.0f64;
+            let ph: Vec<f64> = rows
+                .iter()
+                .enumerate()
+                .map(|(i, r)| {
+                    let p = -r[1].atan2(r[0]);
+                    if i > 0 {
+                        acc += wrap_pi(p - prev);
+                    } else {
+                        acc = p;
+                    }
+                    prev = p;
+                    acc.to_degrees()
+                })
+                .collect();
+            overlapping_adev(&ph, tau0, 8)
+        })
+        .collect();
+    let phase: Vec<AllanPoint> = (0..curves[0].len())
+        .map(|j| {
+            let ms =
+                curves.iter().map(|c| c[j].adev * c[j].adev).sum::<f64>() / curves.len() as f64;
+            AllanPoint {
+                tau_s: curves[0][j].tau_s,
+                adev: ms.sqrt(),
+                n_terms: curves.iter().map(|c| c[j].n_terms).sum(),
+            }
+        })
+        .collect();
+    let rate: Vec<AllanPoint> = phase
+        .iter()
+        .map(|p| AllanPoint {
+            adev: p.adev / scale_deg_per_dps.abs(),
+            ..*p
+        })
+        .collect();
+    Ok(AllanResult {
+        tau0_s: tau0,
+        record_s: n_avg as f64 / fs_out,
+        readings: noise_readings(&rate),
+        phase_deg: phase,
+        rate_dps: rate,
+        scale_deg_per_dps,
+    })
+}
+
+/// The self-calibration at one averaging time.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TauPoint {
+    /// Averaging time asked, s.
+    pub tau_s: f64,
+    /// Averaging time used by the slowest rate (whole half periods once tau allows), s.
+    pub averaged_s: f64,
+    pub predicted_deg_per_dps: f64,
+    /// Predicted over the measured Coriolis slope, minus one.
+    pub relative_error: f64,
+    pub relative_error_ci95: f64,
+    /// Predicted over the small-angle theory of an ideal device, minus one (noise and
+    /// truncation only, without the rate table's own error).
+    pub relative_error_vs_theory: f64,
+}
+
+/// The averaging times read: 1, 2, 5 per decade up to `tau_max_s`, plus the config's
+/// averaging time and 500 s (the paper's) when in range.
+pub fn tau_grid(tau_max_s: f64, average_s: f64) -> Vec<f64> {
+    let mut g: Vec<f64> = (0..8)
+        .flat_map(|d| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(d)))
+        .filter(|&t| t <= tau_max_s)
+        .collect();
+    for t in [average_s, 500.0, tau_max_s] {
+        if t >= 1.0 && t <= tau_max_s && !g.contains(&t) {
+            g.push(t);
+        }
+    }
+    g.sort_by(f64::total_cmp);
+    g
+}
+
+/// One rotating run of `tau_max_s`, read at every averaging time of [`tau_grid`] (each point
+/// averaged over whole half periods once tau spans one, as the sweep does), compared with
+/// the measured Coriolis slope of mode 1.
+pub fn tau_analysis(
+    cfg: &Config,
+    tau_max_s: f64,
+    measured_deg_per_dps: f64,
+    theory_deg_per_dps: f64,
+    progress: Progress,
+) -> Result<Vec<TauPoint>, SweepError> {
+    let (mut rot, _) = sweep_configs(cfg);
+    let grid = tau_grid(tau_max_s, cfg.experiment.average_s);
+    rot.experiment.average_s = tau_max_s;
+    let rates = rot.emulated_rates_dps();
+    let points: Vec<Point> = rates.iter().map(|&r| rot.plan_point(r)).collect();
+    // Window of each point at each tau: plan_point's rule (whole half periods) once tau spans
+    // half a modulation period; below that, exactly tau (the truncated window a user who
+    // stops early gets, so its leakage shows).
+    let fs_out = rot.fs_out_hz();
+    let windows: Vec<Vec<Point>> = grid
+        .iter()
+        .map(|&t| {
+            let mut c = rot.clone();
+            c.experiment.average_s = t;
+            rates
+                .iter()
+                .map(|&r| {
+                    let half_period_s = 180.0 / r.abs().max(1e-300);
+                    if t < half_period_s {
+                        Point {
+                            rate_rad_s: r.to_radians(),
+                            window: Window::Boxcar {
+                                n: ((t * fs_out).floor() as u64).max(1),
+                                frac: 0.0,
+                            },
+                        }
+                    } else {
+                        c.plan_point(r)
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let n_settle = rot.n_settle_out();
+    let groups: Vec<(usize, &[Point])> = points
+        .chunks(MAX_LANES)
+        .enumerate()
+        .map(|(g, c)| (g * MAX_LANES, c))
+        .collect();
+    let (total, _) = canonical_work(&rot, &points);
+    let done = AtomicU64::new(0);
+    let params = rot.board_params();
+    let mut boards = Vec::new();
+    for (first, g) in &groups {
+        let r: Vec<f64> = g.iter().map(|p| p.rate_rad_s).collect();
+        let s: Vec<u64> = (0..g.len()).map(|i| (first + i) as u64).collect();
+        boards.push(Board::<f64x4>::new(&params, &r, &s)?);
+    }
+    let results: Vec<Result<Vec<Vec<LaneResult>>, SweepError>> = boards
+        .into_par_iter()
+        .zip(groups.par_iter())
+        .map(|(mut board, (first, g))| {
+            let early_reads = (0..g.len())
+                .map(|i| {
+                    windows
+                        .iter()
+                        .map(|w| match w[first + i].window {
+                            Window::Boxcar { n, frac } => (n, frac),
+                            Window::Hann { n } => (n, 0.0),
+                        })
+                        .collect()
+                })
+                .collect();
+            let opts = RunOptions {
+                early_reads,
+                ..Default::default()
+            };
+            let last = AtomicU64::new(0);
+            let report = |n: u64| add_group_progress(&done, &last, n, total, progress);
+            Ok(board.run(n_settle, g, opts, &report)?.early_reads)
+        })
+        .collect();
+    let mut per_point: Vec<Vec<LaneResult>> = Vec::new();
+    for r in results {
+        per_point.extend(r?);
+    }
+    let lambda = cfg.device.angular_gain;
+    grid.iter()
+        .enumerate()
+        .map(|(ti, &tau)| {
+            let lanes: Vec<LaneResult> = per_point.iter().map(|cks| cks[ti]).collect();
+            let mut c = rot.clone();
+            c.experiment.average_s = tau;
+            let res = post_process(&c, &rates, &windows[ti], &lanes)?;
+            let xs: Vec<f64> = res.points.iter().map(|p| p.rate_dps).collect();
+            let ys: Vec<f64> = res.points.iter().map(|p| p.phase_deg[0]).collect();
+            let s = linearised_slope(&xs, &ys);
+            let predicted = lambda * s.slope_deg_per_dps;
+            let ratio = predicted / measured_deg_per_dps;
+            let ci = gyroemu_experiment::fit::t95(s.dof) * ratio * s.std_err_deg_per_dps
+                / s.slope_deg_per_dps;
+            Ok(TauPoint {
+                tau_s: tau,
+                averaged_s: res.points.iter().map(|p| p.averaged_s).fold(0.0, f64::max),
+                predicted_deg_per_dps: predicted,
+                relative_error: ratio - 1.0,
+                relative_error_ci95: ci.abs(),
+                relative_error_vs_theory: predicted / theory_deg_per_dps - 1.0,
+            })
+        })
+        .collect()
+}
+
+/// The self-calibration at one temperature offset.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DriftPoint {
+    pub delta_t_k: f64,
+    pub f0_hz: f64,
+    pub q: f64,
+    /// Coriolis slope measured on the rate table at this temperature, deg per deg/s.
+    pub measured_deg_per_dps: f64,
+    /// Self-calibrated at this temperature.
+    pub selfcal_deg_per_dps: f64,
+    /// Self-calibration error at this temperature.
+    pub selfcal_relative_error: f64,
+    /// Error of keeping the nominal-temperature calibration instead.
+    pub stale_relative_error: f64,
+}
+
+/// Re-runs both sweeps on the drifted device at each temperature offset; `nominal_deg_per_dps`
+/// is the calibration taken at the nominal temperature (what a device without
+/// self-calibration keeps using).
+pub fn drift_analysis(
+    cfg: &Config,
+    deltas_k: &[f64],
+    nominal_deg_per_dps: f64,
+    progress: Progress,
+) -> Result<Vec<DriftPoint>, SweepError> {
+    let n = deltas_k.len() as u64;
+    let mut out = Vec::new();
+    for (i, &dt) in deltas_k.iter().enumerate() {
+        let c = drifted(cfg, dt);
+        // Progress in thousandths: each offset is half rotating, half rate table.
+        let at = |half: u64, d: u64, t: u64| {
+            progress(i as u64 * 1000 + half * 500 + d * 500 / t.max(1), n * 1000)
+        };
+        let core = run_selfcal_core(&c, &|d, t| at(0, d, t), &|d, t| at(1, d, t))?;
+        let m = core.modes[0];
+        out.push(DriftPoint {
+            delta_t_k: dt,
+            f0_hz: c.device.f0_hz,
+            q: c.device.q,
+            measured_deg_per_dps: m.coriolis.slope_deg_per_dps,
+            selfcal_deg_per_dps: m.predicted_deg_per_dps,
+            selfcal_relative_error: m.relative_error,
+            stale_relative_error: nominal_deg_per_dps / m.coriolis.slope_deg_per_dps - 1.0,
+        });
+    }
+    Ok(out)
+}

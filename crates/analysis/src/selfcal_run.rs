@@ -1,0 +1,80 @@
+//! `selfcal` as one call: the two sweeps, then the analyses the config's `[selfcal]` section
+//! asks for, each reported as its own task.
+
+use crate::selfcal::{sweep_configs, SelfcalCore};
+use crate::selfcal_analyses::{
+    allan_analysis, drift_analysis, tau_analysis, AllanResult, DriftPoint, TauPoint,
+};
+use gyroemu_config::Config;
+use gyroemu_experiment::{run_sweep, Reporter, SweepError};
+
+/// Everything `selfcal` measured.
+#[derive(Clone, Debug)]
+pub struct SelfcalReport {
+    /// The two sweeps and their comparison.
+    pub core: SelfcalCore,
+    /// Allan deviation of the zero-rate output (`selfcal.allan_record_s`).
+    pub allan: Option<AllanResult>,
+    /// Error against averaging time (`selfcal.tau_max_s`).
+    pub taus: Option<Vec<TauPoint>>,
+    /// Drift scenario (`selfcal.drift_delta_t_k`).
+    pub drift: Option<Vec<DriftPoint>>,
+}
+
+/// Runs the rotating sweep and the rate-table sweep of `cfg` (validated, e.g. by
+/// `validate_selfcal`), compares them, then runs each analysis the config asks for.
+pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalReport, SweepError> {
+    let (rot_cfg, cor_cfg) = sweep_configs(cfg);
+    let p = reporter.task("rotating sweep");
+    let rotating = run_sweep(&rot_cfg, &|d, t| p.update(d, t), None)?;
+    p.finish(Some(rotating.point_samples));
+    let p = reporter.task("rate-table sweep");
+    let coriolis = run_sweep(&cor_cfg, &|d, t| p.update(d, t), None)?;
+    p.finish(Some(coriolis.point_samples));
+    let core = SelfcalCore::from_sweeps(cfg, rotating, coriolis);
+    let m = core.modes[0];
+    let sc = cfg.selfcal.clone().unwrap_or_default();
+    let allan = match sc.allan_record_s {
+        Some(t) => {
+            let p = reporter.task("allan record");
+            let a = allan_analysis(cfg, t, m.coriolis.slope_deg_per_dps, &|d, n| p.update(d, n))?;
+            p.finish(None);
+            Some(a)
+        }
+        None => None,
+    };
+    let taus = match sc.tau_max_s {
+        Some(t) => {
+            let p = reporter.task("averaging-time run");
+            let r = tau_analysis(
+                cfg,
+                t,
+                m.coriolis.slope_deg_per_dps,
+                m.theory_coriolis_deg_per_dps,
+                &|d, n| p.update(d, n),
+            )?;
+            p.finish(None);
+            Some(r)
+        }
+        None => None,
+    };
+    let drift = if sc.drift_delta_t_k.is_empty() {
+        None
+    } else {
+        let p = reporter.task("drift scenario");
+        let d = drift_analysis(
+            cfg,
+            &sc.drift_delta_t_k,
+            m.coriolis.slope_deg_per_dps,
+            &|d, n| p.update(d, n),
+        )?;
+        p.finish(None);
+        Some(d)
+    };
+    Ok(SelfcalReport {
+        core,
+        allan,
+        taus,
+        drift,
+    })
+}

@@ -1,0 +1,251 @@
+//! The readout board assembled from the stage crates. Generic over the sample type: `f64` runs
+//! one operating point, `f64x4` runs four in SIMD lanes through the very same stage code (the
+//! carrier NCO is shared, each lane has its own rate, plant and noise stream).
+
+use crate::fault::NonFinite;
+use crate::params::{build_adc, build_dac, build_lowpass, build_tia, BoardParams, Shape};
+use crate::point::{Point, RunOptions, RunOutput};
+use gyroemu_am::{AmModulator, Dac, DrivePattern, Quantizer};
+use gyroemu_core::noise::{held_white_sigma, stream_seed, NoiseRng};
+use gyroemu_core::{ParamError, Sample};
+use gyroemu_lpf::LowPassBank;
+use gyroemu_mixer::{Stage1Mixer, Stage2Mixer};
+use gyroemu_nco::{Nco, PhaseShifter, RotatingNco};
+use gyroemu_resonator::{thermomechanical_accel_psd, Resonator};
+use gyroemu_tia::{input_referred_noise_a_per_rthz, Tia};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+/// At most this many lanes (the width of `f64x4`).
+pub const MAX_LANES: usize = 4;
+
+/// The sample loop's shapes, chosen once per run (const generics keep the per-sample path free
+/// of the shape test).
+pub(crate) const CORIOLIS: u8 = 0;
+pub(crate) const RATE_TABLE: u8 = 1;
+pub(crate) const ROTATING: u8 = 2;
+
+/// The seeded noise of one lane group: one stream per lane (per operating point) and the
+/// per-sample standard deviations of the force (per unit mass) and input-current sources.
+#[derive(Clone, Debug)]
+pub(crate) struct NoiseState<S> {
+    pub(crate) rng: NoiseRng,
+    pub(crate) sigma_force: [S; 2],
+    pub(crate) sigma_current: [S; 2],
+}
+
+/// The per-sample standard deviations of the force (per unit mass) and of the input-referred
+/// current, per mode: each source is a held white sequence whose density at that mode's
+/// resonance is the physical one.
+pub(crate) fn noise_sigmas(p: &BoardParams) -> ([f64; 2], [f64; 2]) {
+    let Some(n) = &p.noise else {
+        return ([0.0; 2], [0.0; 2]);
+    };
+    let fs = p.fs_hz();
+    let f0 = [p.plant.mode1.f0_hz, p.plant.mode2.f0_hz];
+    let q = [p.plant.mode1.q, p.plant.mode2.q];
+    let force = core::array::from_fn(|k| {
+        n.effective_mass_kg.map_or(0.0, |m| {
+            let psd = thermomechanical_accel_psd(n.temperature_k, m, f0[k], q[k]);
+            held_white_sigma(psd, fs, f0[k])
+        })
+    });
+    let i_n = input_referred_noise_a_per_rthz(
+        n.tia_current_noise_a_per_rthz,
+        n.tia_voltage_noise_v_per_rthz,
+        p.tia.gain_ohm,
+    );
+    let current = core::array::from_fn(|k| held_white_sigma(i_n * i_n, fs, f0[k]));
+    (force, current)
+}
+
+/// The modulation frequency of a rotating operating point, Hz (0 for the other shapes).
+pub(crate) fn modulation_hz(shape: Shape, rate_rad_s: f64) -> f64 {
+    match shape {
+        Shape::Rotating => rate_rad_s / core::f64::consts::TAU,
+        _ => 0.0,
+    }
+}
+
+/// The plant's constant rate for an operating point: the rate of a Coriolis point; a rate
+/// table starts from rest and a rotating excitation keeps the device at rest.
+pub(crate) fn plant_rate(shape: Shape, rate_rad_s: f64) -> f64 {
+    match shape {
+        Shape::Coriolis => rate_rad_s,
+        _ => 0.0,
+    }
+}
+
+/// The table oscillator: the plant holds the rate over each step and its midpoint value makes
+/// that step second-order accurate, so the table NCO runs half a sample ahead.
+pub(crate) fn table_nco(p: &BoardParams) -> Result<Nco, ParamError> {
+    let f = match p.shape {
+        Shape::RateTable { freq_hz } => freq_hz,
+        _ => 0.0,
+    };
+    Nco::new(f, p.fs_hz(), core::f64::consts::PI * f / p.fs_hz())
+}
+
+/// The phase shifter of the drive's quadrature copy (the nominal one is exactly -j: cos ->
+/// sin with no rounding).
+pub(crate) fn shifter(p: &BoardParams) -> Result<PhaseShifter, ParamError> {
+    match p.phase_shifter_error_deg {
+        0.0 => Ok(PhaseShifter::quadrature()),
+        e => PhaseShifter::new((90.0 + e).to_radians()),
+    }
+}
+
+/// The drive pattern of a shape.
+pub(crate) fn pattern(shape: Shape) -> DrivePattern {
+    match shape {
+        Shape::Rotating => DrivePattern::Rotating,
+        _ => DrivePattern::Coriolis,
+    }
+}
+
+/// Per-sample work shared by every lane; all fields are built before the first sample.
+#[derive(Clone)]
+pub struct Board<S: Sample> {
+    pub(crate) shape: Shape,
+    pub(crate) lanes: usize,
+    /// Carrier e^{j w0 t}, shared by all lanes.
+    pub(crate) carrier: RotatingNco<f64>,
+    pub(crate) shifter: PhaseShifter,
+    /// Modulation e^{j Omega t}, one Omega per lane (rotating runs).
+    pub(crate) modulation: RotatingNco<S>,
+    /// Rate-table sine, shared frequency (rate-table runs).
+    pub(crate) table_nco: RotatingNco<f64>,
+    pub(crate) rate: S,
+    pub(crate) am: AmModulator<S>,
+    pub(crate) dac: [Dac<S>; 2],
+    pub(crate) plant: Resonator<S>,
+    pub(crate) tia: [Tia<S>; 2],
+    pub(crate) mix1: [Stage1Mixer<S>; 2],
+    /// The two stage-1 mixers have the same reference phase (their carrier factors agree).
+    pub(crate) mix1_same_ref: bool,
+    /// Stage-1 low-pass of I1, Q1, I2, Q2 (one design).
+    pub(crate) lp: LowPassBank<S, 4>,
+    pub(crate) decimation: usize,
+    pub(crate) mix2: Stage2Mixer<S>,
+    pub(crate) fs_hz: f64,
+    pub(crate) table_f_hz: f64,
+    /// Phase-shifter error on the modulation's quadrature copy (rotating runs): (cos, sin).
+    pub(crate) mod_shift: Option<(S, S)>,
+    pub(crate) noise: NoiseState<S>,
+    /// ADC after each TIA (absent: ideal).
+    pub(crate) adc: Option<[Quantizer<S>; 2]>,
+    /// Noise or ADC present: the sample loop takes its imperfect shape.
+    pub(crate) imperfect: bool,
+    /// The board as built, for locating a non-finite value by replay.
+    pub(crate) pristine: Option<Box<Board<S>>>,
+    /// Raised: the run stops at its next progress report (see [`Board::set_cancel`]).
+    pub(crate) cancel: Option<Arc<AtomicBool>>,
+}
+
+impl<S: Sample> Board<S> {
+    /// Builds the board for up to `S::LANES` operating points (rates in rad/s: rotation,
+    /// excitation or table amplitude, by `p.shape`; unused lanes repeat the last point); lane
+    /// `i` draws noise stream `streams[i]` (a sweep passes each point's index, so its noise
+    /// does not depend on the lane group or shard that runs it).
+    pub fn new(p: &BoardParams, rates_rad_s: &[f64], streams: &[u64]) -> Result<Self, ParamError> {
+        let lanes = rates_rad_s.len();
+        if lanes == 0 || lanes > S::LANES || streams.len() != lanes {
+            return Err(ParamError::new(
+                crate::params::STAGE,
+                "rates_rad_s",
+                lanes,
+                format!(
+                    "must list 1 to {} operating points, one noise stream each",
+                    S::LANES
+                ),
+            ));
+        }
+        p.validate()?;
+        let lane_rate = |i: usize| rates_rad_s[i.min(lanes - 1)];
+        let fs = p.fs_hz();
+        let carrier = Nco::new(p.carrier_hz, fs, 0.0)?;
+        let modulation: Vec<Nco> = (0..S::LANES)
+            .map(|i| Nco::new(modulation_hz(p.shape, lane_rate(i)), fs, 0.0))
+            .collect::<Result<_, _>>()?;
+        let table_nco = table_nco(p)?;
+        let scalar: Vec<Resonator<f64>> = (0..S::LANES)
+            .map(|i| Resonator::<f64>::new(&p.plant, plant_rate(p.shape, lane_rate(i))))
+            .collect::<Result<_, _>>()?;
+        let mix1 = [Stage1Mixer::new(0.0)?, Stage1Mixer::new(0.0)?];
+        let seed = p.noise.map_or(0, |n| n.seed);
+        let lane_stream = |i: usize| streams[i.min(lanes - 1)];
+        let rng = NoiseRng::new(core::array::from_fn(|i| stream_seed(seed, lane_stream(i))));
+        let (sigma_force, sigma_current) = noise_sigmas(p);
+        let adc = build_adc(p)?.map(|q| [q, q]);
+        let imperfect = p.noise.is_some() || adc.is_some();
+        let eps = p.phase_shifter_error_deg.to_radians();
+        let mod_shift = (p.shape.is_rotating() && eps != 0.0)
+            .then(|| (S::splat(eps.cos()), S::splat(eps.sin())));
+        let mut board = Self {
+            shape: p.shape,
+            lanes,
+            carrier: RotatingNco::new(&[carrier]),
+            shifter: shifter(p)?,
+            modulation: RotatingNco::new(&modulation),
+            table_f_hz: table_nco.f_hz(),
+            table_nco: RotatingNco::new(&[table_nco]),
+            rate: S::from_fn(lane_rate),
+            am: AmModulator::new(pattern(p.shape), p.drive[0], p.drive[1])?,
+            dac: [build_dac(p)?, build_dac(p)?],
+            plant: Resonator::<S>::from_lanes(&scalar),
+            tia: [build_tia(p)?, build_tia(p)?],
+            mix1_same_ref: mix1[0].ref_phase_rad() == mix1[1].ref_phase_rad(),
+            mix1,
+            lp: LowPassBank::new(&build_lowpass(p)?),
+            decimation: p.decimation,
+            mix2: Stage2Mixer::default(),
+            fs_hz: fs,
+            mod_shift,
+            noise: NoiseState {
+                rng,
+                sigma_force: sigma_force.map(S::splat),
+                sigma_current: sigma_current.map(S::splat),
+            },
+            adc,
+            imperfect,
+            pristine: None,
+            cancel: None,
+        };
+        board.pristine = Some(Box::new(board.clone()));
+        Ok(board)
+    }
+
+    /// A flag that, once raised, makes a run stop at its next progress report (every 65 536
+    /// input samples or so) and return at once: its averages are then meaningless, so the
+    /// caller must test the flag after the run and discard them (Ctrl-C of a sweep).
+    pub fn set_cancel(&mut self, flag: Arc<AtomicBool>) {
+        self.cancel = Some(flag);
+    }
+
+    /// The operating points this board runs (lanes in use).
+    pub fn lanes(&self) -> usize {
+        self.lanes
+    }
+
+    /// Runs `n_settle` decimated samples of settling, then averages each lane over its point's
+    /// window (plus what `opts` asks). `progress` is called with the number of input samples
+    /// done, every 65 536 or so. A value that stops being finite ends the run with the stage
+    /// and the sample where it happened.
+    pub fn run(
+        &mut self,
+        n_settle: u64,
+        points: &[Point],
+        opts: RunOptions,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<RunOutput, NonFinite> {
+        self.dispatch(n_settle, points, opts, progress)
+            .map_err(|k| self.locate_fault(k))
+    }
+
+    /// The plant takes its decoupled step (exact zeros across the modes in every lane: no
+    /// rotation and no quadrature coupling; never on a rate table, whose step varies). Public
+    /// so tests can check that a run took the shortcut it is compared through.
+    pub fn plant_decoupled(&self) -> bool {
+        !matches!(self.shape, Shape::RateTable { .. }) && self.plant.decoupled()
+    }
+}

@@ -1,0 +1,343 @@
+//! The fused sample loop: every stage on every input sample with no buffers in between, one
+//! monomorphised loop per experiment shape, noise shape and plant step. Its results equal the
+//! reference board's (`reference.rs`, plain `Stage::tick` calls) bit for bit.
+
+use crate::board::{Board, CORIOLIS, RATE_TABLE, ROTATING};
+use crate::fault::NonFinite;
+use crate::params::Shape;
+use crate::point::{LaneResult, Point, RunOptions, RunOutput};
+use crate::probe::Probe;
+use gyroemu_am::AmInput;
+use gyroemu_core::{detmath, Complex64, Sample, Stage};
+use gyroemu_lpf::Averager;
+use gyroemu_mixer::{Iq, Stage1Mixer};
+use std::sync::atomic::Ordering;
+
+/// Input samples between progress reports (and cancel checks).
+const REPORT_EVERY_IN: u64 = 65_536;
+
+impl<S: Sample> Board<S> {
+    /// Picks the sample loop of this board's shape, noise and plant step. Returns the
+    /// decimated index at which an output stopped being finite, if one did.
+    pub(crate) fn dispatch(
+        &mut self,
+        n_settle: u64,
+        points: &[Point],
+        opts: RunOptions,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<RunOutput, u64> {
+        macro_rules! by_plant {
+            ($k:expr) => {
+                match (self.imperfect, self.plant_decoupled()) {
+                    (false, false) => {
+                        self.sample_loop::<$k, false, false>(n_settle, points, opts, progress)
+                    }
+                    (false, true) => {
+                        self.sample_loop::<$k, false, true>(n_settle, points, opts, progress)
+                    }
+                    (true, false) => {
+                        self.sample_loop::<$k, true, false>(n_settle, points, opts, progress)
+                    }
+                    (true, true) => {
+                        self.sample_loop::<$k, true, true>(n_settle, points, opts, progress)
+                    }
+                }
+            };
+        }
+        match self.shape {
+            Shape::Coriolis => by_plant!(CORIOLIS),
+            Shape::RateTable { .. } => by_plant!(RATE_TABLE),
+            Shape::Rotating => by_plant!(ROTATING),
+        }
+    }
+
+    /// One block of the checking replay, in the run's plant shape.
+    pub(crate) fn replay_block(&mut self, n0: u64, probe: &mut Probe) {
+        macro_rules! by_plant {
+            ($k:expr) => {
+                if self.plant_decoupled() {
+                    self.block::<$k, true, true>(n0, Some(probe));
+                } else {
+                    self.block::<$k, true, false>(n0, Some(probe));
+                }
+            };
+        }
+        match self.shape {
+            Shape::Coriolis => by_plant!(CORIOLIS),
+            Shape::RateTable { .. } => by_plant!(RATE_TABLE),
+            Shape::Rotating => by_plant!(ROTATING),
+        }
+    }
+
+    /// The sample loop of experiment shape `K`; `NOISY`: the noise sources and the ADC are in
+    /// the chain; `DECOUPLED`: the plant takes its decoupled step.
+    ///
+    /// Its own function per shape: inlined into the dispatcher beside the other shapes, the
+    /// sample loop's registers were allocated worse (measurably slower).
+    #[allow(clippy::needless_range_loop)] // mode and lane indices address parallel arrays
+    #[inline(never)]
+    fn sample_loop<const K: u8, const NOISY: bool, const DECOUPLED: bool>(
+        &mut self,
+        n_settle: u64,
+        points: &[Point],
+        mut opts: RunOptions,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<RunOutput, u64> {
+        let lanes = self.lanes;
+        let m = self.decimation as u64;
+        let n_out = n_settle + points.iter().map(|p| p.window.samples()).max().unwrap_or(1);
+        let windows: Vec<_> = points.iter().take(lanes).map(|p| p.window).collect();
+        let channels = if K == ROTATING { 8 } else { 4 };
+        let mut avg = Averager::<S, 8>::new(&windows, channels)
+            .expect("the points' windows are valid and one per lane");
+        let mut prev_z = [Iq::<S>::default(); 2];
+        let mut unwrapped = [S::splat(0.0); 2];
+        let report_every = (REPORT_EVERY_IN / m).max(1);
+        let mut read_next = vec![0usize; lanes];
+        let mut early: Vec<Vec<LaneResult>> = vec![Vec::new(); lanes];
+        let mut series: Vec<Vec<[f64; 8]>> = vec![Vec::new(); lanes];
+        let mut series_acc = [S::splat(0.0); 8];
+        for k in 0..n_out {
+            let n0 = k * m;
+            // The recording path only for blocks that touch the dump window.
+            let (z, r) = match opts.probe.as_deref_mut() {
+                Some(p) if p.wants_block(n0, m) => self.block::<K, NOISY, DECOUPLED>(n0, Some(p)),
+                _ => self.block::<K, NOISY, DECOUPLED>(n0, None),
+            };
+            // Each on its own: a sum of large finite values could overflow and false-alarm.
+            if ![z[0].i, z[0].q, z[1].i, z[1].q]
+                .iter()
+                .all(|v| v.all_finite())
+            {
+                return Err(k);
+            }
+            if let Some(p) = opts.probe.as_deref_mut() {
+                p.record_decimated(k, &z, &r, K == ROTATING);
+            }
+            if k % report_every == 0 {
+                progress(n0 + m);
+                if self
+                    .cancel
+                    .as_ref()
+                    .is_some_and(|c| c.load(Ordering::Relaxed))
+                {
+                    break;
+                }
+            }
+            if k < n_settle {
+                prev_z = z;
+                continue;
+            }
+            let j = k - n_settle;
+            // This sample's value of every averaged channel, unweighted.
+            let mut x = [S::splat(0.0); 8];
+            match K {
+                CORIOLIS => {
+                    for md in 0..2 {
+                        x[2 * md] = z[md].i;
+                        x[2 * md + 1] = z[md].q;
+                    }
+                }
+                RATE_TABLE => {
+                    // Phase lag of z, unwrapped, demodulated at the table frequency, with the
+                    // reference at the input sample this output stands for.
+                    let n_in = (n0 + m - 1) as f64;
+                    let (ts, tc) = detmath::sin_cos_turns(n_in * self.table_f_hz / self.fs_hz);
+                    for md in 0..2 {
+                        let d = S::from_fn(|i| {
+                            let a = z[md].lane(i);
+                            let b = prev_z[md].lane(i);
+                            // arg(b/a): the lag accrued since the previous sample.
+                            (b * a.conj()).arg()
+                        });
+                        unwrapped[md] += d;
+                        x[2 * md] = unwrapped[md] * S::splat(2.0 * tc);
+                        x[2 * md + 1] = unwrapped[md] * S::splat(-2.0 * ts);
+                    }
+                    prev_z = z;
+                }
+                _ => {
+                    for (base, zm) in [(0, z[0]), (4, z[1])] {
+                        let o = self.mix2.tick((zm, r));
+                        x[base] = o.c.i;
+                        x[base + 1] = o.c.q;
+                        x[base + 2] = o.s.i;
+                        x[base + 3] = o.s.q;
+                    }
+                }
+            }
+            for (i, reads) in opts.early_reads.iter().enumerate().take(lanes) {
+                while let Some(&(n, frac)) = reads.get(read_next[i]) {
+                    if n != j {
+                        break;
+                    }
+                    early[i].push(lane_result::<K>(&avg.mean_if_ended(i, frac, &x)));
+                    read_next[i] += 1;
+                }
+            }
+            if opts.series_block > 0 {
+                for c in 0..8 {
+                    series_acc[c] += x[c];
+                }
+                if (j + 1).is_multiple_of(opts.series_block) {
+                    let scale = 1.0 / opts.series_block as f64;
+                    for (i, rows) in series.iter_mut().enumerate() {
+                        rows.push(core::array::from_fn(|c| series_acc[c].lane(i) * scale));
+                    }
+                    series_acc = [S::splat(0.0); 8];
+                }
+            }
+            avg.push(&x);
+        }
+        progress(n_out * m);
+        Ok(RunOutput {
+            lanes: (0..lanes).map(|i| lane_result::<K>(&avg.mean(i))).collect(),
+            early_reads: early,
+            series,
+        })
+    }
+
+    /// One decimation block of input samples `n0 .. n0 + M` through the whole chain, fused
+    /// (every stage on every sample, no buffers: a two-pass variant through an L1 buffer
+    /// measured slower). Returns the low-passed stage-1 outputs at the block's last sample
+    /// (the decimated output) and the modulation references (cos, sin of Omega t) at that
+    /// same sample.
+    #[inline(always)]
+    pub(crate) fn block<const K: u8, const NOISY: bool, const DECOUPLED: bool>(
+        &mut self,
+        n0: u64,
+        mut probe: Option<&mut Probe>,
+    ) -> ([Iq<S>; 2], [S; 2]) {
+        let zero = S::splat(0.0);
+        let mut out = ([Iq::<S>::default(); 2], [zero; 2]);
+        for j in 0..self.decimation as u64 {
+            let (c_re, c_im) = self.carrier.tick(());
+            // The rotating drive uses only the in-phase carrier.
+            let cq = if K == ROTATING {
+                0.0
+            } else {
+                self.shifter.apply(Complex64::new(c_re, c_im)).re
+            };
+            let (mod_cos, mod_sin) = if K == ROTATING {
+                self.modulation.tick(())
+            } else {
+                (zero, zero)
+            };
+            // The drive's quadrature copy passes the (imperfect) phase shifter:
+            // sin(Omega t - eps); the stage-2 references stay exact.
+            let drive_sin = match self.mod_shift {
+                Some((ce, se)) if K == ROTATING => mod_sin * ce - mod_cos * se,
+                _ => mod_sin,
+            };
+            let drive = self.am.tick(AmInput {
+                carrier_i: S::splat(c_re),
+                carrier_q: S::splat(cq),
+                mod_cos,
+                mod_sin: drive_sin,
+            });
+            let mut u = [self.dac[0].tick(drive[0]), self.dac[1].tick(drive[1])];
+            if NOISY {
+                // Brownian force on each mode, after the DAC (it acts on the proof mass).
+                let (a, b) = self.noise.rng.normal_pair();
+                u[0] = S::from_x4(a).mul_add(self.noise.sigma_force[0], u[0]);
+                u[1] = S::from_x4(b).mul_add(self.noise.sigma_force[1], u[1]);
+            }
+            let mut p = if K == RATE_TABLE {
+                let (_, sin_t) = self.table_nco.tick(());
+                self.plant.tick_with_rate(u, self.rate * S::splat(sin_t))
+            } else if DECOUPLED {
+                self.plant.tick_decoupled(u)
+            } else {
+                self.plant.tick(u)
+            };
+            if NOISY {
+                // Amplifier noise, referred to the TIA input.
+                let (a, b) = self.noise.rng.normal_pair();
+                p.current[0] = S::from_x4(a).mul_add(self.noise.sigma_current[0], p.current[0]);
+                p.current[1] = S::from_x4(b).mul_add(self.noise.sigma_current[1], p.current[1]);
+            }
+            let mut y = [
+                self.tia[0].tick(p.current[0]),
+                self.tia[1].tick(p.current[1]),
+            ];
+            if NOISY {
+                if let Some(adc) = &self.adc {
+                    y = [adc[0].quantize(y[0]), adc[1].quantize(y[1])];
+                }
+            }
+            // Both stage-1 mixers see the same carrier: when their reference phases agree
+            // (always, as built) they share one set of carrier factors.
+            let carrier = Complex64::new(c_re, c_im);
+            let f0 = self.mix1[0].factors(carrier);
+            let f1 = if self.mix1_same_ref {
+                f0
+            } else {
+                self.mix1[1].factors(carrier)
+            };
+            let z = [Stage1Mixer::mix(y[0], f0), Stage1Mixer::mix(y[1], f1)];
+            if let Some(pr) = probe.as_deref_mut() {
+                pr.record_full(n0 + j, &u, &p, &y, &z);
+            }
+            let [i1, q1, i2, q2] = self.lp.tick([z[0].i, z[0].q, z[1].i, z[1].q]);
+            out = ([Iq::new(i1, q1), Iq::new(i2, q2)], [mod_cos, mod_sin]);
+            if let Some(pr) = probe.as_deref_mut() {
+                pr.check_lowpass(n0 + j, &out.0);
+            }
+        }
+        out
+    }
+}
+
+impl<S: Sample> Board<S> {
+    /// Replays the run from the board as built, checking every stage's output on every
+    /// sample up to block `k_bad` (where the decimated output stopped being finite), and
+    /// names the first stage and sample that went non-finite.
+    #[cold]
+    pub(crate) fn locate_fault(&self, k_bad: u64) -> NonFinite {
+        let m = self.decimation as u64;
+        let rate_dps = |lane: usize| self.rate.lane(lane).to_degrees();
+        let fallback = NonFinite {
+            stage: "lowpass",
+            sample: k_bad * m + m - 1,
+            time_s: (k_bad * m + m - 1) as f64 / self.fs_hz,
+            rate_dps: rate_dps(0),
+        };
+        let Some(pristine) = &self.pristine else {
+            return fallback;
+        };
+        let mut board = (**pristine).clone();
+        let mut probe = Probe::finite_check(self.lanes);
+        for k in 0..=k_bad {
+            board.replay_block(k * m, &mut probe);
+            if let Some((stage, sample, lane)) = probe.fault() {
+                return NonFinite {
+                    stage,
+                    sample,
+                    time_s: sample as f64 / self.fs_hz,
+                    rate_dps: rate_dps(lane),
+                };
+            }
+        }
+        fallback
+    }
+}
+
+/// A lane's averaged channels as the result of its experiment shape.
+pub(crate) fn lane_result<const K: u8>(v: &[f64; 8]) -> LaneResult {
+    let ph = |c: usize| Complex64::new(v[c], v[c + 1]);
+    match K {
+        CORIOLIS => LaneResult {
+            z: [ph(0), ph(2)],
+            ..Default::default()
+        },
+        RATE_TABLE => LaneResult {
+            table_phase: [ph(0), ph(2)],
+            ..Default::default()
+        },
+        _ => LaneResult {
+            c: [ph(0), ph(4)],
+            s: [ph(2), ph(6)],
+            ..Default::default()
+        },
+    }
+}

@@ -1,0 +1,23 @@
+//! The readout board of gyroemu, assembled from the stage crates and run sample by sample.
+//!
+//! It takes a plain, validated [`BoardParams`] (no file format: `gyroemu-config` maps its TOML
+//! onto it) and owns the sample loop: [`Board`] runs up to four operating points in `f64x4`
+//! lanes through one fused kernel (`kernel.rs`); [`reference::run_reference`] runs the same
+//! chain plainly, stage by stage, as its test oracle; [`ChainResponse`] answers the read-out's
+//! compensation from the very stages the board runs; [`Probe`] records signal dumps.
+
+mod board;
+mod chain;
+mod fault;
+mod kernel;
+mod params;
+mod point;
+mod probe;
+pub mod reference;
+
+pub use board::{Board, MAX_LANES};
+pub use chain::{ChainResponse, RotatingTerms};
+pub use fault::NonFinite;
+pub use params::{BoardParams, Converter, NoiseParams, Shape};
+pub use point::{LaneResult, Point, RunOptions, RunOutput};
+pub use probe::{Probe, DUMP_NODES};

@@ -1,0 +1,255 @@
+//! Windowed signal dumps of every node of the board, for one lane of one run. Recording
+//! happens inside the sample loop only for samples inside the window; memory is bounded by
+//! the window.
+
+use gyroemu_core::{Sample, Stage};
+use gyroemu_io::{IoError, SignalRecorder};
+use gyroemu_mixer::{Iq, Stage2Mixer};
+use gyroemu_resonator::PlantOutput;
+use std::path::Path;
+
+/// Which nodes to record, and the recorders for the full-rate and decimated nodes.
+pub struct Probe {
+    lane: usize,
+    nodes: [bool; 7],
+    full: SignalRecorder,
+    decimated: SignalRecorder,
+    full_window: (u64, u64),
+    /// Finite-check mode (locating a non-finite value): every lane of every node is checked
+    /// and the first fault kept as (stage, input sample, lane); nothing is recorded.
+    check_lanes: usize,
+    fault: Option<(&'static str, u64, usize)>,
+}
+
+/// The node names a dump accepts: full-rate `drive`, `displacement`, `velocity`, `tia`,
+/// `stage1`; decimated `lowpass`, `stage2`.
+pub const DUMP_NODES: [&str; 7] = [
+    "drive",
+    "displacement",
+    "velocity",
+    "tia",
+    "stage1",
+    "lowpass",
+    "stage2",
+];
+
+const FULL_NODES: [(&str, [&str; 4]); 5] = [
+    ("drive", ["drive1", "drive2", "", ""]),
+    ("displacement", ["q1_m", "q2_m", "", ""]),
+    ("velocity", ["v1_m_s", "v2_m_s", "", ""]),
+    ("tia", ["tia1_v", "tia2_v", "", ""]),
+    ("stage1", ["mix1_i1", "mix1_q1", "mix1_i2", "mix1_q2"]),
+];
+
+const DEC_NODES: [(&str, [&str; 8]); 2] = [
+    (
+        "lowpass",
+        [
+            "lp_i1", "lp_q1", "lp_i2", "lp_q2", "mod_cos", "mod_sin", "", "",
+        ],
+    ),
+    (
+        "stage2",
+        [
+            "c1_i", "c1_q", "s1_i", "s1_q", "c2_i", "c2_q", "s2_i", "s2_q",
+        ],
+    ),
+];
+
+impl Probe {
+    /// A probe of `lane` recording `nodes` over `[start_s, start_s + duration_s)`.
+    pub fn new(
+        nodes: &[String],
+        fs_hz: f64,
+        decimation: usize,
+        start_s: f64,
+        duration_s: f64,
+        lane: usize,
+    ) -> Self {
+        let mut on = [false; 7];
+        for (i, name) in DUMP_NODES.iter().enumerate() {
+            on[i] = nodes.iter().any(|n| n == name);
+        }
+        let names = |table: &[(&str, &[&str])], offset: usize| -> Vec<String> {
+            table
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| on[offset + i])
+                .flat_map(|(_, (_, chans))| {
+                    chans
+                        .iter()
+                        .filter(|c| !c.is_empty())
+                        .map(|c| c.to_string())
+                })
+                .collect()
+        };
+        let full_table: Vec<(&str, &[&str])> =
+            FULL_NODES.iter().map(|(n, c)| (*n, &c[..])).collect();
+        let dec_table: Vec<(&str, &[&str])> = DEC_NODES.iter().map(|(n, c)| (*n, &c[..])).collect();
+        let fs_out = fs_hz / decimation as f64;
+        let start = (start_s * fs_hz).round() as u64;
+        let len = (duration_s * fs_hz).round().max(1.0) as u64;
+        let start_out = (start_s * fs_out).round() as u64;
+        let len_out = (duration_s * fs_out).round().max(1.0) as u64;
+        Self {
+            lane,
+            nodes: on,
+            full: SignalRecorder::new(names(&full_table, 0), fs_hz, start, len),
+            full_window: (start, len),
+            // Decimated sample k is formed at input sample kM + M - 1.
+            decimated: SignalRecorder::new(names(&dec_table, 5), fs_out, start_out, len_out)
+                .with_time_origin((decimation - 1) as f64 / fs_hz),
+            check_lanes: 0,
+            fault: None,
+        }
+    }
+
+    /// A probe that records nothing and checks that every node of the first `lanes` lanes
+    /// stays finite (the replay that names the stage where a run overflowed).
+    pub fn finite_check(lanes: usize) -> Self {
+        Self {
+            lane: 0,
+            nodes: [false; 7],
+            full: SignalRecorder::new(Vec::new(), 1.0, 0, 0),
+            decimated: SignalRecorder::new(Vec::new(), 1.0, 0, 0),
+            full_window: (0, 0),
+            check_lanes: lanes,
+            fault: None,
+        }
+    }
+
+    /// The first non-finite node found in finite-check mode: (stage, input sample, lane).
+    pub fn fault(&self) -> Option<(&'static str, u64, usize)> {
+        self.fault
+    }
+
+    fn check<S: Sample>(&mut self, stage: &'static str, n: u64, values: &[S]) {
+        if self.fault.is_some() {
+            return;
+        }
+        for lane in 0..self.check_lanes {
+            if values.iter().any(|v| !v.lane(lane).is_finite()) {
+                self.fault = Some((stage, n, lane));
+                return;
+            }
+        }
+    }
+
+    /// Checks the low-pass outputs of input sample `n` (finite-check mode only).
+    #[inline]
+    pub fn check_lowpass<S: Sample>(&mut self, n: u64, z: &[Iq<S>; 2]) {
+        if self.check_lanes > 0 {
+            self.check("lowpass", n, &[z[0].i, z[0].q, z[1].i, z[1].q]);
+        }
+    }
+
+    /// Whether input samples `n0 .. n0 + m` touch the full-rate window.
+    #[inline]
+    pub fn wants_block(&self, n0: u64, m: u64) -> bool {
+        if self.check_lanes > 0 {
+            return true;
+        }
+        let (start, len) = self.full_window;
+        !self.full.names().is_empty() && n0 < start.saturating_add(len) && n0 + m > start
+    }
+
+    /// Records the full-rate nodes of input sample `n`.
+    #[inline]
+    pub fn record_full<S: Sample>(
+        &mut self,
+        n: u64,
+        u: &[S; 2],
+        p: &PlantOutput<S>,
+        y: &[S; 2],
+        z: &[Iq<S>; 2],
+    ) {
+        if self.check_lanes > 0 {
+            // Chain order, so the first stage that overflowed is the one named.
+            self.check("am/dac (drive)", n, u);
+            self.check("resonator", n, &[p.q[0], p.q[1], p.v[0], p.v[1]]);
+            self.check("resonator (motional current)", n, &p.current);
+            self.check("tia/adc", n, y);
+            self.check("mixer (stage 1)", n, &[z[0].i, z[0].q, z[1].i, z[1].q]);
+            return;
+        }
+        if self.full.names().is_empty() || !self.full.wants(n) {
+            return;
+        }
+        let l = self.lane;
+        let mut frame = [0.0f64; 12];
+        let mut k = 0;
+        let mut put = |v: &[f64]| {
+            frame[k..k + v.len()].copy_from_slice(v);
+            k += v.len();
+        };
+        if self.nodes[0] {
+            put(&[u[0].lane(l), u[1].lane(l)]);
+        }
+        if self.nodes[1] {
+            put(&[p.q[0].lane(l), p.q[1].lane(l)]);
+        }
+        if self.nodes[2] {
+            put(&[p.v[0].lane(l), p.v[1].lane(l)]);
+        }
+        if self.nodes[3] {
+            put(&[y[0].lane(l), y[1].lane(l)]);
+        }
+        if self.nodes[4] {
+            put(&[
+                z[0].i.lane(l),
+                z[0].q.lane(l),
+                z[1].i.lane(l),
+                z[1].q.lane(l),
+            ]);
+        }
+        self.full.record(n, &frame[..k]);
+    }
+
+    /// Records the decimated nodes of output sample `k`.
+    pub fn record_decimated<S: Sample>(
+        &mut self,
+        k: u64,
+        z: &[Iq<S>; 2],
+        r: &[S; 2],
+        rotating: bool,
+    ) {
+        if self.decimated.names().is_empty() || !self.decimated.wants(k) {
+            return;
+        }
+        let l = self.lane;
+        let mut frame = [0.0f64; 14];
+        let mut n = 0;
+        if self.nodes[5] {
+            for v in [z[0].i, z[0].q, z[1].i, z[1].q, r[0], r[1]] {
+                frame[n] = v.lane(l);
+                n += 1;
+            }
+        }
+        if self.nodes[6] {
+            let mut mix2 = Stage2Mixer::<S>::default();
+            for zm in z {
+                let o = if rotating {
+                    mix2.tick((*zm, *r))
+                } else {
+                    Default::default()
+                };
+                for v in [o.c.i, o.c.q, o.s.i, o.s.q] {
+                    frame[n] = v.lane(l);
+                    n += 1;
+                }
+            }
+        }
+        self.decimated.record(k, &frame[..n]);
+    }
+
+    /// Writes `<stem>_fullrate.{csv,wav}` and `<stem>_decimated.{csv,wav}` into `dir`.
+    pub fn write(&self, dir: &Path, stem: &str) -> Result<(), IoError> {
+        if !self.full.names().is_empty() {
+            self.full.write(dir, &format!("{stem}_fullrate"))?;
+        }
+        if !self.decimated.names().is_empty() {
+            self.decimated.write(dir, &format!("{stem}_decimated"))?;
+        }
+        Ok(())
+    }
+}

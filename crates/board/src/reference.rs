@@ -1,0 +1,152 @@
+//! The board written plainly, as the test oracle of the fused kernel (what a naive DFT is to an
+//! FFT): one operating point in `f64`, every stage called through its own `Stage::tick` on
+//! every sample, in chain order, with none of the kernel's shortcuts (no shared carrier
+//! factors, no decoupled plant step, no low-pass bank, no skipped shifter). Each shortcut is
+//! exact, so the fused board must give every lane these bits.
+
+use crate::board::{modulation_hz, noise_sigmas, pattern, plant_rate, shifter, table_nco};
+use crate::params::{build_adc, build_dac, build_tia, BoardParams, Shape};
+use crate::point::{LaneResult, Point};
+use gyroemu_am::{AmInput, AmModulator};
+use gyroemu_core::noise::{stream_seed, NoiseRng};
+use gyroemu_core::{detmath, Complex64, ParamResult, Sample, Stage};
+use gyroemu_lpf::{Averager, DecimateMode, Decimator};
+use gyroemu_mixer::{Iq, Stage1Mixer, Stage2Mixer};
+use gyroemu_nco::{Nco, RotatingNco};
+use gyroemu_resonator::Resonator;
+
+/// Runs one operating point (`rate_rad_s`, noise stream `stream`) for `n_settle` decimated
+/// samples of settling and then `point`'s averaging window; returns its averages.
+pub fn run_reference(
+    p: &BoardParams,
+    rate_rad_s: f64,
+    stream: u64,
+    n_settle: u64,
+    point: &Point,
+) -> ParamResult<LaneResult> {
+    p.validate()?;
+    let fs = p.fs_hz();
+    let m = p.decimation;
+    let mut carrier = RotatingNco::<f64>::new(&[Nco::new(p.carrier_hz, fs, 0.0)?]);
+    let mut shift = shifter(p)?;
+    let mut modulation =
+        RotatingNco::<f64>::new(&[Nco::new(modulation_hz(p.shape, rate_rad_s), fs, 0.0)?]);
+    let table = table_nco(p)?;
+    let table_f_hz = table.f_hz();
+    let mut table = RotatingNco::<f64>::new(&[table]);
+    let mut am = AmModulator::<f64>::new(pattern(p.shape), p.drive[0], p.drive[1])?;
+    let mut dac = [build_dac::<f64>(p)?, build_dac::<f64>(p)?];
+    let mut plant = Resonator::<f64>::new(&p.plant, plant_rate(p.shape, rate_rad_s))?;
+    let mut tia = [build_tia::<f64>(p)?, build_tia::<f64>(p)?];
+    let mut adc = build_adc::<f64>(p)?.map(|q| [q, q]);
+    let mut mix1 = [Stage1Mixer::<f64>::new(0.0)?, Stage1Mixer::<f64>::new(0.0)?];
+    let design = DecimateMode::Filter(p.lowpass);
+    let mut dec: [Decimator<f64>; 4] = [
+        Decimator::new(design, m, fs)?,
+        Decimator::new(design, m, fs)?,
+        Decimator::new(design, m, fs)?,
+        Decimator::new(design, m, fs)?,
+    ];
+    let mut mix2 = Stage2Mixer::<f64>::new();
+    let channels = if p.shape.is_rotating() { 8 } else { 4 };
+    let mut avg = Averager::<f64, 8>::new(&[point.window], channels)?;
+    let seed = p.noise.map_or(0, |n| n.seed);
+    let mut rng = NoiseRng::new([stream_seed(seed, stream); 4]);
+    let (sigma_force, sigma_current) = noise_sigmas(p);
+    let eps = p.phase_shifter_error_deg.to_radians();
+    let (ce, se) = (eps.cos(), eps.sin());
+    let n_out = n_settle + point.window.samples();
+    let mut prev_z = [Complex64::default(); 2];
+    let mut unwrapped = [0.0f64; 2];
+    for n in 0..n_out * m as u64 {
+        let (c_re, c_im) = carrier.tick(());
+        let cq = shift.tick(Complex64::new(c_re, c_im)).re;
+        let (mod_cos, mod_sin) = modulation.tick(());
+        let drive_sin = if p.shape.is_rotating() && eps != 0.0 {
+            mod_sin * ce - mod_cos * se
+        } else {
+            mod_sin
+        };
+        let drive = am.tick(AmInput {
+            carrier_i: c_re,
+            carrier_q: cq,
+            mod_cos,
+            mod_sin: drive_sin,
+        });
+        let mut u = [dac[0].tick(drive[0]), dac[1].tick(drive[1])];
+        if p.noise.is_some() {
+            let (a, b) = rng.normal_pair();
+            u[0] = Sample::mul_add(a.to_array()[0], sigma_force[0], u[0]);
+            u[1] = Sample::mul_add(b.to_array()[0], sigma_force[1], u[1]);
+        }
+        let (_, sin_t) = table.tick(());
+        let mut out = match p.shape {
+            Shape::RateTable { .. } => plant.tick_with_rate(u, rate_rad_s * sin_t),
+            _ => plant.tick(u),
+        };
+        if p.noise.is_some() {
+            let (a, b) = rng.normal_pair();
+            out.current[0] = Sample::mul_add(a.to_array()[0], sigma_current[0], out.current[0]);
+            out.current[1] = Sample::mul_add(b.to_array()[0], sigma_current[1], out.current[1]);
+        }
+        let mut y = [tia[0].tick(out.current[0]), tia[1].tick(out.current[1])];
+        if let Some(q) = &mut adc {
+            y = [q[0].tick(y[0]), q[1].tick(y[1])];
+        }
+        let carrier_phasor = Complex64::new(c_re, c_im);
+        let z = [
+            mix1[0].tick((y[0], carrier_phasor)),
+            mix1[1].tick((y[1], carrier_phasor)),
+        ];
+        let lp = [z[0].i, z[0].q, z[1].i, z[1].q];
+        let decimated: [Option<f64>; 4] = core::array::from_fn(|c| dec[c].tick(lp[c]));
+        let [Some(i1), Some(q1), Some(i2), Some(q2)] = decimated else {
+            continue;
+        };
+        let k = n / m as u64;
+        let zk = [Complex64::new(i1, q1), Complex64::new(i2, q2)];
+        if k < n_settle {
+            prev_z = zk;
+            continue;
+        }
+        let mut x = [0.0f64; 8];
+        match p.shape {
+            Shape::Coriolis => {
+                x[..4].copy_from_slice(&[i1, q1, i2, q2]);
+            }
+            Shape::RateTable { .. } => {
+                let (ts, tc) = detmath::sin_cos_turns(n as f64 * table_f_hz / fs);
+                for md in 0..2 {
+                    unwrapped[md] += (prev_z[md] * zk[md].conj()).arg();
+                    x[2 * md] = unwrapped[md] * (2.0 * tc);
+                    x[2 * md + 1] = unwrapped[md] * (-2.0 * ts);
+                }
+                prev_z = zk;
+            }
+            Shape::Rotating => {
+                for (md, zm) in zk.iter().enumerate() {
+                    let o = mix2.tick((Iq::new(zm.re, zm.im), [mod_cos, mod_sin]));
+                    x[4 * md..4 * md + 4].copy_from_slice(&[o.c.i, o.c.q, o.s.i, o.s.q]);
+                }
+            }
+        }
+        avg.push(&x);
+    }
+    let v = avg.mean(0);
+    let ph = |c: usize| Complex64::new(v[c], v[c + 1]);
+    Ok(match p.shape {
+        Shape::Coriolis => LaneResult {
+            z: [ph(0), ph(2)],
+            ..Default::default()
+        },
+        Shape::RateTable { .. } => LaneResult {
+            table_phase: [ph(0), ph(2)],
+            ..Default::default()
+        },
+        Shape::Rotating => LaneResult {
+            c: [ph(0), ph(4)],
+            s: [ph(2), ph(6)],
+            ..Default::default()
+        },
+    })
+}

@@ -1,0 +1,8 @@
+//! One file per subcommand; each reads its arguments, calls the library, prints.
+
+pub mod bench;
+pub mod config;
+pub mod merge;
+pub mod reproduce;
+pub mod run;
+pub mod selfcal;

@@ -1,0 +1,39 @@
+//! `gyroemu selfcal CONFIG --out DIR`.
+
+use crate::input::{list_written, load_config, BadInput};
+use crate::progress::Terminal;
+use anyhow::Result;
+use gyroemu_analysis::run_selfcal;
+use gyroemu_analysis::selfcal::validate_selfcal;
+use gyroemu_report::write_selfcal;
+use gyroemu_runs::prepare_out;
+use std::path::Path;
+
+/// The scale factor from the rotating excitation alone, checked against the virtual rate
+/// table on the same board, plus the analyses the config asks for.
+pub fn selfcal_command(config: &Path, out: &Path) -> Result<()> {
+    let cfg = load_config(config)?;
+    // load_config printed the config's own warnings; these are the derived sweeps' extra ones.
+    let warnings =
+        validate_selfcal(&cfg).map_err(|e| BadInput(format!("{}: {e}", config.display())))?;
+    for w in &warnings {
+        eprintln!("warning: {}: {w}", config.display());
+    }
+    prepare_out(out)?;
+    let report = run_selfcal(&cfg, &Terminal)?;
+    let files = write_selfcal(out, &cfg, &report)?;
+    let m = report.core.modes[0];
+    println!(
+        "self-calibration (mode 1): rotating slope {:.9} deg per deg/s x lambda {} = predicted Coriolis {:.9}; \
+         rate table measured {:.9}; relative error {:+.3e} +- {:.2e} (95 %), averaging {} s",
+        m.rotating.slope_deg_per_dps,
+        report.core.angular_gain,
+        m.predicted_deg_per_dps,
+        m.coriolis.slope_deg_per_dps,
+        m.relative_error,
+        m.relative_error_ci95,
+        cfg.experiment.average_s
+    );
+    list_written(out, &files);
+    Ok(())
+}

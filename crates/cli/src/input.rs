@@ -1,0 +1,46 @@
+//! The program's side of input and output: reading a config file, refusals (exit code 2), and
+//! printing to a stdout that a reader may close early.
+
+use anyhow::Result;
+use gyroemu_config::{parse_config, Config};
+use std::path::Path;
+
+/// A refusal of the user's input (exit code 2), as opposed to a failure while running.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct BadInput(pub String);
+
+/// Reads, parses and validates a config file; prints its warnings.
+pub fn load_config(path: &Path) -> Result<Config> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| BadInput(format!("cannot read config `{}`: {e}", path.display())))?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| BadInput(format!("config `{}` is not UTF-8 text", path.display())))?;
+    let cfg = parse_config(&text).map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    let warnings = cfg
+        .validate()
+        .map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    for w in warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
+    Ok(cfg)
+}
+
+/// Writes to stdout; a reader that closed the pipe early (`| head`) ends the output quietly.
+pub fn print_out(text: &str) -> Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
+}
+
+/// Lists the files a command wrote, one per line on stderr, relative to `out` where inside it.
+pub fn list_written(out: &Path, files: &[std::path::PathBuf]) {
+    eprintln!("wrote {} files in `{}`:", files.len(), out.display());
+    for f in files {
+        let shown = f.strip_prefix(out).unwrap_or(f);
+        eprintln!("  {}", shown.display());
+    }
+}

@@ -1,1 +1,0 @@
-//! The gyroemu command-line program

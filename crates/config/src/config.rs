@@ -1,0 +1,247 @@
+//! The experiment description read from TOML: units in every key, unknown keys rejected,
+//! documented defaults.
+
+use serde::{Deserialize, Serialize};
+
+/// A whole experiment: device, drive, board and sweep (plus optional signal dumps).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Config {
+    pub device: DeviceConfig,
+    pub drive: DriveConfig,
+    pub board: BoardConfig,
+    pub experiment: ExperimentConfig,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dump: Option<DumpConfig>,
+    /// Noise sources (absent: a noiseless board).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise: Option<NoiseConfig>,
+    /// The analyses of `gyroemu selfcal` (absent: only the two sweeps and their comparison).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub selfcal: Option<SelfcalConfig>,
+}
+
+/// The resonator (THEORY.md section 2).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeviceConfig {
+    /// Resonance of mode 1 (and of mode 2 unless offset), Hz.
+    pub f0_hz: f64,
+    /// Quality factor of mode 1 (and of mode 2 unless `q_mode2` is set).
+    pub q: f64,
+    /// Angular gain lambda.
+    pub angular_gain: f64,
+    /// Mode 2 resonance minus mode 1 resonance, Hz (frequency mismatch).
+    #[serde(default)]
+    pub mode2_f0_offset_hz: f64,
+    /// Quality factor of mode 2 (Q mismatch); defaults to `q`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub q_mode2: Option<f64>,
+    /// Quadrature (stiffness) coupling k12, (rad/s)^2.
+    #[serde(default)]
+    pub quadrature_coupling_rad2_s2: f64,
+    /// Motional current per unit velocity, A/(m/s).
+    #[serde(default = "default_transduction")]
+    pub transduction_a_s_per_m: f64,
+}
+
+/// Drive amplitudes (force per unit mass, m/s^2).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriveConfig {
+    /// Mode-1 drive amplitude F1 (F0 on mode 1 in the rotating run).
+    pub f1: f64,
+    /// Mode-2 drive amplitude F2, 90 degrees after mode 1 (F0 on mode 2 in the rotating run).
+    pub f2: f64,
+}
+
+/// The readout board.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoardConfig {
+    /// Emulation sample rate, Hz (at least 16 samples per carrier period is advised).
+    pub fs_hz: f64,
+    /// Transimpedance gain, ohm.
+    #[serde(default = "default_tia_gain")]
+    pub tia_gain_ohm: f64,
+    /// TIA pole, Hz (absent: no pole).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tia_pole_hz: Option<f64>,
+    /// Whether the TIA inverts.
+    #[serde(default = "default_true")]
+    pub tia_inverting: bool,
+    /// TIA output rails, volts (absent: no saturation).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tia_rail_v: Option<f64>,
+    /// Order of the stage-1 Butterworth low-pass (1 to 8).
+    #[serde(default = "default_lpf_order")]
+    pub lpf_order: usize,
+    /// Cutoff of the stage-1 low-pass, Hz.
+    pub lpf_cutoff_hz: f64,
+    /// Decimation factor after the stage-1 low-pass.
+    pub decimation: usize,
+    /// DAC resolution in bits (absent: ideal DAC).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dac_bits: Option<u32>,
+    /// DAC full scale (same unit as the drive amplitudes).
+    #[serde(default = "default_full_scale")]
+    pub dac_full_scale: f64,
+    /// Error of the board's 90-degree phase shifter, degrees.
+    #[serde(default)]
+    pub phase_shifter_error_deg: f64,
+    /// ADC resolution in bits after each TIA (absent: ideal ADC).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adc_bits: Option<u32>,
+    /// ADC full scale, V (the input range is -full scale to +full scale).
+    #[serde(default = "default_adc_full_scale")]
+    pub adc_full_scale_v: f64,
+}
+
+/// White, seeded noise sources (docs/user-guide.md gives the models).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoiseConfig {
+    /// Seed of the random streams; each operating point draws from its own stream, derived
+    /// from the seed and the point's index in `rates_dps`.
+    #[serde(default)]
+    pub seed: u64,
+    /// Resonator temperature, K (thermomechanical noise 4 k T m w0 / Q).
+    #[serde(default = "default_temperature")]
+    pub temperature_k: f64,
+    /// Effective modal mass, kg (absent: no thermomechanical noise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub effective_mass_kg: Option<f64>,
+    /// TIA input current noise density, A/sqrt(Hz).
+    #[serde(default)]
+    pub tia_current_noise_a_per_rthz: f64,
+    /// TIA output voltage noise density, V/sqrt(Hz) (within the TIA's own bandwidth).
+    #[serde(default)]
+    pub tia_voltage_noise_v_per_rthz: f64,
+}
+
+/// The analyses `gyroemu selfcal` adds to its two sweeps; each runs only when its key is set.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SelfcalConfig {
+    /// Length of the zero-rate Coriolis record whose Allan deviation is reported, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub allan_record_s: Option<f64>,
+    /// Longest averaging time of the self-calibration error against averaging time, s
+    /// (the rotating sweep then runs this long; the analysis starts at 1 s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tau_max_s: Option<f64>,
+    /// Temperature offsets of the drift scenario, K (empty: no drift scenario).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub drift_delta_t_k: Vec<f64>,
+    /// Temperature coefficient of f0, ppm/K (silicon: about -30).
+    #[serde(default = "default_f0_tc")]
+    pub f0_tc_ppm_per_k: f64,
+    /// Temperature coefficient of Q, ppm/K (thermoelastic damping: Q falls as T rises).
+    #[serde(default = "default_q_tc")]
+    pub q_tc_ppm_per_k: f64,
+}
+
+/// Which excitation the sweep uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ExperimentKind {
+    /// Drives 90 degrees apart, device rotating (Figs. 4 and 8).
+    Coriolis,
+    /// Device at rest, drive direction rotating at Omega (Figs. 5 and 9).
+    Rotating,
+}
+
+/// Shape of the rotation rate in a Coriolis run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RateTable {
+    /// Constant rate: the listed value.
+    Constant,
+    /// Omega_z(t) = rate * sin(2 pi table_freq_hz t): the listed value is the amplitude.
+    Sinusoid,
+}
+
+/// Averaging window.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum WindowKind {
+    /// Flat average over whole (half) modulation periods.
+    Boxcar,
+    /// Hann-weighted average (robust to a non-whole number of periods).
+    Hann,
+}
+
+/// The sweep.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExperimentConfig {
+    /// `coriolis` or `rotating`.
+    pub kind: ExperimentKind,
+    /// Rotation rates (Coriolis) or excitation rates Omega (rotating), deg/s.
+    pub rates_dps: Vec<f64>,
+    /// Time discarded before averaging, s (absent: 16 mechanical time constants plus the
+    /// low-pass settling).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settle_s: Option<f64>,
+    /// Averaging time, s.
+    pub average_s: f64,
+    /// Averaging window.
+    #[serde(default = "default_window")]
+    pub window: WindowKind,
+    /// Rate-table profile (Coriolis only).
+    #[serde(default = "default_rate_table")]
+    pub rate_table: RateTable,
+    /// Rate-table frequency for `rate_table = "sinusoid"`, Hz.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub table_freq_hz: Option<f64>,
+}
+
+/// A windowed dump of the board's internal signals for one operating point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DumpConfig {
+    /// Which operating point, deg/s (one of the emulated rates: `rates_dps`, plus 0 in a
+    /// constant-rate Coriolis run).
+    pub rate_dps: f64,
+    /// Start of the window, s from the start of the run.
+    pub start_s: f64,
+    /// Length of the window, s.
+    pub duration_s: f64,
+    /// Nodes to dump: any of `drive`, `displacement`, `velocity`, `tia`, `stage1`
+    /// (full rate), `lowpass`, `stage2` (decimated rate).
+    pub nodes: Vec<String>,
+}
+
+fn default_transduction() -> f64 {
+    1e-6
+}
+fn default_tia_gain() -> f64 {
+    1e6
+}
+fn default_true() -> bool {
+    true
+}
+fn default_lpf_order() -> usize {
+    4
+}
+fn default_full_scale() -> f64 {
+    1.0
+}
+fn default_window() -> WindowKind {
+    WindowKind::Boxcar
+}
+fn default_rate_table() -> RateTable {
+    RateTable::Constant
+}
+fn default_adc_full_scale() -> f64 {
+    1.0
+}
+fn default_temperature() -> f64 {
+    300.0
+}
+fn default_f0_tc() -> f64 {
+    -30.0
+}
+fn default_q_tc() -> f64 {
+    -3000.0
+}

@@ -1,0 +1,18 @@
+//! The experiment description of gyroemu: a TOML config with units in every key, unknown keys
+//! rejected and documented defaults; its parsing, its validation before any sample is
+//! computed (every error names the key, the value and the rule), the embedded presets, and
+//! what it implies ([`Config::board_params`], [`Config::plan_point`]).
+
+mod config;
+mod parse;
+mod plan;
+pub mod presets;
+mod validate;
+mod validate_noise;
+
+pub use config::{
+    BoardConfig, Config, DeviceConfig, DriveConfig, DumpConfig, ExperimentConfig, ExperimentKind,
+    NoiseConfig, RateTable, SelfcalConfig, WindowKind,
+};
+pub use parse::{parse_config, ConfigError};
+pub use validate::MAX_RUN_SAMPLES;

@@ -1,0 +1,163 @@
+//! What a config implies before anything runs: its experiment shape, the board it describes,
+//! the operating points it emulates and their settling and averaging windows.
+
+use crate::config::{Config, ExperimentKind, RateTable, WindowKind};
+use gyroemu_board::{BoardParams, Converter, NoiseParams, Point, Shape};
+use gyroemu_lpf::{LowPassDesign, Window};
+use gyroemu_resonator::{ModeParams, ResonatorParams};
+use gyroemu_theory::mechanical_tau_s;
+use gyroemu_tia::TiaParams;
+
+const DEG: f64 = core::f64::consts::PI / 180.0;
+
+impl Config {
+    /// The experiment's shape: the `kind` and `rate_table` keys read once (validation refuses
+    /// a rate table with the rotating excitation).
+    pub fn shape(&self) -> Shape {
+        let e = &self.experiment;
+        match (e.kind, e.rate_table) {
+            (ExperimentKind::Rotating, _) => Shape::Rotating,
+            (ExperimentKind::Coriolis, RateTable::Constant) => Shape::Coriolis,
+            (ExperimentKind::Coriolis, RateTable::Sinusoid) => Shape::RateTable {
+                freq_hz: e.table_freq_hz.unwrap_or(0.0),
+            },
+        }
+    }
+
+    /// Mode-2 resonance, Hz.
+    pub fn f0_mode2_hz(&self) -> f64 {
+        self.device.f0_hz + self.device.mode2_f0_offset_hz
+    }
+
+    /// Output rate of the low-pass decimator, Hz.
+    pub fn fs_out_hz(&self) -> f64 {
+        self.board.fs_hz / self.board.decimation as f64
+    }
+
+    /// The settling time used: the configured one, or 16 mechanical time constants (phase
+    /// error below 0.01 mdeg, THEORY.md section 7) plus 40 low-pass time constants.
+    pub fn settle_s(&self) -> f64 {
+        self.experiment.settle_s.unwrap_or_else(|| {
+            let q = self.device.q.max(self.device.q_mode2.unwrap_or(0.0));
+            16.0 * mechanical_tau_s(self.device.f0_hz, q)
+                + 40.0 / (2.0 * core::f64::consts::PI * self.board.lpf_cutoff_hz)
+        })
+    }
+
+    /// Settling in decimated samples (the whole output periods that cover `settle_s`).
+    pub fn n_settle_out(&self) -> u64 {
+        (self.settle_s() * self.fs_out_hz()).ceil() as u64
+    }
+
+    /// The plant parameters.
+    pub fn resonator_params(&self) -> ResonatorParams {
+        let d = &self.device;
+        ResonatorParams {
+            mode1: ModeParams {
+                f0_hz: d.f0_hz,
+                q: d.q,
+            },
+            mode2: ModeParams {
+                f0_hz: self.f0_mode2_hz(),
+                q: d.q_mode2.unwrap_or(d.q),
+            },
+            angular_gain: d.angular_gain,
+            quadrature_coupling_rad2_s2: d.quadrature_coupling_rad2_s2,
+            transduction_a_s_per_m: d.transduction_a_s_per_m,
+            fs_hz: self.board.fs_hz,
+        }
+    }
+
+    /// The stage-1 low-pass.
+    pub fn lowpass_design(&self) -> LowPassDesign {
+        LowPassDesign::Butterworth {
+            order: self.board.lpf_order,
+            cutoff_hz: self.board.lpf_cutoff_hz,
+        }
+    }
+
+    /// The board this config describes.
+    pub fn board_params(&self) -> BoardParams {
+        let b = &self.board;
+        BoardParams {
+            plant: self.resonator_params(),
+            carrier_hz: self.device.f0_hz,
+            drive: [self.drive.f1, self.drive.f2],
+            phase_shifter_error_deg: b.phase_shifter_error_deg,
+            dac: b.dac_bits.map(|bits| Converter {
+                bits,
+                full_scale: b.dac_full_scale,
+            }),
+            tia: TiaParams {
+                gain_ohm: b.tia_gain_ohm,
+                pole_hz: b.tia_pole_hz,
+                inverting: b.tia_inverting,
+                rail_v: b.tia_rail_v,
+                fs_hz: b.fs_hz,
+            },
+            adc: b.adc_bits.map(|bits| Converter {
+                bits,
+                full_scale: b.adc_full_scale_v,
+            }),
+            lowpass: self.lowpass_design(),
+            decimation: b.decimation,
+            noise: self.noise.as_ref().map(|n| NoiseParams {
+                seed: n.seed,
+                temperature_k: n.temperature_k,
+                effective_mass_kg: n.effective_mass_kg,
+                tia_current_noise_a_per_rthz: n.tia_current_noise_a_per_rthz,
+                tia_voltage_noise_v_per_rthz: n.tia_voltage_noise_v_per_rthz,
+            }),
+            shape: self.shape(),
+        }
+    }
+
+    /// The rates emulated: the listed ones, plus 0 for a constant-rate Coriolis run when it is
+    /// not listed (the reference the shifts are measured against).
+    pub fn emulated_rates_dps(&self) -> Vec<f64> {
+        let mut r = self.experiment.rates_dps.clone();
+        if self.shape() == Shape::Coriolis && !r.contains(&0.0) {
+            r.push(0.0);
+        }
+        r
+    }
+
+    /// The averaging window of a point, in decimated samples after settling: whole half
+    /// modulation periods (rotating) or whole table periods (rate table) with the fractional
+    /// end that makes the span exact, or a Hann window of the averaging time.
+    pub fn plan_point(&self, rate_dps: f64) -> Point {
+        let e = &self.experiment;
+        let fs_out = self.fs_out_hz();
+        let rate_rad_s = rate_dps * DEG;
+        if e.window == WindowKind::Hann {
+            return Point {
+                rate_rad_s,
+                window: Window::Hann {
+                    n: (e.average_s * fs_out).floor().max(1.0) as u64,
+                },
+            };
+        }
+        // The period whose whole multiples make the boxcar exact.
+        let period_s = match self.shape() {
+            Shape::Rotating if rate_dps != 0.0 => Some(180.0 / rate_dps.abs()),
+            Shape::RateTable { freq_hz } => Some(1.0 / freq_hz),
+            _ => None,
+        };
+        let span_s = match period_s {
+            Some(p) => (e.average_s / p).floor().max(1.0) * p,
+            None => e.average_s,
+        };
+        let x = span_s * fs_out;
+        Point {
+            rate_rad_s,
+            window: Window::Boxcar {
+                n: x.floor() as u64,
+                frac: if period_s.is_some() {
+                    x - x.floor()
+                } else {
+                    0.0
+                },
+            },
+        }
+    }
+}

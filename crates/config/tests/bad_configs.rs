@@ -1,0 +1,872 @@
+//! Malformed configs, each one edit away from a valid preset: parsing or validation refuses
+//! it with a message that names the key, shows the bad value, states the rule, and (for a
+//! TOML error) gives the line and column; the soft rules validate with a warning instead.
+
+use gyroemu_config::presets::preset_text;
+use gyroemu_config::{parse_config, ConfigError};
+
+const C: &str = "m2tfg-coriolis";
+const R: &str = "m2tfg-rotating";
+const T: &str = "m2tfg-ratetable";
+
+/// How the edited config must fail.
+#[derive(Debug)]
+enum Expect {
+    /// TOML/serde refuses it at this 1-based line.
+    ParseAt(usize),
+    /// TOML/serde refuses it where no single line is to blame (e.g. a missing table).
+    Parse,
+    /// It parses, `validate()` refuses it.
+    Invalid,
+    /// It parses and validates, with a warning.
+    Warning,
+}
+
+/// One edited config.
+struct Case {
+    what: &'static str,
+    text: String,
+    expect: Expect,
+    needles: Vec<&'static str>,
+}
+
+fn base(name: &str) -> String {
+    preset_text(name).unwrap().to_string()
+}
+
+/// The 0-based index of the header line `[section]` and the end of that section.
+fn section_range(lines: &[&str], section: &str) -> Option<(usize, usize)> {
+    let head = format!("[{section}]");
+    let start = lines
+        .iter()
+        .position(|l| l.trim_start().starts_with(&head))?;
+    let end = lines[start + 1..]
+        .iter()
+        .position(|l| l.trim_start().starts_with('['))
+        .map_or(lines.len(), |i| start + 1 + i);
+    Some((start, end))
+}
+
+fn key_of(line: &str) -> Option<&str> {
+    let l = line.trim_start();
+    if l.starts_with('#') {
+        return None;
+    }
+    l.split_once('=').map(|(k, _)| k.trim())
+}
+
+/// Sets `key = value` in `[section]` (replacing the key's line, or inserting it right after
+/// the header; a missing section is appended). Returns the text and the 1-based line.
+fn set(text: &str, section: &str, key: &str, value: &str) -> (String, usize) {
+    let mut lines: Vec<&str> = text.lines().collect();
+    let new = format!("{key} = {value}");
+    let Some((start, end)) = section_range(&lines, section) else {
+        let t = format!("{text}\n[{section}]\n{new}\n");
+        let n = t.lines().count();
+        return (t, n);
+    };
+    let at = match (start + 1..end).find(|&i| key_of(lines[i]) == Some(key)) {
+        Some(i) => {
+            lines[i] = &new;
+            i
+        }
+        None => {
+            lines.insert(start + 1, &new);
+            start + 1
+        }
+    };
+    (lines.join("\n") + "\n", at + 1)
+}
+
+/// Renames `key` in `[section]` (a misspelling); returns the text and the 1-based line.
+fn rename(text: &str, section: &str, key: &str, to: &str) -> (String, usize) {
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let refs: Vec<&str> = lines.iter().map(String::as_str).collect();
+    let (start, end) = section_range(&refs, section).expect("section");
+    let i = (start + 1..end)
+        .find(|&i| key_of(&lines[i]) == Some(key))
+        .expect("key");
+    lines[i] = lines[i].replacen(key, to, 1);
+    (lines.join("\n") + "\n", i + 1)
+}
+
+/// Removes `key` from `[section]`.
+fn remove(text: &str, section: &str, key: &str) -> String {
+    let lines: Vec<&str> = text.lines().collect();
+    let (start, end) = section_range(&lines, section).expect("section");
+    let i = (start + 1..end)
+        .find(|&i| key_of(lines[i]) == Some(key))
+        .expect("key");
+    let mut lines = lines;
+    lines.remove(i);
+    lines.join("\n") + "\n"
+}
+
+/// Removes the whole `[section]`.
+fn remove_section(text: &str, section: &str) -> String {
+    let lines: Vec<&str> = text.lines().collect();
+    let (start, end) = section_range(&lines, section).expect("section");
+    let mut lines = lines;
+    lines.drain(start..end);
+    lines.join("\n") + "\n"
+}
+
+/// A valid dump for the Coriolis preset (rate 100 deg/s is emulated).
+const DUMP: &str = "\n[dump]\nrate_dps = 100.0\nstart_s = 0.5\nduration_s = 0.002\nnodes = [\"tia\", \"stage2\"]\n";
+
+fn with(text: String, extra: &str) -> String {
+    text + extra
+}
+
+fn parse_case(what: &'static str, (text, line): (String, usize), needles: &[&'static str]) -> Case {
+    Case {
+        what,
+        text,
+        expect: Expect::ParseAt(line),
+        needles: needles.to_vec(),
+    }
+}
+
+fn case(what: &'static str, text: String, expect: Expect, needles: &[&'static str]) -> Case {
+    Case {
+        what,
+        text,
+        expect,
+        needles: needles.to_vec(),
+    }
+}
+
+fn invalid(what: &'static str, (text, _): (String, usize), needles: &[&'static str]) -> Case {
+    case(what, text, Expect::Invalid, needles)
+}
+
+fn cases() -> Vec<Case> {
+    use Expect::*;
+    let c = base(C);
+    let r = base(R);
+    let t = base(T);
+    let noise = with(
+        c.clone(),
+        "\n[noise]\ntemperature_k = 300.0\neffective_mass_kg = 1e-9\n",
+    );
+    let selfcal = with(
+        c.clone(),
+        "\n[selfcal]\ntau_max_s = 10.0\ndrift_delta_t_k = [10.0]\n",
+    );
+    let dumped = with(c.clone(), DUMP);
+    vec![
+        // Unknown or misspelt keys, in every section.
+        parse_case(
+            "misspelt device key",
+            rename(&c, "device", "f0_hz", "f0_hzz"),
+            &[
+                "device.f0_hzz",
+                "unknown field",
+                "expected one of",
+                "`f0_hz`",
+            ],
+        ),
+        parse_case(
+            "unknown drive key",
+            set(&c, "drive", "f3", "1.0"),
+            &["drive.f3", "unknown field", "expected `f1` or `f2`"],
+        ),
+        parse_case(
+            "misspelt board key",
+            rename(&c, "board", "decimation", "decimaton"),
+            &["board.decimaton", "unknown field", "`decimation`"],
+        ),
+        parse_case(
+            "unknown experiment key",
+            set(&c, "experiment", "average", "2.0"),
+            &["experiment.average", "unknown field", "`average_s`"],
+        ),
+        parse_case(
+            "misspelt noise key",
+            set(&noise, "noise", "temprature_k", "300.0"),
+            &["noise.temprature_k", "unknown field", "`temperature_k`"],
+        ),
+        parse_case(
+            "misspelt selfcal key",
+            set(&selfcal, "selfcal", "tau_max", "10.0"),
+            &["selfcal.tau_max", "unknown field", "`tau_max_s`"],
+        ),
+        parse_case(
+            "unknown dump key",
+            set(&dumped, "dump", "window_s", "1.0"),
+            &["dump.window_s", "unknown field", "`duration_s`"],
+        ),
+        parse_case(
+            "unknown section",
+            {
+                // Reported at the appended header, one line above its key.
+                let (t, line) = set(&c, "devices", "f0_hz", "1.0");
+                (t, line - 1)
+            },
+            &["devices", "unknown field", "`device`"],
+        ),
+        // Wrong types.
+        parse_case(
+            "string for a number",
+            set(&c, "device", "q", "\"high\""),
+            &["device.q", "\"high\"", "expected f64"],
+        ),
+        parse_case(
+            "float for an integer",
+            set(&c, "board", "decimation", "100.5"),
+            &["board.decimation", "100.5", "usize"],
+        ),
+        parse_case(
+            "negative for usize",
+            set(&c, "board", "lpf_order", "-4"),
+            &["board.lpf_order", "-4", "usize"],
+        ),
+        parse_case(
+            "negative seed",
+            set(&noise, "noise", "seed", "-1"),
+            &["noise.seed", "-1", "u64"],
+        ),
+        parse_case(
+            "integer for a bool",
+            set(&c, "board", "tia_inverting", "1"),
+            &["board.tia_inverting", "1", "bool"],
+        ),
+        parse_case(
+            "number for a list",
+            set(&c, "experiment", "rates_dps", "25.0"),
+            &["experiment.rates_dps", "25", "sequence"],
+        ),
+        parse_case(
+            "string in the rate list",
+            set(&c, "experiment", "rates_dps", "[25.0, \"x\"]"),
+            &["experiment.rates_dps", "\"x\"", "f64"],
+        ),
+        parse_case(
+            "unknown kind",
+            set(&c, "experiment", "kind", "\"spinning\""),
+            &["experiment.kind", "spinning", "`coriolis`", "`rotating`"],
+        ),
+        parse_case(
+            "unknown rate table",
+            set(&c, "experiment", "rate_table", "\"triangle\""),
+            &[
+                "experiment.rate_table",
+                "triangle",
+                "`constant`",
+                "`sinusoid`",
+            ],
+        ),
+        parse_case(
+            "unknown window",
+            set(&c, "experiment", "window", "\"flat\""),
+            &["experiment.window", "flat", "`boxcar`", "`hann`"],
+        ),
+        parse_case(
+            "negative dac_bits",
+            set(&c, "board", "dac_bits", "-1"),
+            &["board.dac_bits", "-1", "u32"],
+        ),
+        parse_case(
+            "float adc_bits",
+            set(&c, "board", "adc_bits", "16.0"),
+            &["board.adc_bits", "16", "u32"],
+        ),
+        parse_case(
+            "TOML syntax: no value",
+            set(&c, "device", "q", ""),
+            &["device.q"],
+        ),
+        // Missing required keys and tables.
+        case(
+            "missing f0_hz",
+            remove(&c, "device", "f0_hz"),
+            Parse,
+            &["device.f0_hz", "missing field `f0_hz`"],
+        ),
+        case(
+            "missing decimation",
+            remove(&c, "board", "decimation"),
+            Parse,
+            &["board.decimation", "missing field `decimation`"],
+        ),
+        case(
+            "missing rates",
+            remove(&c, "experiment", "rates_dps"),
+            Parse,
+            &["experiment.rates_dps", "missing field `rates_dps`"],
+        ),
+        case(
+            "missing [drive]",
+            remove_section(&c, "drive"),
+            Parse,
+            &["drive", "missing field `drive`"],
+        ),
+        case(
+            "dump without nodes",
+            remove(&dumped, "dump", "nodes"),
+            Parse,
+            &["dump.nodes", "missing field `nodes`"],
+        ),
+        case(
+            "only a comment",
+            "# nothing here\n".into(),
+            Parse,
+            &["missing field `device`"],
+        ),
+        case("empty file", String::new(), Invalid, &["empty"]),
+        case("blank file", " \n\t\n".into(), Invalid, &["empty"]),
+        // nan, inf and -inf (TOML accepts them).
+        invalid(
+            "f0 nan",
+            set(&c, "device", "f0_hz", "nan"),
+            &["device.f0_hz", "NaN", "finite number > 0"],
+        ),
+        invalid(
+            "q inf",
+            set(&c, "device", "q", "inf"),
+            &["device.q", "inf", "finite number > 0"],
+        ),
+        invalid(
+            "lambda -inf",
+            set(&c, "device", "angular_gain", "-inf"),
+            &["device.angular_gain", "-inf", "finite number > 0"],
+        ),
+        invalid(
+            "mismatch nan",
+            set(&c, "device", "mode2_f0_offset_hz", "nan"),
+            &["device.mode2_f0_offset_hz", "NaN", "finite"],
+        ),
+        invalid(
+            "k12 inf",
+            set(&c, "device", "quadrature_coupling_rad2_s2", "inf"),
+            &["device.quadrature_coupling_rad2_s2", "inf", "finite"],
+        ),
+        invalid(
+            "rate nan",
+            set(&c, "experiment", "rates_dps", "[25.0, nan]"),
+            &["experiment.rates_dps[1]", "NaN", "finite"],
+        ),
+        invalid(
+            "phase shifter nan",
+            set(&c, "board", "phase_shifter_error_deg", "nan"),
+            &["board.phase_shifter_error_deg", "NaN", "(-90, 90)"],
+        ),
+        invalid(
+            "average inf",
+            set(&c, "experiment", "average_s", "inf"),
+            &["experiment.average_s", "inf", "finite number > 0"],
+        ),
+        // Zero or negative where meaningless.
+        invalid(
+            "f0 zero",
+            set(&c, "device", "f0_hz", "0.0"),
+            &["device.f0_hz", "= 0", "> 0"],
+        ),
+        invalid(
+            "Q zero",
+            set(&c, "device", "q", "0.0"),
+            &["device.q", "= 0", "> 0"],
+        ),
+        invalid(
+            "Q negative",
+            set(&c, "device", "q", "-5.0"),
+            &["device.q", "-5", "> 0"],
+        ),
+        invalid(
+            "q_mode2 zero",
+            set(&c, "device", "q_mode2", "0.0"),
+            &["device.q_mode2", "= 0", "> 0"],
+        ),
+        invalid(
+            "lambda zero",
+            set(&c, "device", "angular_gain", "0.0"),
+            &["device.angular_gain", "= 0", "> 0"],
+        ),
+        invalid(
+            "mode 2 below 0 Hz",
+            set(&c, "device", "mode2_f0_offset_hz", "-15000.0"),
+            &["device.mode2_f0_offset_hz", "-15000", "> 0"],
+        ),
+        invalid(
+            "transduction zero",
+            set(&c, "device", "transduction_a_s_per_m", "0.0"),
+            &["device.transduction_a_s_per_m", "= 0", "> 0"],
+        ),
+        invalid(
+            "F1 zero",
+            set(&c, "drive", "f1", "0.0"),
+            &["drive.f1", "= 0", "> 0"],
+        ),
+        invalid(
+            "F2 negative",
+            set(&c, "drive", "f2", "-1.0"),
+            &["drive.f2", "-1", "> 0"],
+        ),
+        invalid(
+            "fs negative",
+            set(&c, "board", "fs_hz", "-240000.0"),
+            &["board.fs_hz", "-240000", "> 0"],
+        ),
+        invalid(
+            "TIA gain zero",
+            set(&c, "board", "tia_gain_ohm", "0.0"),
+            &["board.tia_gain_ohm", "= 0", "> 0"],
+        ),
+        invalid(
+            "TIA rail zero",
+            set(&c, "board", "tia_rail_v", "0.0"),
+            &["board.tia_rail_v", "= 0", "> 0"],
+        ),
+        invalid(
+            "DAC full scale zero",
+            set(&c, "board", "dac_full_scale", "0.0"),
+            &["board.dac_full_scale", "= 0", "> 0"],
+        ),
+        invalid(
+            "ADC full scale negative",
+            set(&c, "board", "adc_full_scale_v", "-1.0"),
+            &["board.adc_full_scale_v", "-1", "> 0"],
+        ),
+        invalid(
+            "temperature zero",
+            set(&noise, "noise", "temperature_k", "0.0"),
+            &["noise.temperature_k", "= 0", "> 0"],
+        ),
+        invalid(
+            "mass negative",
+            set(&noise, "noise", "effective_mass_kg", "-1e-9"),
+            &["noise.effective_mass_kg", "-1e-9", "> 0"],
+        ),
+        // Sample rate against f0.
+        invalid(
+            "fs = 2 f0",
+            set(&c, "board", "fs_hz", "30000.0"),
+            &["board.fs_hz", "30000", "above 2*f0 = 30000 Hz"],
+        ),
+        invalid(
+            "fs below 2 f0 of mode 2",
+            set(&c, "device", "mode2_f0_offset_hz", "200000.0"),
+            &["board.fs_hz", "240000", "above 2*f0 = 430000 Hz"],
+        ),
+        case(
+            "fs below 8 f0 warns",
+            set(
+                &set(&c, "board", "fs_hz", "100000.0").0,
+                "board",
+                "tia_pole_hz",
+                "40000.0",
+            )
+            .0,
+            Warning,
+            &["board.fs_hz", "100000", "below 8*f0 = 120000 Hz"],
+        ),
+        // Orders, factors and cutoffs.
+        invalid(
+            "decimation 0",
+            set(&c, "board", "decimation", "0"),
+            &["board.decimation", "= 0", "integer >= 1"],
+        ),
+        invalid(
+            "lpf_order 0",
+            set(&c, "board", "lpf_order", "0"),
+            &["board.lpf_order", "= 0", "1 to 8"],
+        ),
+        invalid(
+            "lpf_order 9",
+            set(&c, "board", "lpf_order", "9"),
+            &["board.lpf_order", "= 9", "1 to 8"],
+        ),
+        invalid(
+            "TIA pole at Nyquist",
+            set(&c, "board", "tia_pole_hz", "120000.0"),
+            &[
+                "board.tia_pole_hz",
+                "120000",
+                "below Nyquist (fs_hz/2 = 120000 Hz)",
+            ],
+        ),
+        invalid(
+            "TIA pole above Nyquist",
+            set(&c, "board", "tia_pole_hz", "200000.0"),
+            &[
+                "board.tia_pole_hz",
+                "200000",
+                "below Nyquist (fs_hz/2 = 120000 Hz)",
+            ],
+        ),
+        invalid(
+            "TIA pole zero",
+            set(&c, "board", "tia_pole_hz", "0.0"),
+            &["board.tia_pole_hz", "= 0", "> 0"],
+        ),
+        invalid(
+            "cutoff at output Nyquist",
+            set(&c, "board", "lpf_cutoff_hz", "1200.0"),
+            &[
+                "board.lpf_cutoff_hz",
+                "1200",
+                "fs_hz/decimation/2 = 1200 Hz",
+            ],
+        ),
+        invalid(
+            "cutoff zero",
+            set(&c, "board", "lpf_cutoff_hz", "0.0"),
+            &["board.lpf_cutoff_hz", "= 0", "> 0"],
+        ),
+        invalid(
+            "cutoff above f0",
+            set(
+                &set(&c, "board", "decimation", "1").0,
+                "board",
+                "lpf_cutoff_hz",
+                "20000.0",
+            ),
+            &["board.lpf_cutoff_hz", "20000", "below f0_hz"],
+        ),
+        invalid(
+            "cutoff f64 cannot realise",
+            set(&c, "board", "lpf_cutoff_hz", "1e-7"),
+            &[
+                "board.lpf_cutoff_hz",
+                "1e-7",
+                "cannot be built",
+                "unit circle",
+            ],
+        ),
+        // Averaging and settling.
+        invalid(
+            "average below one output period",
+            set(&c, "experiment", "average_s", "0.0001"),
+            &[
+                "experiment.average_s",
+                "0.0001",
+                "one output sample period (0.0004166",
+            ],
+        ),
+        invalid(
+            "average zero",
+            set(&c, "experiment", "average_s", "0.0"),
+            &["experiment.average_s", "= 0", "> 0"],
+        ),
+        invalid(
+            "average below half a modulation period",
+            set(&r, "experiment", "average_s", "3.0"),
+            &[
+                "experiment.average_s",
+                "= 3",
+                "half a modulation period",
+                "25 deg/s: 7.2 s",
+            ],
+        ),
+        invalid(
+            "run longer than 2^53 samples",
+            set(&c, "experiment", "average_s", "1e12"),
+            &["experiment.average_s", "1000000000000", "2^53"],
+        ),
+        invalid(
+            "settle negative",
+            set(&c, "experiment", "settle_s", "-1.0"),
+            &["experiment.settle_s", "-1", ">= 0"],
+        ),
+        case(
+            "settle below the mechanical time constants warns",
+            set(&c, "experiment", "settle_s", "0.01").0,
+            Warning,
+            &[
+                "experiment.settle_s",
+                "0.01",
+                "10.6 mechanical time constants",
+            ],
+        ),
+        case(
+            "hann over few modulation periods warns",
+            set(
+                &set(&r, "experiment", "window", "\"hann\"").0,
+                "experiment",
+                "average_s",
+                "20.0",
+            )
+            .0,
+            Warning,
+            &["experiment.window", "hann", "10 periods"],
+        ),
+        invalid(
+            "rotating rate above the cutoff",
+            set(&r, "experiment", "rates_dps", "[25.0, 1e5]"),
+            &[
+                "experiment.rates_dps[1]",
+                "100000",
+                "below board.lpf_cutoff_hz = 200 Hz",
+            ],
+        ),
+        // Rates and the rate table.
+        invalid(
+            "rates empty",
+            set(&c, "experiment", "rates_dps", "[]"),
+            &["experiment.rates_dps", "[]", "at least one rate"],
+        ),
+        invalid(
+            "sinusoid without table_freq_hz",
+            (remove(&t, "experiment", "table_freq_hz"), 0),
+            &["experiment.table_freq_hz", "(missing)", "required"],
+        ),
+        invalid(
+            "table_freq_hz with a constant table",
+            set(&c, "experiment", "table_freq_hz", "2.0"),
+            &["experiment.table_freq_hz", "= 2", "only applies"],
+        ),
+        invalid(
+            "rate table in a rotating run",
+            set(&r, "experiment", "rate_table", "\"sinusoid\""),
+            &["experiment.rate_table", "sinusoid", "coriolis"],
+        ),
+        invalid(
+            "table frequency above the cutoff",
+            set(&t, "experiment", "table_freq_hz", "300.0"),
+            &[
+                "experiment.table_freq_hz",
+                "300",
+                "below board.lpf_cutoff_hz = 200 Hz",
+            ],
+        ),
+        invalid(
+            "table frequency zero",
+            set(&t, "experiment", "table_freq_hz", "0.0"),
+            &["experiment.table_freq_hz", "= 0", "> 0"],
+        ),
+        invalid(
+            "average below a table period",
+            set(&t, "experiment", "average_s", "0.3"),
+            &[
+                "experiment.average_s",
+                "0.3",
+                "one rate-table period (0.5 s)",
+            ],
+        ),
+        // Converter resolutions.
+        invalid(
+            "dac_bits 1",
+            set(&c, "board", "dac_bits", "1"),
+            &["board.dac_bits", "= 1", "2 to 32"],
+        ),
+        invalid(
+            "dac_bits 33",
+            set(&c, "board", "dac_bits", "33"),
+            &["board.dac_bits", "= 33", "2 to 32"],
+        ),
+        invalid(
+            "adc_bits 0",
+            set(&c, "board", "adc_bits", "0"),
+            &["board.adc_bits", "= 0", "2 to 32"],
+        ),
+        invalid(
+            "adc_bits 64",
+            set(&c, "board", "adc_bits", "64"),
+            &["board.adc_bits", "= 64", "2 to 32"],
+        ),
+        // Noise densities.
+        invalid(
+            "current noise negative",
+            set(&noise, "noise", "tia_current_noise_a_per_rthz", "-1e-12"),
+            &["noise.tia_current_noise_a_per_rthz", "-1e-12", ">= 0"],
+        ),
+        invalid(
+            "voltage noise nan",
+            set(&noise, "noise", "tia_voltage_noise_v_per_rthz", "nan"),
+            &["noise.tia_voltage_noise_v_per_rthz", "NaN", ">= 0"],
+        ),
+        case(
+            "noise section with no source warns",
+            with(c.clone(), "\n[noise]\nseed = 3\n"),
+            Warning,
+            &["[noise]", "noiseless"],
+        ),
+        // Self-calibration keys.
+        invalid(
+            "allan record too short",
+            set(&selfcal, "selfcal", "allan_record_s", "5.0"),
+            &["selfcal.allan_record_s", "= 5", "from 10 s"],
+        ),
+        invalid(
+            "tau_max below 2 s",
+            set(&selfcal, "selfcal", "tau_max_s", "1.0"),
+            &["selfcal.tau_max_s", "= 1", "from 2 s"],
+        ),
+        invalid(
+            "drift offset out of range",
+            set(&selfcal, "selfcal", "drift_delta_t_k", "[10.0, 500.0]"),
+            &["selfcal.drift_delta_t_k[1]", "500", "-200..200 K"],
+        ),
+        invalid(
+            "f0 coefficient out of range",
+            set(&selfcal, "selfcal", "f0_tc_ppm_per_k", "2e4"),
+            &["selfcal.f0_tc_ppm_per_k", "20000", "-1e4..1e4"],
+        ),
+        invalid(
+            "Q coefficient nan",
+            set(&selfcal, "selfcal", "q_tc_ppm_per_k", "nan"),
+            &["selfcal.q_tc_ppm_per_k", "NaN", "-1e5..1e5"],
+        ),
+        invalid(
+            "Q coefficient drives Q negative",
+            set(
+                &set(&selfcal, "selfcal", "q_tc_ppm_per_k", "-9e4").0,
+                "selfcal",
+                "drift_delta_t_k",
+                "[20.0]",
+            ),
+            &["selfcal.drift_delta_t_k[0]", "20", "keep Q and f0 > 0"],
+        ),
+        // Dumps.
+        invalid(
+            "dump longer than the run",
+            set(&dumped, "dump", "duration_s", "100.0"),
+            &["dump.duration_s", "100", "within that point's run"],
+        ),
+        invalid(
+            "dump node unknown",
+            set(&dumped, "dump", "nodes", "[\"tia\", \"foo\"]"),
+            &["dump.nodes[1]", "\"foo\"", "must be one of", "\"stage2\""],
+        ),
+        invalid(
+            "dump nodes empty",
+            set(&dumped, "dump", "nodes", "[]"),
+            &["dump.nodes", "[]", "at least one node"],
+        ),
+        invalid(
+            "dump rate not emulated",
+            set(&dumped, "dump", "rate_dps", "33.0"),
+            &["dump.rate_dps", "33", "one of the emulated rates"],
+        ),
+        invalid(
+            "dump start negative",
+            set(&dumped, "dump", "start_s", "-1.0"),
+            &["dump.start_s", "-1", ">= 0"],
+        ),
+        invalid(
+            "dump of a huge settle",
+            set(
+                &set(&dumped, "experiment", "settle_s", "1e300").0,
+                "dump",
+                "duration_s",
+                "1e299",
+            ),
+            &["experiment.settle_s", "1e300", "2^53"],
+        ),
+    ]
+}
+
+fn check_needles(what: &str, msg: &str, needles: &[&str]) -> Result<(), String> {
+    match needles.iter().find(|n| !msg.contains(*n)) {
+        Some(n) => Err(format!("{what}: `{n}` missing from: {msg}")),
+        None => Ok(()),
+    }
+}
+
+/// Checks one case; `Err` says what is wrong with its message.
+fn check_case(case: &Case) -> Result<(), String> {
+    let Case {
+        what,
+        text,
+        expect,
+        needles,
+    } = case;
+    match expect {
+        Expect::ParseAt(_) | Expect::Parse => {
+            let e: ConfigError = parse_config(text)
+                .err()
+                .ok_or_else(|| format!("{what}: parsed"))?;
+            let msg = e.to_string();
+            let loc = e.location.as_deref().unwrap_or("");
+            if !(loc.starts_with("line ") && loc.contains(", column ")) {
+                return Err(format!("{what}: no line and column: {msg}"));
+            }
+            if let Expect::ParseAt(line) = expect {
+                if !loc.starts_with(&format!("line {line}, ")) {
+                    return Err(format!("{what}: expected line {line}: {msg}"));
+                }
+            }
+            eprintln!("{what}: {msg}");
+            if e.key.is_none() {
+                return Err(format!("{what}: no key in {msg}"));
+            }
+            check_needles(what, &msg, needles)
+        }
+        Expect::Invalid => {
+            let e = match parse_config(text) {
+                Err(e) => e,
+                Ok(cfg) => cfg
+                    .validate()
+                    .err()
+                    .ok_or_else(|| format!("{what}: validated"))?,
+            };
+            eprintln!("{what}: {e}");
+            check_needles(what, &e.to_string(), needles)
+        }
+        Expect::Warning => {
+            let cfg = parse_config(text).map_err(|e| format!("{what}: {e}"))?;
+            let w = cfg
+                .validate()
+                .map_err(|e| format!("{what}: refused: {e}"))?;
+            eprintln!("{what}: {w:?}");
+            if w.iter().any(|w| needles.iter().all(|n| w.contains(n))) {
+                Ok(())
+            } else {
+                Err(format!("{what}: no warning with {needles:?} in: {w:?}"))
+            }
+        }
+    }
+}
+
+#[test]
+fn every_malformed_config_is_refused_with_key_value_and_rule() {
+    let cases = cases();
+    assert!(cases.len() >= 40, "{}", cases.len());
+    let parse = cases
+        .iter()
+        .filter(|c| matches!(c.expect, Expect::ParseAt(_) | Expect::Parse))
+        .count();
+    assert!(parse >= 20, "{parse}");
+    let failures: Vec<String> = cases.iter().filter_map(|c| check_case(c).err()).collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn validation_errors_have_the_key_value_rule_form() {
+    // `key `a.b` = value: rule` for every validate() refusal.
+    for Case {
+        what, text, expect, ..
+    } in cases()
+    {
+        if let Expect::Invalid = expect {
+            if let Ok(cfg) = parse_config(&text) {
+                let e = cfg.validate().unwrap_err();
+                let key = e.key.as_deref().unwrap_or_else(|| panic!("{what}: no key"));
+                let msg = e.to_string();
+                assert!(
+                    msg.contains(&format!("key `{key}` = ")) && e.detail.contains(": "),
+                    "{what}: {msg}"
+                );
+                assert!(e.location.is_none(), "{what}");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_unedited_presets_and_the_edit_helpers_are_sound() {
+    for name in [C, R, T] {
+        let c = parse_config(&base(name)).unwrap();
+        assert!(c.validate().is_ok(), "{name}");
+        // Setting a key to its own value changes nothing.
+        let (text, line) = set(&base(name), "device", "f0_hz", "15000.0");
+        assert_eq!(parse_config(&text).unwrap(), c, "{name}");
+        assert!(base(name)
+            .lines()
+            .nth(line - 1)
+            .unwrap()
+            .starts_with("f0_hz"));
+    }
+    let dumped = parse_config(&with(base(C), DUMP)).unwrap();
+    assert!(dumped.validate().is_ok());
+}

@@ -1,0 +1,198 @@
+//! Property test over valid configs: serialising to TOML and parsing back gives the same
+//! config, it validates, and 1e4 input samples of the board run without a panic and give
+//! finite averages.
+
+use gyroemu_board::{Board, Point, RunOptions};
+use gyroemu_config::presets::preset;
+use gyroemu_config::{
+    parse_config, Config, ExperimentKind, NoiseConfig, RateTable, SelfcalConfig, WindowKind,
+};
+use gyroemu_lpf::Window;
+use proptest::prelude::*;
+
+/// Device and drive draws: f0, Q, lambda, mismatch (fraction of f0), Q of mode 2, k12
+/// (fraction of w0^2), F1, F2.
+type DeviceDraw = (f64, f64, f64, f64, Option<f64>, f64, f64, f64);
+/// Board draws: fs/f0, decimation, cutoff (fraction of its limit), order, TIA pole (fraction
+/// of Nyquist), TIA gain, inverting, DAC bits, ADC bits, phase-shifter error.
+type BoardDraw = (
+    f64,
+    usize,
+    f64,
+    usize,
+    Option<f64>,
+    f64,
+    bool,
+    Option<u32>,
+    Option<u32>,
+    f64,
+);
+/// Experiment draws: kind (0 Coriolis, 1 rate table, 2 rotating), rates (fractions of their
+/// limit, signed), average multiple, hann, settle_s, noise, selfcal.
+type ExperimentDraw = (u8, Vec<f64>, f64, bool, Option<f64>, bool, bool);
+
+fn device() -> impl Strategy<Value = DeviceDraw> {
+    (
+        1.0e3f64..1.0e5,
+        10.0f64..5000.0,
+        0.1f64..1.5,
+        -0.01f64..0.01,
+        proptest::option::of(10.0f64..5000.0),
+        -1e-4f64..1e-4,
+        0.1f64..10.0,
+        0.1f64..10.0,
+    )
+}
+
+fn board() -> impl Strategy<Value = BoardDraw> {
+    (
+        8.0f64..40.0,
+        1usize..200,
+        0.05f64..0.9,
+        1usize..=8,
+        proptest::option::of(0.1f64..0.95),
+        1e3f64..1e7,
+        any::<bool>(),
+        proptest::option::of(2u32..=32),
+        proptest::option::of(2u32..=32),
+        -10.0f64..10.0,
+    )
+}
+
+fn experiment() -> impl Strategy<Value = ExperimentDraw> {
+    (
+        0u8..3,
+        proptest::collection::vec(prop_oneof![-0.9f64..-0.05, 0.05f64..0.9], 1..5),
+        1.0f64..3.0,
+        any::<bool>(),
+        proptest::option::of(0.0f64..2.0),
+        any::<bool>(),
+        any::<bool>(),
+    )
+}
+
+/// A valid config built from the draws, starting from the Coriolis preset.
+fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
+    let mut c = preset("m2tfg-coriolis").unwrap();
+    let (f0, q, lambda, mismatch, q2, k12, f1, f2) = d;
+    c.device.f0_hz = f0;
+    c.device.q = q;
+    c.device.angular_gain = lambda;
+    c.device.mode2_f0_offset_hz = mismatch * f0;
+    c.device.q_mode2 = q2;
+    let w0 = std::f64::consts::TAU * f0;
+    c.device.quadrature_coupling_rad2_s2 = k12 * w0 * w0;
+    c.drive.f1 = f1;
+    c.drive.f2 = f2;
+
+    let (fs_mult, dec, cut, order, pole, gain, inverting, dac, adc, shift) = b;
+    let f_max = f0.max(c.f0_mode2_hz());
+    c.board.fs_hz = fs_mult * f_max;
+    c.board.decimation = dec;
+    let nyq_out = 0.5 * c.board.fs_hz / dec as f64;
+    c.board.lpf_cutoff_hz = cut * nyq_out.min(f0);
+    c.board.lpf_order = order;
+    c.board.tia_pole_hz = pole.map(|p| p * 0.5 * c.board.fs_hz);
+    c.board.tia_gain_ohm = gain;
+    c.board.tia_inverting = inverting;
+    c.board.dac_bits = dac;
+    c.board.dac_full_scale = 1.5 * f1.max(f2);
+    c.board.adc_bits = adc;
+    c.board.phase_shifter_error_deg = shift;
+
+    let (kind, rates, avg_mult, hann, settle, noise, selfcal) = e;
+    let cutoff = c.board.lpf_cutoff_hz;
+    let x = &mut c.experiment;
+    x.window = if hann {
+        WindowKind::Hann
+    } else {
+        WindowKind::Boxcar
+    };
+    x.settle_s = settle;
+    let out_period = dec as f64 / c.board.fs_hz;
+    match kind {
+        0 => {
+            x.kind = ExperimentKind::Coriolis;
+            x.rate_table = RateTable::Constant;
+            x.table_freq_hz = None;
+            x.rates_dps = rates.iter().map(|r| r * 500.0).collect();
+            x.average_s = avg_mult * out_period;
+        }
+        1 => {
+            x.kind = ExperimentKind::Coriolis;
+            x.rate_table = RateTable::Sinusoid;
+            let ft = 0.5 * cutoff * rates[0].abs();
+            x.table_freq_hz = Some(ft);
+            x.rates_dps = rates.iter().map(|r| r * 500.0).collect();
+            x.average_s = avg_mult * (1.0 / ft).max(out_period);
+        }
+        _ => {
+            x.kind = ExperimentKind::Rotating;
+            x.rate_table = RateTable::Constant;
+            x.table_freq_hz = None;
+            // |rate|/360 below the cutoff.
+            x.rates_dps = rates.iter().map(|r| r * 360.0 * cutoff).collect();
+            let slowest = x.rates_dps.iter().map(|r| r.abs()).fold(f64::MAX, f64::min);
+            x.average_s = avg_mult * (180.0 / slowest).max(out_period);
+        }
+    }
+    c.noise = noise.then_some(NoiseConfig {
+        seed: (f0 * 1e3) as u64,
+        temperature_k: 300.0,
+        effective_mass_kg: Some(1e-9),
+        tia_current_noise_a_per_rthz: 1e-12,
+        tia_voltage_noise_v_per_rthz: 1e-8,
+    });
+    c.selfcal = selfcal.then(|| SelfcalConfig {
+        allan_record_s: Some(10.0f64.max(20.0 * out_period)),
+        tau_max_s: Some(4.0),
+        drift_delta_t_k: vec![-10.0, 25.0],
+        f0_tc_ppm_per_k: -30.0,
+        q_tc_ppm_per_k: -3000.0,
+    });
+    c
+}
+
+fn all_finite(z: &[gyroemu_core::Complex64]) -> bool {
+    z.iter().all(|v| v.re.is_finite() && v.im.is_finite())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn valid_configs_round_trip_validate_and_run_finite(
+        d in device(),
+        b in board(),
+        e in experiment(),
+    ) {
+        let cfg = build(d, b, e);
+        let text = toml::to_string(&cfg).expect("serialises");
+        let back = parse_config(&text).unwrap_or_else(|err| panic!("{err}\n{text}"));
+        prop_assert_eq!(&back, &cfg);
+        cfg.validate().unwrap_or_else(|err| panic!("{err}\n{text}"));
+
+        // About 1e4 input samples: settling plus window plus the one extra output sample.
+        let n_out = (10_000 / cfg.board.decimation as u64).max(3);
+        let n_settle = n_out / 2;
+        let rate_rad_s = cfg.experiment.rates_dps[0].to_radians();
+        let point = Point {
+            rate_rad_s,
+            window: Window::Boxcar {
+                n: n_out - n_settle - 1,
+                frac: 0.0,
+            },
+        };
+        let mut board = Board::<f64>::new(&cfg.board_params(), &[rate_rad_s], &[0])
+            .unwrap_or_else(|err| panic!("{err}\n{text}"));
+        let lanes = board
+            .run(n_settle, &[point], RunOptions::default(), &|_| {})
+            .unwrap_or_else(|err| panic!("{err:?}\n{text}"))
+            .lanes;
+        prop_assert_eq!(lanes.len(), 1);
+        let r = &lanes[0];
+        for (name, v) in [("z", &r.z), ("c", &r.c), ("s", &r.s), ("table_phase", &r.table_phase)] {
+            prop_assert!(all_finite(v), "{} = {:?}\n{}", name, v, text);
+        }
+    }
+}

@@ -1,0 +1,226 @@
+//! From the board's averages to phases: the estimators of THEORY.md section 6, the chain terms
+//! compensated from the board's own stage responses, the exact theory beside every point, and
+//! the paper's best linear fit.
+
+use crate::fit::{fit_line, LineFit};
+use gyroemu_board::{ChainResponse, LaneResult, Point, Shape};
+use gyroemu_config::Config;
+use gyroemu_core::{Complex64, ParamError};
+use gyroemu_mixer::{paper_i_channel_psi_rad, phase_lag_rad, sideband_estimate, Mode};
+use gyroemu_theory::DrivenDevice;
+use serde::Serialize;
+
+const DEG: f64 = core::f64::consts::PI / 180.0;
+
+/// One operating point's result. Phases in degrees, lag positive.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PointResult {
+    /// Rate (rotation, excitation, or rate-table amplitude), deg/s.
+    pub rate_dps: f64,
+    /// Measured phase per mode: Coriolis shift against zero rate, compensated psi (rotating),
+    /// or the phase amplitude at the table frequency (rate table).
+    pub phase_deg: [f64; 2],
+    /// Exact theory for the same quantity.
+    pub theory_deg: [f64; 2],
+    /// Rotating: the paper-style real-I-channel estimate, with the same compensation.
+    pub paper_i_deg: Option<[f64; 2]>,
+    /// Rotating: psi before compensation of the chain terms.
+    pub raw_psi_deg: Option<[f64; 2]>,
+    /// Rotating: the carrier phase alpha of each mode.
+    pub alpha_deg: Option<[f64; 2]>,
+    /// Coriolis: the paper's single real mixer DC reading (mixing with the mode's own drive), V.
+    pub single_mixer_dc_v: Option<[f64; 2]>,
+    /// Rate table: lag of the phase response behind the table, degrees (theory beside).
+    pub table_lag_deg: Option<[f64; 2]>,
+    /// Rate table: theory of that lag.
+    pub table_lag_theory_deg: Option<f64>,
+    /// Averaging time actually used, s.
+    pub averaged_s: f64,
+}
+
+/// What the rotating readout compensated at one point, millidegrees (added to psi by the chain).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Compensation {
+    /// The point's rate, deg/s.
+    pub rate_dps: f64,
+    /// TIA: (arg H(f0 - fm) - arg H(f0 + fm))/2, removed from psi.
+    pub tia_mdeg: f64,
+    /// DAC zero-order hold (about Omega Ts / 2), removed from psi.
+    pub dac_hold_mdeg: f64,
+    /// Stage-1 low-pass, -arg L(fm): it delays the envelope but not the Omega references
+    /// (taken at the decimated instants), so it is removed from psi from the filter's exact
+    /// discrete response.
+    pub lowpass_mdeg: f64,
+    /// Pipeline delay between drive and reference, samples (0: both use the same sample).
+    pub pipeline_delay_samples: u64,
+}
+
+/// A whole sweep's results and how they were obtained.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepResult {
+    /// The experiment.
+    pub shape: Shape,
+    /// One result per listed rate.
+    pub points: Vec<PointResult>,
+    /// Rotating: what was compensated at each point.
+    pub compensation: Vec<Compensation>,
+    /// Fit of the measured phase against the listed rates, per mode.
+    pub fit: [LineFit; 2],
+    /// Small-angle theory slope per mode, degrees per deg/s.
+    pub theory_slope_deg_per_dps: [f64; 2],
+    /// Settling before the averages, s.
+    pub settle_s: f64,
+    /// Sample rate, Hz.
+    pub fs_hz: f64,
+    /// Decimated rate, Hz.
+    pub fs_out_hz: f64,
+    /// Input samples emulated in all (per lane group).
+    pub samples: u64,
+    /// Operating-point samples emulated (samples times the points each group carries).
+    pub point_samples: u64,
+}
+
+impl SweepResult {
+    /// Largest |measured - theory| of one mode over the points, millidegrees.
+    pub fn max_abs_error_mdeg(&self, mode: usize) -> f64 {
+        self.points
+            .iter()
+            .map(|p| ((p.phase_deg[mode] - p.theory_deg[mode]) * 1e3).abs())
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The device and drive of a config, for the theory.
+pub fn driven_device(cfg: &Config) -> DrivenDevice {
+    DrivenDevice {
+        plant: cfg.resonator_params(),
+        drive: [cfg.drive.f1, cfg.drive.f2],
+        phase_shifter_error_deg: cfg.board.phase_shifter_error_deg,
+    }
+}
+
+/// The exact theory of the quantity a sweep measures at `rate_dps`, per mode, degrees (the
+/// rate-table case is the small-signal first-order model of THEORY.md section 3).
+pub fn theory_deg(cfg: &Config, rate_dps: f64) -> [f64; 2] {
+    let omega = rate_dps * DEG;
+    let dev = driven_device(cfg);
+    let rad = match cfg.shape() {
+        Shape::Coriolis => dev.coriolis_phase_rad(omega),
+        Shape::RateTable { freq_hz } => dev.rate_table_gain(freq_hz).map(|g| g * omega),
+        Shape::Rotating => dev.rotating_psi_rad(omega),
+    };
+    rad.map(|r| r / DEG)
+}
+
+/// Turns each emulated point's lane averages into phases, compensation, theory and fits (the
+/// `samples` and rate fields of the result are left for the caller).
+#[allow(clippy::needless_range_loop)] // mode indices address parallel arrays
+pub fn post_process(
+    cfg: &Config,
+    rates: &[f64],
+    points: &[Point],
+    lanes: &[LaneResult],
+) -> Result<SweepResult, ParamError> {
+    let d = &cfg.device;
+    let fs_out = cfg.fs_out_hz();
+    let shape = cfg.shape();
+    let chain = ChainResponse::new(&cfg.board_params())?;
+    let dev = driven_device(cfg);
+    let mut out = Vec::new();
+    let mut comp = Vec::new();
+    let zero = rates.iter().position(|&r| r == 0.0);
+    let averaged = |p: &Point| p.span_samples() / fs_out;
+    for (i, &rate) in rates.iter().enumerate() {
+        if !cfg.experiment.rates_dps.contains(&rate) {
+            continue; // the implicit zero-rate reference
+        }
+        let lr = &lanes[i];
+        let omega = rate * DEG;
+        let mut r = PointResult {
+            rate_dps: rate,
+            phase_deg: [0.0; 2],
+            theory_deg: theory_deg(cfg, rate),
+            paper_i_deg: None,
+            raw_psi_deg: None,
+            alpha_deg: None,
+            single_mixer_dc_v: None,
+            table_lag_deg: None,
+            table_lag_theory_deg: None,
+            averaged_s: averaged(&points[i]),
+        };
+        match shape {
+            Shape::Coriolis => {
+                let z0 = lanes[zero.expect("zero rate is always emulated")].z;
+                for k in 0..2 {
+                    r.phase_deg[k] = phase_lag_rad(lr.z[k], z0[k]) / DEG;
+                }
+                // Mixing with the mode's own drive: cos w0t (mode 1), sin w0t (mode 2).
+                r.single_mixer_dc_v = Some([0.5 * lr.z[0].re, -0.5 * lr.z[1].im]);
+            }
+            Shape::RateTable { freq_hz: ft } => {
+                let l = chain.lowpass(ft);
+                let mut lag = [0.0; 2];
+                for k in 0..2 {
+                    // The phase passed through the stage-1 low-pass: divide its response out.
+                    let x = lr.table_phase[k] / l;
+                    r.phase_deg[k] = x.norm().to_degrees();
+                    // Response to A sin(wt) has complex amplitude -j A e^{-j lag}.
+                    lag[k] = -(x * Complex64::new(0.0, 1.0)).arg().to_degrees();
+                }
+                let (_, ph) =
+                    gyroemu_theory::rate_table_gain(d.f0_hz, d.q, d.angular_gain, 1.0, 1.0, ft);
+                r.table_lag_theory_deg = Some(ph.to_degrees());
+                r.table_lag_deg = Some(lag);
+            }
+            Shape::Rotating => {
+                let terms = chain.rotating_terms(omega / core::f64::consts::TAU);
+                let total = terms.total_rad();
+                comp.push(Compensation {
+                    rate_dps: rate,
+                    tia_mdeg: terms.tia_rad / DEG * 1e3,
+                    dac_hold_mdeg: terms.dac_hold_rad / DEG * 1e3,
+                    lowpass_mdeg: terms.lowpass_rad / DEG * 1e3,
+                    pipeline_delay_samples: 0,
+                });
+                let mut raw = [0.0; 2];
+                let mut paper = [0.0; 2];
+                let mut alpha = [0.0; 2];
+                for (k, mode) in [Mode::One, Mode::Two].into_iter().enumerate() {
+                    let est = sideband_estimate(lr.c[k], lr.s[k], mode);
+                    raw[k] = est.psi_rad / DEG;
+                    alpha[k] = est.alpha_rad / DEG;
+                    r.phase_deg[k] = (est.psi_rad - total) / DEG;
+                    // A real channel cannot tell the sign of the carrier (an inverting TIA
+                    // flips it): fold the paper-style reading into (-90, 90] degrees.
+                    let p = paper_i_channel_psi_rad(lr.c[k], lr.s[k], mode) - total;
+                    paper[k] =
+                        (p - core::f64::consts::PI * (p / core::f64::consts::PI).round()) / DEG;
+                }
+                r.raw_psi_deg = Some(raw);
+                r.paper_i_deg = Some(paper);
+                r.alpha_deg = Some(alpha);
+            }
+        }
+        out.push(r);
+    }
+    let xs: Vec<f64> = out.iter().map(|p| p.rate_dps).collect();
+    let fit =
+        [0, 1].map(|k| fit_line(&xs, &out.iter().map(|p| p.phase_deg[k]).collect::<Vec<_>>()));
+    let slope = match shape {
+        Shape::Coriolis => dev.coriolis_slope(),
+        Shape::RateTable { freq_hz } => dev.rate_table_gain(freq_hz),
+        Shape::Rotating => dev.rotating_slope(),
+    };
+    Ok(SweepResult {
+        shape,
+        points: out,
+        compensation: comp,
+        fit,
+        theory_slope_deg_per_dps: slope,
+        settle_s: 0.0,
+        fs_hz: 0.0,
+        fs_out_hz: 0.0,
+        samples: 0,
+        point_samples: 0,
+    })
+}

@@ -1,0 +1,39 @@
+//! Why writing a report failed.
+
+use gyroemu_config::ConfigError;
+use gyroemu_experiment::SweepError;
+use gyroemu_io::IoError;
+use gyroemu_plot::PlotError;
+
+/// A report (or the runs it needs) failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    /// A config (a preset, or one derived from the user's) is refused: bad input.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// The emulation failed.
+    #[error("emulation failed: {0}")]
+    Sweep(#[from] SweepError),
+    /// Writing a file failed.
+    #[error(transparent)]
+    Io(#[from] IoError),
+    /// Rendering a figure failed.
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+    /// Creating a folder failed.
+    #[error("cannot create `{path}`: {source}")]
+    Dir {
+        /// The folder.
+        path: std::path::PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+}
+
+/// Creates `dir` (and its parents).
+pub(crate) fn create_dir(dir: &std::path::Path) -> Result<(), ReportError> {
+    std::fs::create_dir_all(dir).map_err(|source| ReportError::Dir {
+        path: dir.to_path_buf(),
+        source,
+    })
+}

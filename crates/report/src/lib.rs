@@ -1,0 +1,14 @@
+//! What gyroemu writes: the results table, summary and paper-style figure of a sweep, the
+//! self-calibration's files, and the `reproduce` job (the paper's figures from the embedded
+//! presets). Every file is written atomically (`gyroemu-io`) and every function returns the
+//! paths it wrote, so a program can list them.
+
+mod error;
+pub mod reproduce;
+pub mod selfcal_report;
+pub mod sweep_report;
+
+pub use error::ReportError;
+pub use reproduce::{plan_reproduce, reproduce, ReproducePlan};
+pub use selfcal_report::write_selfcal;
+pub use sweep_report::{run_title, write_run, RUN_FILES};

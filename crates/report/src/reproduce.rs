@@ -1,0 +1,271 @@
+//! `gyroemu reproduce`: the paper's Figs. 4, 5, 6, 8 and 9 from the emulated board, on the
+//! embedded presets, with the exact theory beside every point.
+
+use crate::error::{create_dir, ReportError};
+use crate::sweep_report::{sweep_figure, theory_series, write_run};
+use gyroemu_analysis::bandwidth::{bandwidth, BANDWIDTH_AMPLITUDE_DPS, BANDWIDTH_FREQS_HZ};
+use gyroemu_config::presets::preset;
+use gyroemu_config::Config;
+use gyroemu_experiment::{run_sweep, Reporter, SweepResult};
+use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
+use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
+use gyroemu_theory::rate_table_gain;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// Averaging of Fig. 9 with `--quick`, s (the paper: 500 s).
+const QUICK_AVERAGE_S: f64 = 15.0;
+
+struct Job {
+    preset: &'static str,
+    title: &'static str,
+    cfg: Config,
+}
+
+/// What `reproduce` checked before running: every experiment's config, validated.
+pub struct ReproducePlan {
+    jobs: Vec<Job>,
+    quick: bool,
+    /// The configs' warnings, each prefixed with its preset.
+    pub warnings: Vec<String>,
+}
+
+/// The presets of the figures (with `quick`, Fig. 9 averages 15 s instead of 500 s), each
+/// validated before any sample is computed.
+pub fn plan_reproduce(quick: bool) -> Result<ReproducePlan, ReportError> {
+    let specs = [
+        (
+            "m2tfg-coriolis",
+            "Fig. 8: Coriolis phase shift, M^2-TFG-like gyroscope (Q = 2000)",
+        ),
+        (
+            "m2tfg-rotating",
+            "Fig. 9: rotating excitation, M^2-TFG-like gyroscope",
+        ),
+        (
+            "baw-coriolis",
+            "Fig. 4: Coriolis phase shift, BAW disk (n = 3, lambda = 0.6)",
+        ),
+        ("baw-rotating", "Fig. 5: rotating excitation, BAW disk"),
+        (
+            "m2tfg-ratetable",
+            "Sinusoidal rate table at Q = 36 000: the mechanical bandwidth",
+        ),
+    ];
+    let mut jobs = Vec::new();
+    let mut warnings = Vec::new();
+    for (name, title) in specs {
+        let mut cfg = preset(name)?;
+        if quick && name == "m2tfg-rotating" {
+            cfg.experiment.average_s = QUICK_AVERAGE_S;
+        }
+        warnings.extend(cfg.validate()?.into_iter().map(|w| format!("{name}: {w}")));
+        jobs.push(Job {
+            preset: name,
+            title,
+            cfg,
+        });
+    }
+    Ok(ReproducePlan {
+        jobs,
+        quick,
+        warnings,
+    })
+}
+
+/// Runs every figure's experiment of `plan` and writes the figures and summaries into `out`
+/// (which must exist); returns the files written.
+pub fn reproduce(
+    plan: &ReproducePlan,
+    out: &Path,
+    reporter: &dyn Reporter,
+) -> Result<Vec<PathBuf>, ReportError> {
+    let (jobs, quick) = (&plan.jobs, plan.quick);
+    let mut files = Vec::new();
+    let mut results = Vec::new();
+    for job in jobs {
+        let progress = reporter.task(job.preset);
+        let r = run_sweep(&job.cfg, &|d, t| progress.update(d, t), None)?;
+        progress.finish(Some(r.point_samples));
+        files.extend(write_run(&out.join(job.preset), &job.cfg, &r, job.title)?);
+        results.push(r);
+    }
+    let get = |name: &str| {
+        let i = jobs.iter().position(|j| j.preset == name).unwrap_or(0);
+        (&jobs[i].cfg, &results[i], jobs[i].title)
+    };
+    for (fig, name) in [
+        ("fig8", "m2tfg-coriolis"),
+        ("fig9", "m2tfg-rotating"),
+        ("fig4", "baw-coriolis"),
+        ("fig5", "baw-rotating"),
+        ("fig_ratetable", "m2tfg-ratetable"),
+    ] {
+        let (cfg, r, title) = get(name);
+        let mut f = sweep_figure(cfg, r, title);
+        if let Some(paper) = paper_i_series(r) {
+            f = f.with(paper);
+        }
+        let path = out.join(format!("{fig}.png"));
+        render_png(&f, &path)?;
+        files.push(path);
+    }
+    let (rt_cfg, _, _) = get("m2tfg-ratetable");
+    let task = reporter.task("bandwidth");
+    let (figure, csv) = bandwidth_outputs(rt_cfg, out)?;
+    task.finish(None);
+    let path = out.join("fig_bandwidth.png");
+    render_png(&figure, &path)?;
+    files.extend([csv, path]);
+    let (cc, cr, _) = get("baw-coriolis");
+    let (_, rr, _) = get("baw-rotating");
+    let path = out.join("fig6.png");
+    render_png(&fig6(cc, cr, rr), &path)?;
+    files.push(path);
+    let pair = |c: &str, rname: &str| {
+        let (cfg, rc, _) = get(c);
+        let (_, rrot, _) = get(rname);
+        let lambda = cfg.device.angular_gain;
+        let ratio = rc.fit[0].slope / rrot.fit[0].slope;
+        json!({
+            "coriolis_slope_deg_per_dps": rc.fit[0].slope,
+            "rotating_slope_deg_per_dps": rrot.fit[0].slope,
+            "slope_ratio": ratio,
+            "angular_gain": lambda,
+            "ratio_relative_error": ratio / lambda - 1.0,
+        })
+    };
+    let max_err = |r: &SweepResult| r.max_abs_error_mdeg(0).max(r.max_abs_error_mdeg(1));
+    let summary = json!({
+        "fig8_fig9": pair("m2tfg-coriolis", "m2tfg-rotating"),
+        "fig4_fig5": pair("baw-coriolis", "baw-rotating"),
+        "max_abs_error_mdeg": {
+            "fig8": max_err(get("m2tfg-coriolis").1),
+            "fig9": max_err(get("m2tfg-rotating").1),
+            "fig4": max_err(get("baw-coriolis").1),
+            "fig5": max_err(get("baw-rotating").1),
+        },
+        "fig9_average_s": get("m2tfg-rotating").0.experiment.average_s,
+        "quick": quick,
+    });
+    let path = out.join("summary.json");
+    write_json(&path, &summary)?;
+    files.push(path);
+    Ok(files)
+}
+
+/// The bandwidth sweep of the rate-table preset: writes `m2tfg-ratetable/bandwidth.csv` and
+/// returns its figure (the emulated gains against the first-order low-pass of THEORY.md
+/// section 3) and the CSV's path.
+fn bandwidth_outputs(base: &Config, out: &Path) -> Result<(Figure, PathBuf), ReportError> {
+    let d = &base.device;
+    let runs = bandwidth(base)?;
+    let rows = runs
+        .iter()
+        .map(|p| {
+            [
+                p.table_freq_hz,
+                p.gain_deg_per_dps[0],
+                p.gain_deg_per_dps[1],
+                p.theory_gain_deg_per_dps,
+                p.lag_deg[0],
+                p.lag_deg[1],
+                p.theory_lag_deg,
+            ]
+            .map(CsvCell::F64)
+            .to_vec()
+        })
+        .collect();
+    let headers = [
+        "table_freq_hz",
+        "gain_mode1_deg_per_dps",
+        "gain_mode2_deg_per_dps",
+        "theory_gain_deg_per_dps",
+        "lag_mode1_deg",
+        "lag_mode2_deg",
+        "theory_lag_deg",
+    ];
+    let dir = out.join("m2tfg-ratetable");
+    create_dir(&dir)?;
+    let csv = dir.join("bandwidth.csv");
+    write_csv(
+        &csv,
+        &CsvTable {
+            headers: headers.map(String::from).to_vec(),
+            rows,
+        },
+    )?;
+    let theory = |f: f64| rate_table_gain(d.f0_hz, d.q, d.angular_gain, 1.0, 1.0, f);
+    let fmax = BANDWIDTH_FREQS_HZ[BANDWIDTH_FREQS_HZ.len() - 1];
+    let fs: Vec<f64> = (0..=200)
+        .map(|i| 0.01 + (fmax - 0.01) * i as f64 / 200.0)
+        .collect();
+    let corner = d.f0_hz / (2.0 * d.q);
+    let figure = Figure::new(
+        format!(
+            "Mechanical bandwidth: rate table at Q = {}, corner f0/(2Q) = {corner:.3} Hz",
+            d.q
+        ),
+        "Rate-table frequency (Hz)",
+        "Phase amplitude per unit rate (deg per deg/s)",
+    )
+    .with(Series {
+        name: format!("mode 1 emulated ({BANDWIDTH_AMPLITUDE_DPS} deg/s amplitude)"),
+        style: SeriesStyle::Points,
+        xs: runs.iter().map(|r| r.table_freq_hz).collect(),
+        ys: runs.iter().map(|r| r.gain_deg_per_dps[0]).collect(),
+    })
+    .with(Series {
+        name: "mode 2 emulated".into(),
+        style: SeriesStyle::OpenPoints,
+        xs: runs.iter().map(|r| r.table_freq_hz).collect(),
+        ys: runs.iter().map(|r| r.gain_deg_per_dps[1]).collect(),
+    })
+    .with(Series {
+        name: "first-order low-pass: (2 Q lambda / w0) / sqrt(1 + (2 pi f tau)^2)".into(),
+        style: SeriesStyle::Line,
+        ys: fs.iter().map(|&f| theory(f).0).collect(),
+        xs: fs,
+    });
+    Ok((figure, csv))
+}
+
+/// The paper-style real-I-channel estimate of mode 1, for the rotating figures.
+fn paper_i_series(r: &SweepResult) -> Option<Series> {
+    let ys: Option<Vec<f64>> = r
+        .points
+        .iter()
+        .map(|p| p.paper_i_deg.map(|v| v[0]))
+        .collect();
+    Some(Series {
+        name: "mode 1, paper-style I-channel estimate".into(),
+        style: SeriesStyle::Points,
+        xs: r.points.iter().map(|p| p.rate_dps).collect(),
+        ys: ys?,
+    })
+}
+
+/// Fig. 6: the Coriolis phase against the rotation rate, and the rotating-excitation phase
+/// against the excitation rate divided by lambda: the two coincide.
+fn fig6(cfg: &Config, cor: &SweepResult, rot: &SweepResult) -> Figure {
+    let lambda = cfg.device.angular_gain;
+    let x_max = cor.points.iter().map(|p| p.rate_dps).fold(0.0, f64::max);
+    Figure::new(
+        "Fig. 6: Coriolis and rotating excitation coincide (excitation axis / lambda)",
+        "Rotation rate, or excitation rate / lambda (deg/s)",
+        "Phase (deg)",
+    )
+    .with(Series {
+        name: "Coriolis, mode 1".into(),
+        style: SeriesStyle::Points,
+        xs: cor.points.iter().map(|p| p.rate_dps).collect(),
+        ys: cor.points.iter().map(|p| p.phase_deg[0]).collect(),
+    })
+    .with(Series {
+        name: format!("rotating excitation, mode 1 (Omega / {lambda})"),
+        style: SeriesStyle::OpenPoints,
+        xs: rot.points.iter().map(|p| p.rate_dps / lambda).collect(),
+        ys: rot.points.iter().map(|p| p.phase_deg[0]).collect(),
+    })
+    .with(theory_series(cfg, x_max, 0, 1.0, "exact theory (eq. 3)"))
+}

@@ -1,0 +1,362 @@
+//! What `selfcal` writes: selfcal.json, selfcal.csv, selfcal.png, and allan.*,
+//! error_vs_tau.*, drift.* for the analyses that ran. Every file is written atomically.
+
+use crate::error::ReportError;
+use gyroemu_analysis::allan::AllanPoint;
+use gyroemu_analysis::selfcal::SelfcalCore;
+use gyroemu_analysis::selfcal_analyses::{AllanResult, DriftPoint, TauPoint};
+use gyroemu_analysis::SelfcalReport;
+use gyroemu_config::Config;
+use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
+use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// Writes the self-calibration's files into `out`; returns their paths.
+pub fn write_selfcal(
+    out: &Path,
+    cfg: &Config,
+    report: &SelfcalReport,
+) -> Result<Vec<PathBuf>, ReportError> {
+    let core = &report.core;
+    let (allan, taus, drift) = (
+        report.allan.as_ref(),
+        report.taus.as_deref(),
+        report.drift.as_deref(),
+    );
+    let m = core.modes[0];
+    let scale_s = m.predicted_deg_per_dps; // rad per rad/s is the same number
+    let summary = json!({
+        "gyroemu_version": env!("CARGO_PKG_VERSION"),
+        "angular_gain": core.angular_gain,
+        "averaging_s": cfg.experiment.average_s,
+        "rotating_slope_deg_per_dps": m.rotating.slope_deg_per_dps,
+        "predicted_coriolis_slope_deg_per_dps": m.predicted_deg_per_dps,
+        "predicted_coriolis_scale_factor_s": scale_s,
+        "predicted_coriolis_slope_mdeg_per_dph": m.predicted_deg_per_dps * 1e3 / 3600.0,
+        "measured_coriolis_slope_deg_per_dps": m.coriolis.slope_deg_per_dps,
+        "relative_error": m.relative_error,
+        "relative_error_ci95": m.relative_error_ci95,
+        "theory_coriolis_slope_deg_per_dps": m.theory_coriolis_deg_per_dps,
+        "modes": core.modes,
+        "single_channel_vs_iq": {
+            "rotating_iq_slope_deg_per_dps": m.rotating.slope_deg_per_dps,
+            "rotating_paper_i_slope_deg_per_dps": m.rotating_paper_i.slope_deg_per_dps,
+            "relative_error_iq": m.relative_error,
+            "relative_error_paper_i": m.relative_error_paper_i,
+            "rotating_iq_fit_r2": m.rotating.plain_fit.r2,
+            "rotating_paper_i_fit_r2": m.rotating_paper_i.plain_fit.r2,
+        },
+        "rotating_points": core.rotating.points,
+        "coriolis_points": core.coriolis.points,
+        "compensation_mdeg": core.rotating.compensation,
+        "allan": allan,
+        "error_vs_averaging_time": taus,
+        "drift": drift,
+        "config": cfg,
+    });
+    let mut files = Vec::new();
+    let mut path = |name: &str| {
+        let p = out.join(name);
+        files.push(p.clone());
+        p
+    };
+    write_json(&path("selfcal.json"), &summary)?;
+    write_csv(&path("selfcal.csv"), &points_table(core))?;
+    render_png(&selfcal_figure(core), &path("selfcal.png"))?;
+    if let Some(a) = allan {
+        write_csv(&path("allan.csv"), &allan_table(a))?;
+        render_png(&allan_figure(a), &path("allan.png"))?;
+    }
+    if let Some(t) = taus {
+        write_csv(&path("error_vs_tau.csv"), &tau_table(t))?;
+        render_png(
+            &tau_figure(t, cfg.experiment.average_s),
+            &path("error_vs_tau.png"),
+        )?;
+    }
+    if let Some(d) = drift {
+        write_csv(&path("drift.csv"), &drift_table(d))?;
+        render_png(&drift_figure(d), &path("drift.png"))?;
+    }
+    Ok(files)
+}
+
+fn table(headers: &[&str], rows: Vec<Vec<f64>>) -> CsvTable {
+    CsvTable {
+        headers: headers.iter().map(|h| h.to_string()).collect(),
+        rows: rows
+            .into_iter()
+            .map(|r| r.into_iter().map(CsvCell::F64).collect())
+            .collect(),
+    }
+}
+
+fn points_table(core: &SelfcalCore) -> CsvTable {
+    let rows = core
+        .rotating
+        .points
+        .iter()
+        .zip(&core.coriolis.points)
+        .map(|(r, c)| {
+            let paper = r.paper_i_deg.unwrap_or([f64::NAN; 2]);
+            vec![
+                r.rate_dps,
+                r.phase_deg[0],
+                r.phase_deg[1],
+                paper[0],
+                paper[1],
+                c.phase_deg[0],
+                c.phase_deg[1],
+                c.theory_deg[0],
+            ]
+        })
+        .collect();
+    table(
+        &[
+            "rate_dps",
+            "rotating_psi_mode1_deg",
+            "rotating_psi_mode2_deg",
+            "rotating_paper_i_mode1_deg",
+            "rotating_paper_i_mode2_deg",
+            "coriolis_phase_mode1_deg",
+            "coriolis_phase_mode2_deg",
+            "coriolis_theory_mode1_deg",
+        ],
+        rows,
+    )
+}
+
+fn selfcal_figure(core: &SelfcalCore) -> Figure {
+    let m = core.modes[0];
+    let lambda = core.angular_gain;
+    let xs: Vec<f64> = core.coriolis.points.iter().map(|p| p.rate_dps).collect();
+    let x_max = xs.iter().cloned().fold(0.0, f64::max);
+    let line = |slope: f64| -> Vec<f64> {
+        [0.0, x_max]
+            .iter()
+            .map(|x| (slope.to_radians() * x).atan().to_degrees())
+            .collect()
+    };
+    Figure::new(
+        format!(
+            "Self-calibration: predicted / measured - 1 = {:+.2e} (+- {:.1e}, 95 %)",
+            m.relative_error, m.relative_error_ci95
+        ),
+        "Rotation rate, or excitation rate / lambda (deg/s)",
+        "Phase (deg), mode 1",
+    )
+    .with(Series::new(
+        "rate table (Coriolis), measured",
+        SeriesStyle::Points,
+        xs.clone(),
+        core.coriolis
+            .points
+            .iter()
+            .map(|p| p.phase_deg[0])
+            .collect(),
+    ))
+    .with(Series::new(
+        "rotating excitation, measured (x / lambda)",
+        SeriesStyle::OpenPoints,
+        core.rotating
+            .points
+            .iter()
+            .map(|p| p.rate_dps / lambda)
+            .collect(),
+        // A rotating excitation at Omega gives the Coriolis phase of Omega / lambda; its
+        // small-angle slope per Omega is the Coriolis one divided by lambda.
+        core.rotating
+            .points
+            .iter()
+            .map(|p| p.phase_deg[0])
+            .collect(),
+    ))
+    .with(Series::new(
+        format!(
+            "self-calibrated: lambda x rotating slope = {:.6} deg per deg/s",
+            m.predicted_deg_per_dps
+        ),
+        SeriesStyle::Line,
+        vec![0.0, x_max],
+        line(m.predicted_deg_per_dps),
+    ))
+    .with(Series::new(
+        format!(
+            "rate table: {:.6} deg per deg/s",
+            m.coriolis.slope_deg_per_dps
+        ),
+        SeriesStyle::DashedLine,
+        vec![0.0, x_max],
+        line(m.coriolis.slope_deg_per_dps),
+    ))
+}
+
+fn allan_table(a: &AllanResult) -> CsvTable {
+    let rows = a
+        .phase_deg
+        .iter()
+        .zip(&a.rate_dps)
+        .map(|(p, r)| vec![p.tau_s, p.adev, r.adev, r.adev * 3600.0, p.n_terms as f64])
+        .collect();
+    table(
+        &[
+            "tau_s",
+            "adev_phase_deg",
+            "adev_rate_dps",
+            "adev_rate_dph",
+            "n_terms",
+        ],
+        rows,
+    )
+}
+
+fn log_series(name: &str, style: SeriesStyle, pts: &[AllanPoint], scale: f64) -> Series {
+    Series::new(
+        name,
+        style,
+        pts.iter().map(|p| p.tau_s.log10()).collect(),
+        pts.iter().map(|p| (p.adev * scale).log10()).collect(),
+    )
+}
+
+fn allan_figure(a: &AllanResult) -> Figure {
+    let title = match a.readings {
+        Some(r) => format!(
+            "Allan deviation at zero rate: ARW {:.3e} deg/sqrt(h), bias instability {:.3e} deg/h",
+            r.arw_deg_per_rt_h, r.bias_instability_deg_per_h
+        ),
+        None => "Allan deviation at zero rate".to_string(),
+    };
+    let mut fig =
+        Figure::new(title, "log10(tau / s)", "log10(Allan deviation / (deg/h))").with(log_series(
+            "rate-equivalent output (phase / scale factor)",
+            SeriesStyle::Points,
+            &a.rate_dps,
+            3600.0,
+        ));
+    if let Some(r) = a.readings {
+        // The -1/2 line of the ARW reading: sigma = N / sqrt(tau), N = ARW / 60 deg/s*sqrt(s).
+        let n = r.arw_deg_per_rt_h / 60.0;
+        let ends: Vec<f64> = [a.rate_dps[0].tau_s, a.rate_dps[a.rate_dps.len() - 1].tau_s].into();
+        fig = fig.with(Series::new(
+            "angle random walk: N / sqrt(tau)",
+            SeriesStyle::DashedLine,
+            ends.iter().map(|t| t.log10()).collect(),
+            ends.iter()
+                .map(|t| (n / t.sqrt() * 3600.0).log10())
+                .collect(),
+        ));
+    }
+    fig
+}
+
+fn tau_table(t: &[TauPoint]) -> CsvTable {
+    let rows = t
+        .iter()
+        .map(|p| {
+            vec![
+                p.tau_s,
+                p.averaged_s,
+                p.predicted_deg_per_dps,
+                p.relative_error,
+                p.relative_error_ci95,
+                p.relative_error_vs_theory,
+            ]
+        })
+        .collect();
+    table(
+        &[
+            "tau_s",
+            "averaged_s",
+            "predicted_deg_per_dps",
+            "relative_error",
+            "relative_error_ci95",
+            "relative_error_vs_theory",
+        ],
+        rows,
+    )
+}
+
+fn tau_figure(t: &[TauPoint], average_s: f64) -> Figure {
+    let lg = |v: f64| v.abs().max(1e-12).log10();
+    let mut fig = Figure::new(
+        "Self-calibration error against averaging time",
+        "log10(averaging time / s)",
+        "log10 |relative error|",
+    )
+    .with(Series::new(
+        "|predicted / rate table - 1|",
+        SeriesStyle::Points,
+        t.iter().map(|p| p.tau_s.log10()).collect(),
+        t.iter().map(|p| lg(p.relative_error)).collect(),
+    ))
+    .with(Series::new(
+        "95 % confidence half-width",
+        SeriesStyle::DashedLine,
+        t.iter().map(|p| p.tau_s.log10()).collect(),
+        t.iter().map(|p| lg(p.relative_error_ci95)).collect(),
+    ));
+    for (name, at) in [("500 s (the paper)", 500.0), ("this config", average_s)] {
+        if let Some(p) = t.iter().find(|p| p.tau_s == at) {
+            fig = fig.with(Series::new(
+                name,
+                SeriesStyle::OpenPoints,
+                vec![p.tau_s.log10()],
+                vec![lg(p.relative_error)],
+            ));
+        }
+    }
+    fig
+}
+
+fn drift_table(d: &[DriftPoint]) -> CsvTable {
+    let rows = d
+        .iter()
+        .map(|p| {
+            vec![
+                p.delta_t_k,
+                p.f0_hz,
+                p.q,
+                p.measured_deg_per_dps,
+                p.selfcal_deg_per_dps,
+                p.selfcal_relative_error,
+                p.stale_relative_error,
+            ]
+        })
+        .collect();
+    table(
+        &[
+            "delta_t_k",
+            "f0_hz",
+            "q",
+            "measured_deg_per_dps",
+            "selfcal_deg_per_dps",
+            "selfcal_relative_error",
+            "stale_relative_error",
+        ],
+        rows,
+    )
+}
+
+fn drift_figure(d: &[DriftPoint]) -> Figure {
+    let xs: Vec<f64> = d.iter().map(|p| p.delta_t_k).collect();
+    let pct = |v: f64| 100.0 * v;
+    Figure::new(
+        "Drift: the self-calibration tracks the Coriolis scale factor",
+        "Temperature offset (K)",
+        "Scale-factor error against the rate table (%)",
+    )
+    .with(Series::new(
+        "self-calibrated at that temperature",
+        SeriesStyle::Points,
+        xs.clone(),
+        d.iter().map(|p| pct(p.selfcal_relative_error)).collect(),
+    ))
+    .with(Series::new(
+        "calibrated once at the nominal temperature",
+        SeriesStyle::OpenPoints,
+        xs,
+        d.iter().map(|p| pct(p.stale_relative_error)).collect(),
+    ))
+}

@@ -1,0 +1,18 @@
+//! The run lifecycle of gyroemu, as a library the program drives: per-point result files named
+//! by the config's hash, manifests, resuming after an interrupt, shards (Slurm arrays,
+//! Kubernetes Indexed Jobs) and their merge into the outputs one machine would have written.
+//! Errors are typed ([`RunError`]) so a program can map them to exit codes.
+
+mod error;
+pub mod manifest;
+mod merge;
+pub mod points;
+mod resume;
+mod run;
+pub mod shard;
+
+pub use error::RunError;
+pub use merge::merge;
+pub use resume::previous_points;
+pub use run::{prepare_out, run, RunOutcome, RunRequest};
+pub use shard::{resolve_shard, Shard};

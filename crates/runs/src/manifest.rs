@@ -1,0 +1,111 @@
+//! The manifest a run or a shard writes beside its outputs: what is done, what is missing,
+//! what to do next, and the canonical config (so `merge` can rebuild the results).
+
+use crate::error::RunError;
+use gyroemu_board::LaneResult;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Format tag of run and shard manifests.
+pub const MANIFEST_FORMAT: &str = "gyroemu-manifest/1";
+
+/// The manifest of a one-machine run.
+pub const RUN_MANIFEST: &str = "manifest.json";
+
+/// A shard's place in the split.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ShardId {
+    pub index: usize,
+    pub count: usize,
+}
+
+/// What a run or a shard has done, written beside its outputs (`manifest.json`, or
+/// `shard-I-of-N.json`). Not part of the byte-identical results: it may name the time-free
+/// facts of one particular run.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Manifest {
+    /// [`MANIFEST_FORMAT`].
+    pub format: String,
+    /// `running`, `interrupted` or `complete`.
+    pub status: String,
+    /// SHA-256 of the canonical config TOML.
+    pub config_sha256: String,
+    /// The shard (absent: the whole sweep).
+    pub shard: Option<ShardId>,
+    /// Operating points of the whole sweep.
+    pub points_total: usize,
+    /// The point indices this run or shard is responsible for.
+    pub points: Vec<usize>,
+    /// Of those, the ones whose results are in `points/`.
+    pub points_done: Vec<usize>,
+    /// Of those, the ones still to compute.
+    pub points_missing: Vec<usize>,
+    /// What to do next.
+    pub next: String,
+    pub gyroemu_version: String,
+    /// The canonical config (`gyroemu merge` rebuilds the results from it).
+    pub config_toml: String,
+}
+
+impl Manifest {
+    /// A manifest for `points` of a sweep, those in `done` being finished (`next` empty).
+    pub fn new(
+        status: &str,
+        hash: &str,
+        config_toml: &str,
+        shard: Option<ShardId>,
+        points_total: usize,
+        points: &[usize],
+        done: &BTreeMap<usize, LaneResult>,
+    ) -> Self {
+        let (d, m): (Vec<usize>, Vec<usize>) = points.iter().partition(|i| done.contains_key(i));
+        Self {
+            format: MANIFEST_FORMAT.to_string(),
+            status: status.to_string(),
+            config_sha256: hash.to_string(),
+            shard,
+            points_total,
+            points: points.to_vec(),
+            points_done: d,
+            points_missing: m,
+            next: String::new(),
+            gyroemu_version: env!("CARGO_PKG_VERSION").to_string(),
+            config_toml: config_toml.to_string(),
+        }
+    }
+
+    /// Writes the manifest atomically.
+    pub fn write(&self, path: &Path) -> Result<(), RunError> {
+        gyroemu_io::write_json(path, self)
+            .map_err(|e| RunError::Report(gyroemu_report::ReportError::Io(e)))
+    }
+}
+
+/// Reads a manifest file.
+pub fn read_manifest(path: &Path) -> Result<Manifest, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
+    let m: Manifest = serde_json::from_str(&text).map_err(|e| e.to_string())?;
+    if m.format != MANIFEST_FORMAT {
+        return Err(format!(
+            "format `{}`, expected `{MANIFEST_FORMAT}`",
+            m.format
+        ));
+    }
+    Ok(m)
+}
+
+/// The shard manifests `shard-I-of-N.json` in `dir`, sorted by name.
+pub fn shard_manifest_paths(dir: &Path) -> Result<Vec<PathBuf>, RunError> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(RunError::io(format!("cannot read `{}`", dir.display())))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .is_some_and(|n| n.starts_with("shard-") && n.ends_with(".json"))
+        })
+        .collect();
+    v.sort();
+    Ok(v)
+}

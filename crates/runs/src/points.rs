@@ -1,0 +1,268 @@
+//! Per-point files of a sweep: the config hash that names a sweep, and one small JSON
+//! file per finished operating point holding its raw lane averages bit for bit (f64 as the hex
+//! of its IEEE bits: decimal text round-trips only with a correctly rounded parser). A resumed
+//! run, a shard, and `gyroemu merge` rebuild the sweep's results from these files; the lane
+//! grouping does not change any bits, so the outputs equal a one-machine run's.
+
+use gyroemu_board::LaneResult;
+use gyroemu_config::Config;
+use gyroemu_core::Complex64;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Format tag of a point file.
+pub const POINT_FORMAT: &str = "gyroemu-point/1";
+
+/// The folder of the point files inside an output folder.
+pub const POINTS_DIR: &str = "points";
+
+/// The canonical text of a config: `toml::to_string` of the parsed config (comments, key
+/// order and number spelling of the user's file do not matter).
+pub fn canonical_toml(cfg: &Config) -> String {
+    toml::to_string(cfg).expect("a config always serialises to TOML")
+}
+
+/// SHA-256 of the canonical config text, lowercase hex: the identity of a sweep.
+pub fn config_hash(cfg: &Config) -> String {
+    hex(&Sha256::digest(canonical_toml(cfg).as_bytes()))
+}
+
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// One finished operating point as stored on disk.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PointFile {
+    /// [`POINT_FORMAT`].
+    pub format: String,
+    /// [`config_hash`] of the sweep the point belongs to.
+    pub config_sha256: String,
+    /// Index of the point in `emulated_rates_dps(cfg)` (also its noise stream).
+    pub index: usize,
+    /// The point's rate, deg/s (for people reading the file).
+    pub rate_dps: f64,
+    /// The lane averages, each f64 as 16 hex digits of its bits: z, c, s, table_phase, each
+    /// as [re mode 1, im mode 1, re mode 2, im mode 2].
+    pub z: [String; 4],
+    pub c: [String; 4],
+    pub s: [String; 4],
+    pub table_phase: [String; 4],
+}
+
+fn enc(v: &[Complex64; 2]) -> [String; 4] {
+    [v[0].re, v[0].im, v[1].re, v[1].im].map(|x| format!("{:016x}", x.to_bits()))
+}
+
+fn dec(v: &[String; 4]) -> Result<[Complex64; 2], String> {
+    let mut x = [0.0; 4];
+    for (o, s) in x.iter_mut().zip(v) {
+        if s.len() != 16 {
+            return Err(format!("`{s}` is not 16 hex digits"));
+        }
+        *o = f64::from_bits(u64::from_str_radix(s, 16).map_err(|e| format!("`{s}`: {e}"))?);
+    }
+    Ok([Complex64::new(x[0], x[1]), Complex64::new(x[2], x[3])])
+}
+
+impl PointFile {
+    /// The record of point `index` of the sweep named by `hash`.
+    pub fn new(hash: &str, index: usize, rate_dps: f64, lane: &LaneResult) -> Self {
+        Self {
+            format: POINT_FORMAT.to_string(),
+            config_sha256: hash.to_string(),
+            index,
+            rate_dps,
+            z: enc(&lane.z),
+            c: enc(&lane.c),
+            s: enc(&lane.s),
+            table_phase: enc(&lane.table_phase),
+        }
+    }
+
+    /// The lane averages, bit for bit as they were computed.
+    pub fn lane(&self) -> Result<LaneResult, String> {
+        Ok(LaneResult {
+            z: dec(&self.z)?,
+            c: dec(&self.c)?,
+            s: dec(&self.s)?,
+            table_phase: dec(&self.table_phase)?,
+        })
+    }
+
+    /// The file name of point `index`.
+    pub fn file_name(index: usize) -> String {
+        format!("point-{index}.json")
+    }
+}
+
+/// Atomically writes point `index` into `out/points/` (the folder is created).
+pub fn write_point(
+    out: &Path,
+    hash: &str,
+    index: usize,
+    rate_dps: f64,
+    lane: &LaneResult,
+) -> Result<(), String> {
+    let dir = out.join(POINTS_DIR);
+    std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
+    let rec = PointFile::new(hash, index, rate_dps, lane);
+    gyroemu_io::write_json(&dir.join(PointFile::file_name(index)), &rec).map_err(|e| e.to_string())
+}
+
+/// Every point file found in `out/points/`, with its path, or why it could not be read.
+pub struct PointScan {
+    /// Readable point files.
+    pub files: Vec<(PathBuf, PointFile)>,
+    /// Files in the folder that are not valid point files: (path, reason).
+    pub bad: Vec<(PathBuf, String)>,
+}
+
+impl PointScan {
+    /// The config hashes present, with how many files carry each.
+    pub fn hashes(&self) -> BTreeMap<&str, usize> {
+        let mut m = BTreeMap::new();
+        for (_, f) in &self.files {
+            *m.entry(f.config_sha256.as_str()).or_insert(0) += 1;
+        }
+        m
+    }
+
+    /// The lane results of the sweep `hash` with `n_points` points, by index. Errors name a
+    /// point present twice (two files with the same index), an index out of range, or a
+    /// file whose data do not decode.
+    pub fn lanes(
+        &self,
+        hash: &str,
+        n_points: usize,
+    ) -> Result<BTreeMap<usize, LaneResult>, String> {
+        let mut out = BTreeMap::new();
+        let mut from: BTreeMap<usize, &Path> = BTreeMap::new();
+        for (path, f) in self.files.iter().filter(|(_, f)| f.config_sha256 == hash) {
+            if f.index >= n_points {
+                return Err(format!(
+                    "`{}` holds point {} but the config has {n_points} points (0..{})",
+                    path.display(),
+                    f.index,
+                    n_points.saturating_sub(1)
+                ));
+            }
+            if let Some(prev) = from.insert(f.index, path) {
+                return Err(format!(
+                    "point {} is duplicated: `{}` and `{}` both hold it",
+                    f.index,
+                    prev.display(),
+                    path.display()
+                ));
+            }
+            let lane = f.lane().map_err(|e| format!("`{}`: {e}", path.display()))?;
+            out.insert(f.index, lane);
+        }
+        Ok(out)
+    }
+}
+
+/// Reads every `*.json` file in `out/points/` (none when the folder does not exist; hidden
+/// temporary files of an interrupted write are skipped).
+pub fn scan_points(out: &Path) -> Result<PointScan, String> {
+    let dir = out.join(POINTS_DIR);
+    let mut scan = PointScan {
+        files: Vec::new(),
+        bad: Vec::new(),
+    };
+    let entries = match std::fs::read_dir(&dir) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(scan),
+        Err(e) => return Err(format!("cannot read `{}`: {e}", dir.display())),
+    };
+    let mut paths: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let name = p.file_name().map(|n| n.to_string_lossy().into_owned());
+            name.is_some_and(|n| !n.starts_with('.') && n.ends_with(".json"))
+        })
+        .collect();
+    paths.sort();
+    for p in paths {
+        let parsed = std::fs::read_to_string(&p)
+            .map_err(|e| e.to_string())
+            .and_then(|t| serde_json::from_str::<PointFile>(&t).map_err(|e| e.to_string()))
+            .and_then(|f| {
+                if f.format == POINT_FORMAT {
+                    Ok(f)
+                } else {
+                    Err(format!("format `{}`, expected `{POINT_FORMAT}`", f.format))
+                }
+            });
+        match parsed {
+            Ok(f) => scan.files.push((p, f)),
+            Err(e) => scan.bad.push((p, e)),
+        }
+    }
+    Ok(scan)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lane_bits_round_trip_exactly() {
+        let odd = [
+            0.1,
+            -0.0,
+            f64::MIN_POSITIVE / 3.0,
+            1.0 / 3.0,
+            f64::MAX,
+            -2.5e-300,
+            core::f64::consts::PI,
+            7.0,
+        ];
+        let c = |i: usize| {
+            [
+                Complex64::new(odd[i], odd[7 - i]),
+                Complex64::new(odd[i + 1], 1e-17),
+            ]
+        };
+        let lane = LaneResult {
+            z: c(0),
+            c: c(1),
+            s: c(2),
+            table_phase: c(3),
+        };
+        let f = PointFile::new("abc", 3, 25.0, &lane);
+        let text = serde_json::to_string(&f).unwrap();
+        let back: PointFile = serde_json::from_str(&text).unwrap();
+        let l2 = back.lane().unwrap();
+        let bits = |l: &LaneResult| {
+            [l.z, l.c, l.s, l.table_phase]
+                .iter()
+                .flat_map(|v| [v[0].re, v[0].im, v[1].re, v[1].im])
+                .map(f64::to_bits)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bits(&l2), bits(&lane));
+    }
+
+    #[test]
+    fn sha256_hex_matches_the_fips_180_example() {
+        assert_eq!(
+            hex(&Sha256::digest(b"abc")),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+    }
+
+    #[test]
+    fn hash_ignores_comments_and_spelling_but_not_values() {
+        let base = gyroemu_config::presets::preset("m2tfg-coriolis").unwrap();
+        let text = canonical_toml(&base);
+        let reparsed = gyroemu_config::parse_config(&format!("# a comment\n{text}")).unwrap();
+        assert_eq!(config_hash(&reparsed), config_hash(&base));
+        let mut other = base.clone();
+        other.device.q += 1.0;
+        assert_ne!(config_hash(&other), config_hash(&base));
+        assert_eq!(config_hash(&base).len(), 64);
+    }
+}

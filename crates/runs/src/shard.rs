@@ -1,0 +1,189 @@
+//! Which share of a sweep's operating points this process runs: `--shard i/n`, or the index a
+//! scheduler gives an array task (Slurm job arrays, Kubernetes Indexed Jobs). Point `p` belongs
+//! to shard `p % n`, so the assignment depends on nothing but the config and `n`.
+
+use crate::error::RunError;
+
+/// Shard `index` of `count` (0-based), and where that came from (for messages).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Shard {
+    pub index: usize,
+    pub count: usize,
+    pub source: String,
+}
+
+/// The environment variable giving the shard count beside `JOB_COMPLETION_INDEX`.
+pub const SHARD_COUNT_ENV: &str = "GYROEMU_SHARD_COUNT";
+
+impl Shard {
+    /// The points of `n_points` that this shard runs: `p % count == index`.
+    pub fn points(&self, n_points: usize) -> Vec<usize> {
+        (self.index..n_points).step_by(self.count).collect()
+    }
+
+    /// The manifest name of this shard inside the output folder.
+    pub fn manifest_name(&self) -> String {
+        format!("shard-{}-of-{}.json", self.index, self.count)
+    }
+
+    fn new(index: i64, count: i64, source: String) -> Result<Self, RunError> {
+        if count < 1 {
+            return Err(RunError::BadInput(format!(
+                "{source}: shard count {count} must be at least 1"
+            )));
+        }
+        if index < 0 || index >= count {
+            return Err(RunError::BadInput(format!(
+                "{source}: shard index {index} must be in 0..{} (0-based, below the count {count})",
+                count - 1
+            )));
+        }
+        Ok(Self {
+            index: index as usize,
+            count: count as usize,
+            source,
+        })
+    }
+}
+
+fn int(name: &str, text: &str) -> Result<i64, RunError> {
+    text.trim()
+        .parse()
+        .map_err(|_| RunError::BadInput(format!("{name} = `{text}`: not an integer")))
+}
+
+/// Parses `i/n` (0 <= i < n).
+pub fn parse_shard(text: &str) -> Result<Shard, RunError> {
+    let src = format!("--shard {text}");
+    let (i, n) = text
+        .split_once('/')
+        .ok_or_else(|| RunError::BadInput(format!("{src}: expected INDEX/COUNT, e.g. 0/4")))?;
+    Shard::new(int("--shard index", i)?, int("--shard count", n)?, src)
+}
+
+/// The shard of this process: `--shard` if given, else the Slurm array task
+/// (`SLURM_ARRAY_TASK_ID` minus `SLURM_ARRAY_TASK_MIN`, over `SLURM_ARRAY_TASK_STEP`, of
+/// `SLURM_ARRAY_TASK_COUNT` shards, or of those `MIN` to `SLURM_ARRAY_TASK_MAX`), else a Kubernetes Indexed Job
+/// (`JOB_COMPLETION_INDEX` with `--shard-count` or `GYROEMU_SHARD_COUNT`); `None`: no sharding.
+pub fn resolve_shard(
+    flag: Option<&str>,
+    count_flag: Option<usize>,
+    env: &dyn Fn(&str) -> Option<String>,
+) -> Result<Option<Shard>, RunError> {
+    if let Some(f) = flag {
+        return parse_shard(f).map(Some);
+    }
+    if let Some(id) = env("SLURM_ARRAY_TASK_ID") {
+        let id = int("SLURM_ARRAY_TASK_ID", &id)?;
+        let min = env("SLURM_ARRAY_TASK_MIN")
+            .map(|m| int("SLURM_ARRAY_TASK_MIN", &m))
+            .transpose()?
+            .unwrap_or(0);
+        let step = env("SLURM_ARRAY_TASK_STEP")
+            .map(|m| int("SLURM_ARRAY_TASK_STEP", &m))
+            .transpose()?
+            .unwrap_or(1)
+            .max(1);
+        let count = match (
+            count_flag,
+            env("SLURM_ARRAY_TASK_COUNT"),
+            env("SLURM_ARRAY_TASK_MAX"),
+        ) {
+            (Some(n), _, _) => n as i64,
+            (None, Some(c), _) => int("SLURM_ARRAY_TASK_COUNT", &c)?,
+            (None, None, Some(max)) => (int("SLURM_ARRAY_TASK_MAX", &max)? - min) / step + 1,
+            _ => {
+                return Err(RunError::BadInput(
+                    "SLURM_ARRAY_TASK_ID is set but neither SLURM_ARRAY_TASK_COUNT nor \
+                     SLURM_ARRAY_TASK_MAX: give --shard-count N"
+                        .into(),
+                ))
+            }
+        };
+        let src = format!("SLURM_ARRAY_TASK_ID = {}", id);
+        if (id - min) % step != 0 {
+            return Err(RunError::BadInput(format!(
+                "{src} is not on the array's grid (SLURM_ARRAY_TASK_MIN = {min}, step {step})"
+            )));
+        }
+        return Shard::new((id - min) / step, count, src).map(Some);
+    }
+    if let Some(idx) = env("JOB_COMPLETION_INDEX") {
+        let idx = int("JOB_COMPLETION_INDEX", &idx)?;
+        let count = match (count_flag, env(SHARD_COUNT_ENV)) {
+            (Some(n), _) => n as i64,
+            (None, Some(c)) => int(SHARD_COUNT_ENV, &c)?,
+            (None, None) => {
+                return Err(RunError::BadInput(format!(
+                    "JOB_COMPLETION_INDEX is set (Kubernetes Indexed Job) but the shard count is \
+                     not: give --shard-count N or set {SHARD_COUNT_ENV} to the Job's completions"
+                )))
+            }
+        };
+        let src = format!("JOB_COMPLETION_INDEX = {idx}");
+        return Shard::new(idx, count, src).map(Some);
+    }
+    if count_flag.is_some() {
+        return Err(RunError::BadInput(
+            "--shard-count needs a shard index: --shard I/N, SLURM_ARRAY_TASK_ID or \
+             JOB_COMPLETION_INDEX"
+                .into(),
+        ));
+    }
+    Ok(None)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn env_of(vars: &'static [(&'static str, &'static str)]) -> impl Fn(&str) -> Option<String> {
+        move |k| {
+            vars.iter()
+                .find(|(n, _)| *n == k)
+                .map(|(_, v)| v.to_string())
+        }
+    }
+
+    #[test]
+    fn flag_env_and_errors() {
+        let none = env_of(&[]);
+        assert_eq!(resolve_shard(None, None, &none).unwrap(), None);
+        let s = resolve_shard(Some("2/4"), None, &none).unwrap().unwrap();
+        assert_eq!((s.index, s.count), (2, 4));
+        assert_eq!(s.points(11), vec![2, 6, 10]);
+        for bad in ["4/4", "1", "-1/3", "a/2", "0/0"] {
+            assert!(resolve_shard(Some(bad), None, &none).is_err(), "{bad}");
+        }
+        let slurm = env_of(&[
+            ("SLURM_ARRAY_TASK_ID", "3"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ]);
+        let s = resolve_shard(None, None, &slurm).unwrap().unwrap();
+        assert_eq!((s.index, s.count), (3, 4));
+        // An array 1-4: ids 1..=4 map to shards 0..=3.
+        let slurm = env_of(&[
+            ("SLURM_ARRAY_TASK_ID", "1"),
+            ("SLURM_ARRAY_TASK_MIN", "1"),
+            ("SLURM_ARRAY_TASK_MAX", "4"),
+        ]);
+        let s = resolve_shard(None, None, &slurm).unwrap().unwrap();
+        assert_eq!((s.index, s.count), (0, 4));
+        // An array 10-16:2 (10, 12, 14, 16): id 14 is shard 2 of 4.
+        let slurm = env_of(&[
+            ("SLURM_ARRAY_TASK_ID", "14"),
+            ("SLURM_ARRAY_TASK_MIN", "10"),
+            ("SLURM_ARRAY_TASK_MAX", "16"),
+            ("SLURM_ARRAY_TASK_STEP", "2"),
+        ]);
+        let s = resolve_shard(None, None, &slurm).unwrap().unwrap();
+        assert_eq!((s.index, s.count), (2, 4));
+        let k8s = env_of(&[("JOB_COMPLETION_INDEX", "5")]);
+        assert!(resolve_shard(None, None, &k8s).is_err());
+        let s = resolve_shard(None, Some(8), &k8s).unwrap().unwrap();
+        assert_eq!((s.index, s.count), (5, 8));
+        let k8s = env_of(&[("JOB_COMPLETION_INDEX", "5"), (SHARD_COUNT_ENV, "6")]);
+        assert_eq!(resolve_shard(None, None, &k8s).unwrap().unwrap().count, 6);
+        assert!(resolve_shard(None, Some(3), &none).is_err());
+    }
+}

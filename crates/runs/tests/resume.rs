@@ -1,0 +1,162 @@
+//! The run lifecycle as a library: a run cancelled after its first saved lane group keeps
+//! exactly the saved points, marks its manifest interrupted and writes no results; the rerun
+//! computes only the missing points and its outputs equal an uninterrupted run's byte for
+//! byte; a third run reuses everything. A cancel raised before the start saves nothing.
+
+use gyroemu_config::{parse_config, Config};
+use gyroemu_experiment::Quiet;
+use gyroemu_runs::{prepare_out, run, RunError, RunOutcome, RunRequest};
+use serde_json::Value;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// A Coriolis sweep with every noise source (so each point's random stream matters): nine
+/// listed rates plus the implicit zero, three lane groups.
+const NOISY: &str = r#"
+[device]
+f0_hz = 15000.0
+q = 1000.0
+angular_gain = 1.0
+[drive]
+f1 = 1.0
+f2 = 1.0
+[board]
+fs_hz = 240000.0
+lpf_cutoff_hz = 200.0
+decimation = 100
+adc_bits = 14
+adc_full_scale_v = 0.1
+[experiment]
+kind = "coriolis"
+rates_dps = [25.0, 50.0, 75.0, 100.0, 125.0, 150.0, 175.0, 200.0, 225.0]
+average_s = 0.2
+settle_s = 0.25
+[noise]
+seed = 7
+effective_mass_kg = 1e-9
+tia_current_noise_a_per_rthz = 1e-13
+tia_voltage_noise_v_per_rthz = 2e-8
+"#;
+
+fn config() -> Config {
+    let c = parse_config(NOISY).unwrap();
+    c.validate().unwrap();
+    c
+}
+
+/// Runs `cfg` into `out` on one worker thread (lane groups in turn), raising the cancel flag
+/// once `stop_after` points are saved.
+fn run_into(cfg: &Config, out: &Path, stop_after: Option<usize>) -> Result<RunOutcome, RunError> {
+    prepare_out(out).unwrap();
+    let cancel = Arc::new(AtomicBool::new(stop_after == Some(0)));
+    let flag = cancel.clone();
+    let on_saved = move |k: usize| {
+        if stop_after.is_some_and(|s| k >= s) {
+            flag.store(true, Ordering::SeqCst);
+        }
+    };
+    let req = RunRequest {
+        config: cfg,
+        out,
+        shard: None,
+        force: false,
+        cancel,
+        on_saved: Some(&on_saved),
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    pool.install(|| run(&req, &Quiet))
+}
+
+fn json(p: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+fn indices(v: &Value) -> Vec<u64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_u64().unwrap())
+        .collect()
+}
+
+fn point_files(out: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(out.join("points"))
+        .map(|d| {
+            d.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+#[test]
+fn interrupted_run_resumes_to_byte_identical_outputs() {
+    let cfg = config();
+    let dir = tempfile::tempdir().unwrap();
+    let reference = dir.path().join("ref");
+    let RunOutcome::Complete(files) = run_into(&cfg, &reference, None).unwrap() else {
+        panic!("a whole run completes");
+    };
+    assert_eq!(
+        files.len(),
+        4,
+        "results.csv, summary.json, plot.png, manifest.json"
+    );
+
+    let out = dir.path().join("out");
+    let e = run_into(&cfg, &out, Some(1)).unwrap_err();
+    assert!(matches!(&e, RunError::Interrupted(m) if m.contains("rerun the same command")));
+    let m = json(&out.join("manifest.json"));
+    assert_eq!(m["status"], "interrupted");
+    // One lane group of four points finished before the flag stopped the rest.
+    let (done, missing) = (indices(&m["points_done"]), indices(&m["points_missing"]));
+    assert_eq!(done, vec![0, 1, 2, 3]);
+    assert_eq!(missing, (4..10).collect::<Vec<_>>());
+    assert_eq!(
+        point_files(&out),
+        [
+            "point-0.json",
+            "point-1.json",
+            "point-2.json",
+            "point-3.json"
+        ]
+    );
+    for f in gyroemu_report::RUN_FILES {
+        assert!(!out.join(f).exists(), "{f} written by an interrupted run");
+    }
+
+    // The rerun computes the six missing points only; the outputs equal the reference's.
+    let saved_before = std::fs::read(out.join("points/point-2.json")).unwrap();
+    run_into(&cfg, &out, None).unwrap();
+    assert_eq!(
+        std::fs::read(out.join("points/point-2.json")).unwrap(),
+        saved_before
+    );
+    for f in gyroemu_report::RUN_FILES {
+        let (a, b) = (reference.join(f), out.join(f));
+        assert_eq!(
+            std::fs::read(&a).unwrap(),
+            std::fs::read(&b).unwrap(),
+            "{f}"
+        );
+    }
+    assert_eq!(json(&out.join("manifest.json"))["status"], "complete");
+}
+
+#[test]
+fn a_cancel_before_the_start_saves_nothing_and_says_so() {
+    let cfg = config();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let e = run_into(&cfg, &out, Some(0)).unwrap_err();
+    assert!(matches!(e, RunError::Interrupted(_)), "{e}");
+    assert!(point_files(&out).is_empty());
+    let m = json(&out.join("manifest.json"));
+    assert_eq!(m["status"], "interrupted");
+    assert_eq!(indices(&m["points_missing"]).len(), 10);
+}

@@ -1,0 +1,118 @@
+//! The exact theory of what each experiment measures, for a device driven as the board drives
+//! it, ideal or not: the closed forms for an ideal device, else the continuous-time steady
+//! state of the imperfect plant read as THEORY.md section 6 reads it.
+
+use crate::closed_form::{coriolis_theta_rad, rate_table_gain, rotating_psi_rad};
+use gyroemu_core::Complex64;
+use gyroemu_resonator::{continuous_steady_state, ResonatorParams};
+
+const DEG: f64 = core::f64::consts::PI / 180.0;
+
+/// A device and the drive the board gives it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DrivenDevice {
+    /// The plant (its `fs_hz` is not used: the theory is continuous-time).
+    pub plant: ResonatorParams,
+    /// Drive amplitudes F1, F2.
+    pub drive: [f64; 2],
+    /// Error of the board's 90-degree phase shifter, degrees.
+    pub phase_shifter_error_deg: f64,
+}
+
+/// Phase lag of `x` behind the reference `x0`, in (-pi, pi]: `arg(x0 / x)` (the branch of
+/// the read-out's own `phase_lag_rad`).
+fn lag_rad(x: Complex64, x0: Complex64) -> f64 {
+    let a = (x0 * x.conj()).arg();
+    if a <= -core::f64::consts::PI {
+        core::f64::consts::PI
+    } else {
+        a
+    }
+}
+
+impl DrivenDevice {
+    /// Matched modes, equal Q, no quadrature coupling and an exact phase shifter: the closed
+    /// forms apply.
+    pub fn is_ideal(&self) -> bool {
+        let p = &self.plant;
+        p.mode2.f0_hz == p.mode1.f0_hz
+            && p.mode2.q == p.mode1.q
+            && p.quadrature_coupling_rad2_s2 == 0.0
+            && self.phase_shifter_error_deg == 0.0
+    }
+
+    fn f0(&self) -> f64 {
+        self.plant.mode1.f0_hz
+    }
+
+    /// Coriolis phase shift per mode at the constant rate `omega` (rad/s) against zero rate
+    /// (each mode against its own drive): eqs. 2-3, or the steady state of the imperfect plant.
+    pub fn coriolis_phase_rad(&self, omega: f64) -> [f64; 2] {
+        let p = &self.plant;
+        let [f1, f2] = self.drive;
+        if self.is_ideal() {
+            return coriolis_theta_rad(self.f0(), p.mode1.q, p.angular_gain, f1, f2, omega);
+        }
+        let shift = (90.0 + self.phase_shifter_error_deg) * DEG;
+        let force = [Complex64::new(f1, 0.0), Complex64::from_polar(f2, -shift)];
+        let v = |w: f64| continuous_steady_state(p, w, self.f0(), force);
+        let (x0, x) = (v(0.0), v(omega));
+        [lag_rad(x[2], x0[2]), lag_rad(x[3], x0[3])]
+    }
+
+    /// Rotating-excitation psi per mode at excitation rate `omega` (rad/s): the closed form
+    /// for an ideal device; otherwise the major-axis estimator applied to the continuous-time
+    /// velocity phasors of the imperfect plant at the two sidebands w0 +- Omega (drive
+    /// sidebands F1/2, F1/2 on mode 1 and -j F2/2, +j F2/2 on mode 2), psi_k = (arg(V_k(-)/M-)
+    /// - arg(V_k(+)/M+))/2 as in THEORY.md section 6. A phase-shifter error eps makes the
+    ///   mode-2 modulation sin(Omega t - eps), which turns its sidebands by e^{-+j eps}.
+    pub fn rotating_psi_rad(&self, omega: f64) -> [f64; 2] {
+        let p = &self.plant;
+        if self.is_ideal() || omega == 0.0 {
+            return [rotating_psi_rad(self.f0(), p.mode1.q, omega); 2];
+        }
+        let fm = omega / core::f64::consts::TAU;
+        let [f1, f2] = self.drive;
+        let j = Complex64::new(0.0, 1.0);
+        let eps = self.phase_shifter_error_deg * DEG;
+        let v = |sign: f64| {
+            let turn = Complex64::from_polar(1.0, -sign * eps);
+            let force = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
+            continuous_steady_state(p, 0.0, self.f0() + sign * fm, force)
+        };
+        let (vp, vm) = (v(1.0), v(-1.0));
+        let m = [
+            (Complex64::new(1.0, 0.0), Complex64::new(1.0, 0.0)),
+            (-j, j),
+        ];
+        [0, 1].map(|k| {
+            let (mp, mm) = m[k];
+            0.5 * ((vm[2 + k] / mm).arg() - (vp[2 + k] / mp).arg())
+        })
+    }
+
+    /// Small-signal phase amplitude per unit rate-table amplitude at `table_hz`, per mode
+    /// (rad per rad/s): the first-order model of THEORY.md section 3.
+    pub fn rate_table_gain(&self, table_hz: f64) -> [f64; 2] {
+        let p = &self.plant;
+        let [f1, f2] = self.drive;
+        let g = |a: f64, b: f64| {
+            rate_table_gain(self.f0(), p.mode1.q, p.angular_gain, a, b, table_hz).0
+        };
+        [g(f1, f2), g(f2, f1)]
+    }
+
+    /// Small-angle Coriolis slope per mode, rad per rad/s: 2 Q lambda / w0 times the drive ratio
+    /// of the other mode over this one.
+    pub fn coriolis_slope(&self) -> [f64; 2] {
+        let p = &self.plant;
+        let [f1, f2] = self.drive;
+        let g = 2.0 * p.mode1.q * p.angular_gain / (2.0 * core::f64::consts::PI * self.f0());
+        [g * f2 / f1, g * f1 / f2]
+    }
+
+    /// Small-angle rotating slope, rad per rad/s: 2 Q / w0 (both modes).
+    pub fn rotating_slope(&self) -> [f64; 2] {
+        [2.0 * self.plant.mode1.q / (2.0 * core::f64::consts::PI * self.f0()); 2]
+    }
+}
