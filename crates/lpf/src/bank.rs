@@ -7,8 +7,8 @@ use gyroemu_core::{Complex64, Response, Sample, Stage};
 /// `C` channels through the same [`LowPass`] (the board's I and Q of both modes): each
 /// channel's output equals a `LowPass` of its own bit for bit (the same cascade code runs
 /// both), but the cascade's shape (section count, first-order section, filter kind) is read
-/// once per sample for all channels and each coefficient is loaded once for all of them. Per
-/// channel and per sample that removed about 25 instructions of loop control.
+/// once per sample for all channels and each coefficient is loaded once for all of them (the
+/// loop control is paid once, not per channel; figures in docs/performance.md).
 #[derive(Clone, Debug)]
 pub struct LowPassBank<S, const C: usize> {
     proto: LowPass<S>,

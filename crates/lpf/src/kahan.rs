@@ -9,7 +9,7 @@ use gyroemu_core::Sample;
 /// Form: Knuth's branch-free TwoSum gives the exact rounding error of each addition, which is
 /// accumulated apart (the Kahan-Babuska/Neumaier sum without its magnitude test; Ogita-Rump-
 /// Oishi "Sum2"). Unlike classic Kahan it stays exact when a term exceeds the running sum,
-/// and the loop-carried dependency is one addition (not four), so it runs about 3x faster.
+/// and the loop-carried dependency is one addition (not four), so it pipelines better.
 /// Branch-free, so it is generic over `S` and every lane of `f64x4` gives the scalar bits.
 /// It relies on IEEE evaluation order: it must never be compiled with fast-math /
 /// reassociation, which would simplify the error term to zero.
