@@ -1,10 +1,13 @@
 //! The responses of the board's own linear stages, built by the same code the board runs, so
 //! that the read-out compensates exactly the chain that produced the data.
 
+use crate::board::modulation_hz;
 use crate::params::{build_dac, build_lowpass, build_tia, BoardParams};
+use crate::point::Point;
 use gyroemu_am::Dac;
 use gyroemu_core::{Complex64, ParamResult, Response};
-use gyroemu_lpf::LowPass;
+use gyroemu_lpf::{KahanSum, LowPass};
+use gyroemu_nco::{phasor_of_word, Nco};
 use gyroemu_tia::Tia;
 
 /// The linear stages between the drive and the stage-2 read-out, as built.
@@ -45,6 +48,40 @@ impl ChainResponse {
     /// filter's output at input sample kM + M - 1, so no delay is added by decimation).
     pub fn lowpass(&self, f_hz: f64) -> Complex64 {
         self.lowpass.response(f_hz)
+    }
+
+    /// The stage-2 window leak of a rotating point: `W = sum_j w_j e^{j 2 Omega t_j} / sum_j
+    /// w_j` over the point's averaging window, with `t_j` the instants of the decimated
+    /// samples it averages (input index (n_settle + j) M + M - 1) and `Omega` the modulation
+    /// oscillator's exact frequency. Stage 2 averages `2 z cos(Omega t)` and `2 z sin(Omega t)`
+    /// over that window; with `z = Z+ e^{j Omega t} + Z- e^{-j Omega t}` its averages are
+    /// `(C - jS)/2 = Z+ + conj(W) Z-` and `(C + jS)/2 = Z- + W Z+`, so `W` is exactly what a
+    /// window of a not quite whole number of half periods leaks (0 for whole periods of a
+    /// continuous average). [`unleak_sidebands`] undoes it.
+    pub fn stage2_leak(&self, point: &Point, n_settle: u64) -> ParamResult<Complex64> {
+        let nco = Nco::new(
+            modulation_hz(crate::params::Shape::Rotating, point.rate_rad_s),
+            self.fs_hz,
+            0.0,
+        )?;
+        let step = nco.step_word();
+        let m = self.decimation as u64;
+        let (mut sum, mut wsum) = (KahanSum::<f64>::new(), KahanSum::<f64>::new());
+        let (mut sum_im, samples) = (KahanSum::<f64>::new(), point.window.samples());
+        for j in 0..samples {
+            let w = point.window.weight(j);
+            if w == 0.0 {
+                continue;
+            }
+            let n = (n_settle + j) * m + m - 1;
+            // The oscillator's phase word at sample n, doubled: e^{j 2 Omega t_n} exactly as
+            // the word arithmetic defines it (wrapping is the 2 pi periodicity).
+            let p = phasor_of_word(step.wrapping_mul(n).wrapping_mul(2));
+            sum.add(w * p.re);
+            sum_im.add(w * p.im);
+            wsum.add(w);
+        }
+        Ok(Complex64::new(sum.value(), sum_im.value()) / wsum.value())
     }
 
     /// The carrier frequency, Hz.
@@ -91,4 +128,20 @@ impl RotatingTerms {
     pub fn total_rad(&self) -> f64 {
         self.tia_rad + self.dac_hold_rad + self.lowpass_rad
     }
+}
+
+/// The sideband phasors `(Z+, Z-)` of a rotating point from its stage-2 averages `C`, `S` and
+/// the window leak `w` of [`ChainResponse::stage2_leak`]: the averages are `B = (C - jS)/2 =
+/// Z+ + conj(w) Z-` and `A = (C + jS)/2 = Z- + w Z+`, solved exactly:
+/// `Z+ = (B - conj(w) A) / (1 - |w|^2)`, `Z- = (A - w B) / (1 - |w|^2)`. Returned as the
+/// `(C, S)` a leak-free window would have given, `C = Z+ + Z-`, `S = j (Z+ - Z-)`, so every
+/// estimator reads them unchanged.
+pub fn unleak_sidebands(c: Complex64, s: Complex64, w: Complex64) -> (Complex64, Complex64) {
+    let j = Complex64::new(0.0, 1.0);
+    let b = (c - j * s) * 0.5;
+    let a = (c + j * s) * 0.5;
+    let det = 1.0 - w.norm_sqr();
+    let zp = (b - w.conj() * a) / det;
+    let zm = (a - w * b) / det;
+    (zp + zm, j * (zp - zm))
 }

@@ -16,7 +16,7 @@ mod probe;
 pub mod reference;
 
 pub use board::{Board, MAX_LANES};
-pub use chain::{ChainResponse, RotatingTerms};
+pub use chain::{unleak_sidebands, ChainResponse, RotatingTerms};
 pub use fault::NonFinite;
 pub use params::{BoardParams, Converter, NoiseParams, Shape};
 pub use point::{LaneResult, Point, RunOptions, RunOutput};

@@ -3,10 +3,10 @@
 //! the paper's best linear fit.
 
 use crate::fit::{fit_line, LineFit};
-use gyroemu_board::{ChainResponse, LaneResult, Point, Shape};
+use gyroemu_board::{unleak_sidebands, ChainResponse, LaneResult, Point, Shape};
 use gyroemu_config::Config;
 use gyroemu_core::{Complex64, ParamError};
-use gyroemu_mixer::{paper_i_channel_psi_rad, phase_lag_rad, sideband_estimate, Mode};
+use gyroemu_mixer::{paper_i_channel_psi_rad, phase_lag_rad, sideband_estimate, wrap_pi, Mode};
 use gyroemu_theory::DrivenDevice;
 use serde::Serialize;
 
@@ -88,6 +88,23 @@ impl SweepResult {
             .map(|p| ((p.phase_deg[mode] - p.theory_deg[mode]) * 1e3).abs())
             .fold(0.0, f64::max)
     }
+}
+
+/// `x` moved by a whole number of half turns into `(-pi/2, pi/2]`, and whether that number
+/// was odd.
+fn fold_half_turn(x: f64) -> (f64, bool) {
+    use core::f64::consts::{FRAC_PI_2, PI};
+    let k = (x / PI).round();
+    let mut y = x - k * PI;
+    let mut odd = k.rem_euclid(2.0) == 1.0;
+    if y <= -FRAC_PI_2 {
+        y += PI;
+        odd = !odd;
+    } else if y > FRAC_PI_2 {
+        y -= PI;
+        odd = !odd;
+    }
+    (y, odd)
 }
 
 /// The device and drive of a config, for the theory.
@@ -185,14 +202,28 @@ pub fn post_process(
                 let mut raw = [0.0; 2];
                 let mut paper = [0.0; 2];
                 let mut alpha = [0.0; 2];
+                // The window is a not quite whole number of half periods of decimated samples:
+                // its exact leak is removed before the sidebands are read.
+                let leak = chain.stage2_leak(&points[i], cfg.n_settle_out())?;
                 for (k, mode) in [Mode::One, Mode::Two].into_iter().enumerate() {
-                    let est = sideband_estimate(lr.c[k], lr.s[k], mode);
-                    raw[k] = est.psi_rad / DEG;
-                    alpha[k] = est.alpha_rad / DEG;
-                    r.phase_deg[k] = (est.psi_rad - total) / DEG;
+                    let (c, s) = unleak_sidebands(lr.c[k], lr.s[k], leak);
+                    let est = sideband_estimate(c, s, mode);
+                    // (psi, alpha) and (psi + pi, alpha + pi) give the same sidebands. The
+                    // plant's psi lies in (-90, 90) degrees and the chain adds up to 180 more
+                    // (the low-pass near its cutoff), so the branch is chosen once the chain
+                    // is removed, not before.
+                    let (psi, turned) = fold_half_turn(est.psi_rad - total);
+                    let a = if turned {
+                        wrap_pi(est.alpha_rad + core::f64::consts::PI)
+                    } else {
+                        est.alpha_rad
+                    };
+                    r.phase_deg[k] = psi / DEG;
+                    raw[k] = (psi + total) / DEG;
+                    alpha[k] = a / DEG;
                     // A real channel cannot tell the sign of the carrier (an inverting TIA
                     // flips it): fold the paper-style reading into (-90, 90] degrees.
-                    let p = paper_i_channel_psi_rad(lr.c[k], lr.s[k], mode) - total;
+                    let p = paper_i_channel_psi_rad(c, s, mode) - total;
                     paper[k] =
                         (p - core::f64::consts::PI * (p / core::f64::consts::PI).round()) / DEG;
                 }
