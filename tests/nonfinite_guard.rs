@@ -1,4 +1,6 @@
-//! A value that overflows inside the chain stops the run and names the stage and the sample.
+//! Validation refuses a chain whose signals would overflow; a library user who runs it anyway
+//! meets the second line of defence: a value that overflows inside the chain stops the run and
+//! names the stage and the sample.
 //! A matched mode driven at resonance from rest has the velocity envelope
 //! v(t) = F Q / w0 (1 - exp(-t / tau)), tau = 2 Q / w0; the TIA output envelope is
 //! v * t_a * R * |H(f0)|. The stage-1 mixer doubles it (2 y cos w0t), so the first value to
@@ -17,7 +19,8 @@ fn overflow_names_the_stage_and_the_sample() {
     c.drive.f1 = f;
     c.drive.f2 = f;
     c.experiment.average_s = 0.1;
-    c.validate().expect("each value is finite and in range");
+    let refused = c.validate().expect_err("the drive is far beyond 1e100");
+    assert_eq!(refused.key.as_deref(), Some("drive.f1"), "{refused}");
     let d = &c.device;
     let w0 = 2.0 * PI * d.f0_hz;
     let tau = 2.0 * d.q / w0;

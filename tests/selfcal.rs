@@ -138,3 +138,27 @@ fn noisy_selfcal_errors_scatter_as_their_reported_confidence() {
     let again = run_selfcal_core(&c, &quiet, &quiet).unwrap().modes[0].relative_error;
     assert_eq!(again.to_bits(), errs[0].to_bits());
 }
+
+#[test]
+fn selfcal_refuses_too_few_distinct_rates_naming_the_key() {
+    // One rate: no slope; two: a slope without a confidence interval; zero and repeats do not
+    // count. Three distinct non-zero rates pass.
+    for rates in [
+        &[100.0][..],
+        &[0.0, 100.0, 100.0],
+        &[50.0, 100.0],
+        &[0.0, 50.0, 100.0, 50.0],
+    ] {
+        let e = validate_selfcal(&fast_cfg(rates, 7.2)).unwrap_err();
+        assert_eq!(
+            e.key.as_deref(),
+            Some("experiment.rates_dps"),
+            "{rates:?}: {e}"
+        );
+        assert!(
+            e.detail.contains("at least 3 distinct non-zero rates"),
+            "{e}"
+        );
+    }
+    validate_selfcal(&fast_cfg(&[50.0, 100.0, 150.0], 7.2)).unwrap();
+}

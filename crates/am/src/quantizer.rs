@@ -53,6 +53,19 @@ impl<S: Sample> Quantizer<S> {
             .clamp_to(self.code_lo, self.code_hi)
             * self.step
     }
+
+    /// [`Quantizer::quantize`] (the same bits), adding 1 in each lane to `clipped` where the
+    /// input lay beyond the end codes and to `zeros` where the output is exactly 0: how a
+    /// board tells a clipped or dead converter from a working one.
+    #[inline]
+    pub fn quantize_counting(&self, x: S, clipped: &mut S, zeros: &mut S) -> S {
+        let code = (x / self.step).round_away();
+        let kept = code.clamp_to(self.code_lo, self.code_hi);
+        *clipped += code.flag_ne(kept);
+        let y = kept * self.step;
+        *zeros += y.flag_eq(S::splat(0.0));
+        y
+    }
 }
 
 impl<S: Sample> Stage for Quantizer<S> {

@@ -2,7 +2,7 @@
 //! frequency response, parameter errors.
 
 use gyroemu_am::{Dac, Quantizer};
-use gyroemu_core::{Response, Stage};
+use gyroemu_core::{f64x4, Response, Sample, Stage};
 use num_complex::Complex64;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -153,4 +153,42 @@ fn bad_parameters_are_refused() {
         assert_eq!((e.stage, e.param), ("dac", "fs_hz"));
     }
     assert!(Quantizer::<f64>::new(2, 1.0).is_ok() && Quantizer::<f64>::new(32, 1.0).is_ok());
+}
+
+#[test]
+fn counting_quantizer_gives_the_same_bits_and_counts_clips_and_zeros() {
+    // 4 bits over +-1: step 1/8, codes -8..=7, so inputs beyond 7.5 steps up or 8.5 steps down
+    // clip, and inputs within half a step of 0 give an exact 0.
+    let q = Quantizer::<f64>::new(4, 1.0).unwrap();
+    let xs = [
+        0.0, 0.06, -0.0624, 0.0626, 0.93, 0.94, -1.06, -1.07, 5.0, -5.0,
+    ];
+    let clips = [0, 0, 0, 0, 0, 1, 0, 1, 1, 1];
+    let zeros = [1, 1, 1, 0, 0, 0, 0, 0, 0, 0];
+    for (i, &x) in xs.iter().enumerate() {
+        let (mut c, mut z) = (0.0, 0.0);
+        let y = q.quantize_counting(x, &mut c, &mut z);
+        assert_eq!(y.to_bits(), q.quantize(x).to_bits(), "x = {x}");
+        assert_eq!((c, z), (clips[i] as f64, zeros[i] as f64), "x = {x}");
+    }
+    // Lanes count on their own.
+    let v = Quantizer::<f64x4>::new(4, 1.0).unwrap();
+    let (mut c, mut z) = (f64x4::splat(0.0), f64x4::splat(0.0));
+    for chunk in xs.chunks(4).filter(|c| c.len() == 4) {
+        v.quantize_counting(f64x4::from_fn(|i| chunk[i]), &mut c, &mut z);
+    }
+    let (want_c, want_z): (Vec<f64>, Vec<f64>) = (0..4)
+        .map(|l| {
+            let sel = |t: &[i32; 10]| {
+                (0..8)
+                    .filter(|k| k % 4 == l)
+                    .map(|k| t[k] as f64)
+                    .sum::<f64>()
+            };
+            (sel(&clips), sel(&zeros))
+        })
+        .unzip();
+    for l in 0..4 {
+        assert_eq!((c.lane(l), z.lane(l)), (want_c[l], want_z[l]), "lane {l}");
+    }
 }

@@ -9,4 +9,4 @@ pub mod selfcal;
 pub mod selfcal_analyses;
 mod selfcal_run;
 
-pub use selfcal_run::{run_selfcal, SelfcalReport};
+pub use selfcal_run::{run_selfcal, selfcal_work, SelfcalReport};

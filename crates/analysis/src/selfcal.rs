@@ -130,6 +130,24 @@ pub fn drifted(cfg: &Config, delta_t_k: f64) -> Config {
 /// any sample is computed; returns the warnings they add to those of `cfg.validate()`.
 pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
     let base = cfg.validate()?;
+    // A slope needs two distinct rates besides zero, and its 95 % interval a third (the
+    // residual scatter has points - 2 degrees of freedom).
+    let mut distinct: Vec<f64> = Vec::new();
+    for &r in &cfg.experiment.rates_dps {
+        if r != 0.0 && !distinct.contains(&r) {
+            distinct.push(r);
+        }
+    }
+    if distinct.len() < 3 {
+        return Err(ConfigError::key(
+            "experiment.rates_dps",
+            format!("{:?}", cfg.experiment.rates_dps),
+            format!(
+                "selfcal needs at least 3 distinct non-zero rates (here {}): 2 for the slope of each sweep and a third for its 95 % confidence interval",
+                distinct.len()
+            ),
+        ));
+    }
     let mut warnings = Vec::new();
     let (rot, cor) = sweep_configs(cfg);
     let tag = |what: &str, e: ConfigError| ConfigError {

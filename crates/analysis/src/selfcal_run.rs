@@ -6,7 +6,7 @@ use crate::selfcal_analyses::{
     allan_analysis, drift_analysis, tau_analysis, AllanResult, DriftPoint, TauPoint,
 };
 use gyroemu_config::Config;
-use gyroemu_experiment::{run_sweep, Reporter, SweepError};
+use gyroemu_experiment::{run_sweep, sweep_work, Reporter, SweepError, Work};
 
 /// Everything `selfcal` measured.
 #[derive(Clone, Debug)]
@@ -77,4 +77,30 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
         taus,
         drift,
     })
+}
+
+/// What `selfcal` on `cfg` will emulate: both sweeps, then the Allan record (four streams),
+/// the averaging-time run and two sweeps per drift temperature.
+pub fn selfcal_work(cfg: &Config) -> Work {
+    let (rot, cor) = sweep_configs(cfg);
+    let mut w = sweep_work(&rot).plus(sweep_work(&cor));
+    let sc = cfg.selfcal.clone().unwrap_or_default();
+    if let Some(t) = sc.allan_record_s {
+        let mut a = cor.clone();
+        a.experiment.rates_dps = vec![0.0; 4];
+        a.experiment.average_s = t;
+        let m = sweep_work(&a);
+        // Four lanes of one group (the zero rate is listed, so no reference is added).
+        w = w.plus(Work { points: 4, ..m });
+    }
+    if let Some(t) = sc.tau_max_s {
+        let mut r = rot.clone();
+        r.experiment.average_s = t;
+        w = w.plus(sweep_work(&r));
+    }
+    for &dt in &sc.drift_delta_t_k {
+        let (r, c) = sweep_configs(&crate::selfcal::drifted(cfg, dt));
+        w = w.plus(sweep_work(&r)).plus(sweep_work(&c));
+    }
+    w
 }

@@ -134,7 +134,10 @@ pub struct Board<S: Sample> {
     pub(crate) noise: NoiseState<S>,
     /// ADC after each TIA (absent: ideal).
     pub(crate) adc: Option<[Quantizer<S>; 2]>,
-    /// Noise or ADC present: the sample loop takes its imperfect shape.
+    /// Noise sources present (their draws are made).
+    pub(crate) noise_on: bool,
+    /// Noise, a converter's quantiser or TIA rails present: the sample loop takes its
+    /// imperfect shape, which also counts clipped and zero samples.
     pub(crate) imperfect: bool,
     /// The board as built, for locating a non-finite value by replay.
     pub(crate) pristine: Option<Box<Board<S>>>,
@@ -177,7 +180,8 @@ impl<S: Sample> Board<S> {
         let rng = NoiseRng::new(core::array::from_fn(|i| stream_seed(seed, lane_stream(i))));
         let (sigma_force, sigma_current) = noise_sigmas(p);
         let adc = build_adc(p)?.map(|q| [q, q]);
-        let imperfect = p.noise.is_some() || adc.is_some();
+        let imperfect =
+            p.noise.is_some() || adc.is_some() || p.dac.is_some() || p.tia.rail_v.is_some();
         let eps = p.phase_shifter_error_deg.to_radians();
         let mod_shift = (p.shape.is_rotating() && eps != 0.0)
             .then(|| (S::splat(eps.cos()), S::splat(eps.sin())));
@@ -207,6 +211,7 @@ impl<S: Sample> Board<S> {
                 sigma_current: sigma_current.map(S::splat),
             },
             adc,
+            noise_on: p.noise.is_some(),
             imperfect,
             pristine: None,
             cancel: None,

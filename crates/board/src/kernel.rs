@@ -4,6 +4,7 @@
 
 use crate::board::{Board, CORIOLIS, RATE_TABLE, ROTATING};
 use crate::fault::NonFinite;
+use crate::health::{Counters, Health, ADC_CLIP, ADC_ZERO, DAC_CLIP, DAC_ZERO, TIA_RAIL};
 use crate::params::Shape;
 use crate::point::{LaneResult, Point, RunOptions, RunOutput};
 use crate::probe::Probe;
@@ -53,12 +54,13 @@ impl<S: Sample> Board<S> {
 
     /// One block of the checking replay, in the run's plant shape.
     pub(crate) fn replay_block(&mut self, n0: u64, probe: &mut Probe) {
+        let mut counts = Counters::default();
         macro_rules! by_plant {
             ($k:expr) => {
                 if self.plant_decoupled() {
-                    self.block::<$k, true, true>(n0, Some(probe));
+                    self.block::<$k, true, true>(n0, Some(probe), &mut counts);
                 } else {
-                    self.block::<$k, true, false>(n0, Some(probe));
+                    self.block::<$k, true, false>(n0, Some(probe), &mut counts);
                 }
             };
         }
@@ -97,13 +99,37 @@ impl<S: Sample> Board<S> {
         let mut early: Vec<Vec<LaneResult>> = vec![Vec::new(); lanes];
         let mut series: Vec<Vec<[f64; 8]>> = vec![Vec::new(); lanes];
         let mut series_acc = [S::splat(0.0); 8];
+        // Each lane counts its own run only, so its counts do not depend on its group.
+        let lane_end: Vec<u64> = points
+            .iter()
+            .take(lanes)
+            .map(|p| n_settle + p.window.samples())
+            .collect();
+        let mut health: Vec<Health> = lane_end
+            .iter()
+            .map(|&e| Health {
+                samples: e * m,
+                ..Default::default()
+            })
+            .collect();
+        let mut counts = Counters::<S>::default();
         for k in 0..n_out {
             let n0 = k * m;
             // The recording path only for blocks that touch the dump window.
             let (z, r) = match opts.probe.as_deref_mut() {
-                Some(p) if p.wants_block(n0, m) => self.block::<K, NOISY, DECOUPLED>(n0, Some(p)),
-                _ => self.block::<K, NOISY, DECOUPLED>(n0, None),
+                Some(p) if p.wants_block(n0, m) => {
+                    self.block::<K, NOISY, DECOUPLED>(n0, Some(p), &mut counts)
+                }
+                _ => self.block::<K, NOISY, DECOUPLED>(n0, None, &mut counts),
             };
+            if NOISY {
+                for (i, h) in health.iter_mut().enumerate() {
+                    if k < lane_end[i] {
+                        counts.drain_into(i, h);
+                    }
+                }
+                counts = Counters::default();
+            }
             // Each on its own: a sum of large finite values could overflow and false-alarm.
             if ![z[0].i, z[0].q, z[1].i, z[1].q]
                 .iter()
@@ -191,7 +217,12 @@ impl<S: Sample> Board<S> {
         }
         progress(n_out * m);
         Ok(RunOutput {
-            lanes: (0..lanes).map(|i| lane_result::<K>(&avg.mean(i))).collect(),
+            lanes: (0..lanes)
+                .map(|i| LaneResult {
+                    health: health[i],
+                    ..lane_result::<K>(&avg.mean(i))
+                })
+                .collect(),
             early_reads: early,
             series,
         })
@@ -207,6 +238,7 @@ impl<S: Sample> Board<S> {
         &mut self,
         n0: u64,
         mut probe: Option<&mut Probe>,
+        counts: &mut Counters<S>,
     ) -> ([Iq<S>; 2], [S; 2]) {
         let zero = S::splat(0.0);
         let mut out = ([Iq::<S>::default(); 2], [zero; 2]);
@@ -235,8 +267,18 @@ impl<S: Sample> Board<S> {
                 mod_cos,
                 mod_sin: drive_sin,
             });
-            let mut u = [self.dac[0].tick(drive[0]), self.dac[1].tick(drive[1])];
-            if NOISY {
+            let mut u = drive;
+            for md in 0..2 {
+                u[md] = match self.dac[md].quantizer() {
+                    // The same bits as the DAC's tick, with its clipped and zero samples counted.
+                    Some(q) if NOISY => {
+                        let (clip, zeros) = counts.0.split_at_mut(DAC_ZERO);
+                        q.quantize_counting(drive[md], &mut clip[DAC_CLIP + md], &mut zeros[md])
+                    }
+                    _ => self.dac[md].tick(drive[md]),
+                };
+            }
+            if NOISY && self.noise_on {
                 // Brownian force on each mode, after the DAC (it acts on the proof mass).
                 let (a, b) = self.noise.rng.normal_pair();
                 u[0] = S::from_x4(a).mul_add(self.noise.sigma_force[0], u[0]);
@@ -250,7 +292,7 @@ impl<S: Sample> Board<S> {
             } else {
                 self.plant.tick(u)
             };
-            if NOISY {
+            if NOISY && self.noise_on {
                 // Amplifier noise, referred to the TIA input.
                 let (a, b) = self.noise.rng.normal_pair();
                 p.current[0] = S::from_x4(a).mul_add(self.noise.sigma_current[0], p.current[0]);
@@ -261,8 +303,19 @@ impl<S: Sample> Board<S> {
                 self.tia[1].tick(p.current[1]),
             ];
             if NOISY {
+                let c = &mut counts.0;
+                for md in 0..2 {
+                    c[TIA_RAIL + md] += self.tia[md].rail_flags(y[md]);
+                }
                 if let Some(adc) = &self.adc {
-                    y = [adc[0].quantize(y[0]), adc[1].quantize(y[1])];
+                    let (clip, zeros) = c.split_at_mut(ADC_ZERO);
+                    for md in 0..2 {
+                        y[md] = adc[md].quantize_counting(
+                            y[md],
+                            &mut clip[ADC_CLIP + md],
+                            &mut zeros[md],
+                        );
+                    }
                 }
             }
             // Both stage-1 mixers see the same carrier: when their reference phases agree

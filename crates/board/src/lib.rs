@@ -9,6 +9,7 @@
 mod board;
 mod chain;
 mod fault;
+mod health;
 mod kernel;
 mod params;
 mod point;
@@ -18,6 +19,7 @@ pub mod reference;
 pub use board::{Board, MAX_LANES};
 pub use chain::{unleak_sidebands, ChainResponse, RotatingTerms};
 pub use fault::NonFinite;
+pub use health::Health;
 pub use params::{BoardParams, Converter, NoiseParams, Shape};
 pub use point::{LaneResult, Point, RunOptions, RunOutput};
 pub use probe::{Probe, DUMP_NODES};

@@ -1,6 +1,7 @@
 //! What a run is asked (operating points and their averaging windows, optional extra reads)
 //! and what it returns.
 
+use crate::health::Health;
 use crate::probe::Probe;
 use gyroemu_core::Complex64;
 use gyroemu_lpf::Window;
@@ -38,6 +39,8 @@ pub struct LaneResult {
     pub s: [Complex64; 2],
     /// Rate-table run: complex amplitude of the phase (lag) at the table frequency, per mode.
     pub table_phase: [Complex64; 2],
+    /// The converters' and rails' counts over the point's run.
+    pub health: Health,
 }
 
 /// Optional work of a run beyond each lane's average.

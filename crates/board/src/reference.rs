@@ -5,6 +5,7 @@
 //! exact, so the fused board must give every lane these bits.
 
 use crate::board::{modulation_hz, noise_sigmas, pattern, plant_rate, shifter, table_nco};
+use crate::health::Health;
 use crate::params::{build_adc, build_dac, build_tia, BoardParams, Shape};
 use crate::point::{LaneResult, Point};
 use gyroemu_am::{AmInput, AmModulator};
@@ -56,6 +57,10 @@ pub fn run_reference(
     let eps = p.phase_shifter_error_deg.to_radians();
     let (ce, se) = (eps.cos(), eps.sin());
     let n_out = n_settle + point.window.samples();
+    let mut health = Health {
+        samples: n_out * m as u64,
+        ..Default::default()
+    };
     let mut prev_z = [Complex64::default(); 2];
     let mut unwrapped = [0.0f64; 2];
     for n in 0..n_out * m as u64 {
@@ -74,6 +79,14 @@ pub fn run_reference(
             mod_sin: drive_sin,
         });
         let mut u = [dac[0].tick(drive[0]), dac[1].tick(drive[1])];
+        for md in 0..2 {
+            if let Some(q) = dac[md].quantizer() {
+                let (mut clip, mut zero) = (0.0, 0.0);
+                q.quantize_counting(drive[md], &mut clip, &mut zero);
+                health.dac_clipped[md] += clip as u64;
+                health.dac_zero[md] += zero as u64;
+            }
+        }
         if p.noise.is_some() {
             let (a, b) = rng.normal_pair();
             u[0] = Sample::mul_add(a.to_array()[0], sigma_force[0], u[0]);
@@ -90,7 +103,16 @@ pub fn run_reference(
             out.current[1] = Sample::mul_add(b.to_array()[0], sigma_current[1], out.current[1]);
         }
         let mut y = [tia[0].tick(out.current[0]), tia[1].tick(out.current[1])];
+        for md in 0..2 {
+            health.tia_railed[md] += tia[md].rail_flags(y[md]) as u64;
+        }
         if let Some(q) = &mut adc {
+            for md in 0..2 {
+                let (mut clip, mut zero) = (0.0, 0.0);
+                q[md].quantize_counting(y[md], &mut clip, &mut zero);
+                health.adc_clipped[md] += clip as u64;
+                health.adc_zero[md] += zero as u64;
+            }
             y = [q[0].tick(y[0]), q[1].tick(y[1])];
         }
         let carrier_phasor = Complex64::new(c_re, c_im);
@@ -134,7 +156,7 @@ pub fn run_reference(
     }
     let v = avg.mean(0);
     let ph = |c: usize| Complex64::new(v[c], v[c + 1]);
-    Ok(match p.shape {
+    let result = match p.shape {
         Shape::Coriolis => LaneResult {
             z: [ph(0), ph(2)],
             ..Default::default()
@@ -148,5 +170,6 @@ pub fn run_reference(
             s: [ph(2), ph(6)],
             ..Default::default()
         },
-    })
+    };
+    Ok(LaneResult { health, ..result })
 }

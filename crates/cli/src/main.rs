@@ -52,7 +52,8 @@ enum Command {
         /// The shard count N beside JOB_COMPLETION_INDEX (or GYROEMU_SHARD_COUNT).
         #[arg(long, value_name = "N")]
         shard_count: Option<usize>,
-        /// Delete results of another config found in the output folder instead of refusing.
+        /// Run even when the plan exceeds the cap of 1e11 point-samples, and delete results
+        /// of another config found in the output folder instead of refusing.
         #[arg(long)]
         force: bool,
     },
@@ -70,6 +71,9 @@ enum Command {
         /// Output folder.
         #[arg(long, default_value = "out")]
         out: PathBuf,
+        /// Run even when the plan exceeds the cap of 1e11 point-samples.
+        #[arg(long)]
+        force: bool,
     },
     /// Measure throughput: the whole chain on 1 and on all threads, and each stage.
     Bench {
@@ -178,7 +182,9 @@ fn run_cli() -> ExitCode {
             force,
         }),
         Command::Merge { dir } => cmd::merge::merge_command(&dir),
-        Command::Selfcal { config, out } => cmd::selfcal::selfcal_command(&config, &out),
+        Command::Selfcal { config, out, force } => {
+            cmd::selfcal::selfcal_command(&config, &out, force)
+        }
         Command::Config { preset, list } => cmd::config::config_command(preset.as_deref(), list),
         Command::Bench {
             preset,

@@ -9,6 +9,7 @@ mod plan;
 pub mod presets;
 mod validate;
 mod validate_noise;
+mod validate_regime;
 
 pub use config::{
     BoardConfig, Config, DeviceConfig, DriveConfig, DumpConfig, ExperimentConfig, ExperimentKind,
@@ -16,3 +17,4 @@ pub use config::{
 };
 pub use parse::{parse_config, ConfigError};
 pub use validate::MAX_RUN_SAMPLES;
+pub use validate_regime::{MAX_HOLD_ERROR_MDEG, NODE_RANGE, WARN_HOLD_ERROR_MDEG};

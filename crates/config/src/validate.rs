@@ -80,13 +80,6 @@ impl Config {
             b.fs_hz,
             &format!("must be above 2*f0 = {} Hz", 2.0 * f_max),
         )?;
-        if b.fs_hz < 8.0 * f_max {
-            warnings.push(format!(
-                "board.fs_hz = {} is below 8*f0 = {} Hz: the sample hold distorts the drive; 16 samples per period is advised",
-                b.fs_hz,
-                8.0 * f_max
-            ));
-        }
         positive("board.tia_gain_ohm", b.tia_gain_ohm)?;
         if let Some(p) = b.tia_pole_hz {
             check(
@@ -291,6 +284,7 @@ impl Config {
             }
         }
         self.validate_noise_adc_selfcal(&mut warnings)?;
+        self.validate_regime(&mut warnings)?;
         if let Some(dump) = &self.dump {
             let emulated = self.emulated_rates_dps();
             check(

@@ -140,6 +140,14 @@ fn invalid(what: &'static str, (text, _): (String, usize), needles: &[&'static s
     case(what, text, Expect::Invalid, needles)
 }
 
+/// `text` at sample rate `fs` just above 2 f0, with the decimation and TIA pole that rate
+/// allows (the 200 Hz low-pass stays below the decimated Nyquist rate).
+fn near_nyquist(text: &str, fs: &str) -> String {
+    let t = set(text, "board", "fs_hz", fs).0;
+    let t = set(&t, "board", "decimation", "10").0;
+    set(&t, "board", "tia_pole_hz", "10000.0").0
+}
+
 fn cases() -> Vec<Case> {
     use Expect::*;
     let c = base(C);
@@ -449,16 +457,101 @@ fn cases() -> Vec<Case> {
             &["board.fs_hz", "240000", "above 2*f0 = 430000 Hz"],
         ),
         case(
-            "fs below 8 f0 warns",
+            "fs near 2 f0 states the hold's error",
+            near_nyquist(&c, "30300.0"),
+            Warning,
+            &[
+                "board.fs_hz = 30300",
+                "2.02 samples per carrier period",
+                "mdeg",
+            ],
+        ),
+        case(
+            "fs at 2.0003 f0 is refused: the hold's images dominate",
+            near_nyquist(&c, "30004.0"),
+            Invalid,
+            &["board.fs_hz", "30004", "zero-order hold", "raise fs_hz"],
+        ),
+        // Signals that would overflow or underflow, a plant that is unstable.
+        invalid(
+            "drive that overflows",
+            set(&c, "drive", "f1", "1e120"),
+            &["drive.f1", "1e120", "overflow"],
+        ),
+        invalid(
+            "drive that underflows",
+            set(&c, "drive", "f2", "1e-120"),
+            &["drive.f2", "1e-120", "underflow", "mode 2"],
+        ),
+        invalid(
+            "TIA gain that overflows",
+            set(&c, "board", "tia_gain_ohm", "1e110"),
+            &["board.tia_gain_ohm", "1e110", "TIA output", "overflow"],
+        ),
+        invalid(
+            "coupling that makes the plant unstable",
+            set(&c, "device", "quadrature_coupling_rad2_s2", "1e10"),
+            &[
+                "device.quadrature_coupling_rad2_s2",
+                "10000000000",
+                "unstable",
+            ],
+        ),
+        // Converters that would be dead, or clip.
+        invalid(
+            "drive below half a DAC LSB",
+            set(&set(&c, "board", "dac_bits", "8").0, "drive", "f1", "1e-3"),
+            &[
+                "drive.f1",
+                "0.001",
+                "half an LSB of the DAC",
+                "board.dac_bits",
+            ],
+        ),
+        case(
+            "drive beyond the DAC's range warns",
             set(
-                &set(&c, "board", "fs_hz", "100000.0").0,
+                &set(&c, "board", "dac_bits", "12").0,
                 "board",
-                "tia_pole_hz",
-                "40000.0",
+                "dac_full_scale",
+                "0.5",
             )
             .0,
             Warning,
-            &["board.fs_hz", "100000", "below 8*f0 = 120000 Hz"],
+            &["drive.f1 = 1", "clip", "board.dac_full_scale"],
+        ),
+        invalid(
+            "TIA output far below an ADC LSB",
+            set(
+                &set(&c, "board", "adc_bits", "8").0,
+                "board",
+                "adc_full_scale_v",
+                "100.0",
+            ),
+            &[
+                "board.adc_bits",
+                "= 8",
+                "half an LSB",
+                "board.adc_full_scale_v",
+            ],
+        ),
+        case(
+            "TIA output beyond the ADC's range warns",
+            set(
+                &set(&c, "board", "adc_bits", "12").0,
+                "board",
+                "adc_full_scale_v",
+                "0.01",
+            )
+            .0,
+            Warning,
+            &["ADC's range", "board.adc_full_scale_v"],
+        ),
+        case(
+            "TIA output beyond its rails warns",
+            set(&c, "board", "tia_rail_v", "0.01").0,
+            Warning,
+            &["board.tia_rail_v = 0.01", "saturate"],
         ),
         // Orders, factors and cutoffs.
         invalid(

@@ -53,8 +53,10 @@ fn board() -> impl Strategy<Value = BoardDraw> {
         proptest::option::of(0.1f64..0.95),
         1e3f64..1e7,
         any::<bool>(),
-        proptest::option::of(2u32..=32),
-        proptest::option::of(2u32..=32),
+        // Converters fine enough for the drive ratio and signal levels drawn (coarser ones
+        // would put out all-zero channels, which validation refuses).
+        proptest::option::of(6u32..=32),
+        proptest::option::of(6u32..=32),
         -10.0f64..10.0,
     )
 }
@@ -98,6 +100,11 @@ fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
     c.board.dac_bits = dac;
     c.board.dac_full_scale = 1.5 * f1.max(f2);
     c.board.adc_bits = adc;
+    // The ADC's full scale at twice the TIA output at resonance (the larger mode).
+    let amp = |f: f64, w: f64, q: f64| f * q / w * c.device.transduction_a_s_per_m * gain;
+    let q2v = q2.unwrap_or(q);
+    let w2 = std::f64::consts::TAU * c.f0_mode2_hz();
+    c.board.adc_full_scale_v = 2.0 * amp(f1, w0, q).max(amp(f2, w2, q2v));
     c.board.phase_shifter_error_deg = shift;
 
     let (kind, rates, avg_mult, hann, settle, noise, selfcal) = e;

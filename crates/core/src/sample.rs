@@ -37,6 +37,11 @@ pub trait Sample:
     fn round_away(self) -> Self;
     /// True when every lane is finite.
     fn all_finite(self) -> bool;
+    /// 1.0 in the lanes where `self == other`, 0.0 elsewhere: a count a lane-parallel loop
+    /// can add up without a branch (how often a converter clips, or outputs exact zeros).
+    fn flag_eq(self, other: Self) -> Self;
+    /// 1.0 in the lanes where `self != other` (a NaN counts as different), 0.0 elsewhere.
+    fn flag_ne(self, other: Self) -> Self;
     /// `self * a + b`: fused (one rounding) when the build targets FMA (x86-64-v3, see
     /// `.cargo/config.toml`), two roundings otherwise. The choice is the same for every lane
     /// type, so f64x4 lanes keep the bits of the scalar path in either build.
@@ -82,6 +87,18 @@ impl Sample for f64 {
     #[inline(always)]
     fn all_finite(self) -> bool {
         self.is_finite()
+    }
+    #[inline(always)]
+    fn flag_eq(self, other: Self) -> Self {
+        if self == other {
+            1.0
+        } else {
+            0.0
+        }
+    }
+    #[inline(always)]
+    fn flag_ne(self, other: Self) -> Self {
+        1.0 - self.flag_eq(other)
     }
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
@@ -137,6 +154,15 @@ impl Sample for f64x4 {
         self.is_finite().all()
     }
     #[inline(always)]
+    fn flag_eq(self, other: Self) -> Self {
+        // The comparison's lane masks are all ones or all zeros: and-ed with 1.0's bits.
+        self.simd_eq(other) & f64x4::splat(1.0)
+    }
+    #[inline(always)]
+    fn flag_ne(self, other: Self) -> Self {
+        f64x4::splat(1.0) - self.flag_eq(other)
+    }
+    #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
         #[cfg(target_feature = "fma")]
         {
@@ -178,6 +204,22 @@ mod tests {
             assert_eq!(c.lane(i), xs[i].clamp_to(-1.0, 1.0));
         }
         assert!(!f64x4::from_fn(|i| if i == 2 { f64::NAN } else { 0.0 }).all_finite());
+    }
+
+    #[test]
+    fn flags_are_one_where_the_comparison_holds_in_each_lane() {
+        let a = [0.0, -0.0, f64::NAN, 2.5];
+        let b = [0.0, 0.0, f64::NAN, 2.0];
+        let (va, vb) = (f64x4::from_fn(|i| a[i]), f64x4::from_fn(|i| b[i]));
+        let (eq, ne) = (va.flag_eq(vb), va.flag_ne(vb));
+        // -0 == +0 in IEEE; NaN equals nothing.
+        let want_eq = [1.0, 1.0, 0.0, 0.0];
+        for i in 0..4 {
+            assert_eq!(eq.lane(i), want_eq[i], "lane {i}");
+            assert_eq!(ne.lane(i), 1.0 - want_eq[i], "lane {i}");
+            assert_eq!(a[i].flag_eq(b[i]), want_eq[i], "scalar {i}");
+            assert_eq!(a[i].flag_ne(b[i]), 1.0 - want_eq[i], "scalar {i}");
+        }
     }
 
     #[test]

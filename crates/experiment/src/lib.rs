@@ -8,9 +8,11 @@ pub mod fit;
 pub mod progress;
 pub mod readout;
 pub mod sweep;
+pub mod work;
 
 pub use progress::{Progress, Quiet, Reporter, Task};
 pub use readout::{post_process, theory_deg, Compensation, PointResult, SweepResult};
 pub use sweep::{
     finish_sweep, run_sweep, run_sweep_with, OnGroup, SweepError, SweepOptions, SweepRun,
 };
+pub use work::{sweep_work, Work, MAX_POINT_SAMPLES};

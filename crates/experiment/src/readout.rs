@@ -3,7 +3,7 @@
 //! the paper's best linear fit.
 
 use crate::fit::{fit_line, LineFit};
-use gyroemu_board::{unleak_sidebands, ChainResponse, LaneResult, Point, Shape};
+use gyroemu_board::{unleak_sidebands, ChainResponse, Health, LaneResult, Point, Shape};
 use gyroemu_config::Config;
 use gyroemu_core::{Complex64, ParamError};
 use gyroemu_mixer::{paper_i_channel_psi_rad, phase_lag_rad, sideband_estimate, wrap_pi, Mode};
@@ -78,16 +78,106 @@ pub struct SweepResult {
     pub samples: u64,
     /// Operating-point samples emulated (samples times the points each group carries).
     pub point_samples: u64,
+    /// The converters' and rails' counts, summed over every emulated point.
+    pub health: Health,
+    /// Why a phase was refused (set to NaN): a dead channel, a non-finite read-out. A sweep
+    /// with problems has no trustworthy number and the program exits non-zero.
+    pub problems: Vec<String>,
+    /// What the user should know but that does not void a phase (clipping, saturation).
+    pub warnings: Vec<String>,
 }
 
 impl SweepResult {
-    /// Largest |measured - theory| of one mode over the points, millidegrees.
+    /// Largest |measured - theory| of one mode over the points, millidegrees; NaN when any
+    /// point's is (a refused phase is never skipped into a clean-looking maximum).
     pub fn max_abs_error_mdeg(&self, mode: usize) -> f64 {
         self.points
             .iter()
             .map(|p| ((p.phase_deg[mode] - p.theory_deg[mode]) * 1e3).abs())
-            .fold(0.0, f64::max)
+            .fold(0.0, |a, b| {
+                if a.is_nan() || b.is_nan() {
+                    f64::NAN
+                } else {
+                    a.max(b)
+                }
+            })
     }
+}
+
+/// The channels of one point that carry no signal: `(mode, reason)`. A drive the DAC put out
+/// as zeros on every sample voids both modes (each phase is read against both drives).
+fn dead_channels(cfg: &Config, lr: &LaneResult) -> Vec<(usize, String)> {
+    let h = &lr.health;
+    let b = &cfg.board;
+    let mut dead = Vec::new();
+    for k in 0..2 {
+        if b.dac_bits.is_some() && h.samples > 0 && h.dac_zero[k] == h.samples {
+            let key = ["drive.f1", "drive.f2"][k];
+            for md in 0..2 {
+                dead.push((
+                    md,
+                    format!(
+                        "the DAC put out every sample of drive {} as 0 ({key} is below half an LSB of board.dac_full_scale / 2^(board.dac_bits - 1)): raise {key} or board.dac_bits, or lower board.dac_full_scale",
+                        k + 1
+                    ),
+                ));
+            }
+        }
+        if b.adc_bits.is_some() && h.samples > 0 && h.adc_zero[k] == h.samples {
+            dead.push((
+                k,
+                format!(
+                    "the ADC put out every sample of mode {} as 0 (the TIA output is below half an LSB): raise board.tia_gain_ohm or board.adc_bits, or lower board.adc_full_scale_v",
+                    k + 1
+                ),
+            ));
+        }
+    }
+    let zero = Complex64::new(0.0, 0.0);
+    for k in 0..2 {
+        let silent = match cfg.shape() {
+            Shape::Coriolis => lr.z[k] == zero,
+            Shape::RateTable { .. } => lr.table_phase[k] == zero,
+            Shape::Rotating => lr.c[k] == zero && lr.s[k] == zero,
+        };
+        if silent && !dead.iter().any(|d| d.0 == k) {
+            dead.push((
+                k,
+                format!(
+                    "mode {}'s read-out averaged to exactly 0 (no signal reached the mixer): check the drive amplitudes, device.transduction_a_s_per_m and board.tia_gain_ohm",
+                    k + 1
+                ),
+            ));
+        }
+    }
+    dead
+}
+
+/// The clipping a point's counts show, as warnings naming the stage and its setting.
+fn clipping_warnings(h: &Health) -> Vec<String> {
+    let pct = |n: u64| 100.0 * n as f64 / h.samples.max(1) as f64;
+    let mut w = Vec::new();
+    for (what, counts, setting) in [
+        ("the DAC clipped", h.dac_clipped, "board.dac_full_scale"),
+        (
+            "the TIA sat on its rails for",
+            h.tia_railed,
+            "board.tia_rail_v",
+        ),
+        ("the ADC clipped", h.adc_clipped, "board.adc_full_scale_v"),
+    ] {
+        for (k, &n) in counts.iter().enumerate() {
+            if n > 0 {
+                w.push(format!(
+                    "{what} {n} of {} samples ({:.3} %) of mode {}: raise {setting} (clipping distorts the signal; the phase of its fundamental survives only for a pure tone)",
+                    h.samples,
+                    pct(n),
+                    k + 1
+                ));
+            }
+        }
+    }
+    w
 }
 
 /// `x` moved by a whole number of half turns into `(-pi/2, pi/2]`, and whether that number
@@ -169,7 +259,12 @@ pub fn post_process(
             Shape::Coriolis => {
                 let z0 = lanes[zero.expect("zero rate is always emulated")].z;
                 for k in 0..2 {
-                    r.phase_deg[k] = phase_lag_rad(lr.z[k], z0[k]) / DEG;
+                    // A product that underflowed to 0 has no phase (atan2(0, 0) would read 0).
+                    r.phase_deg[k] = if z0[k] * lr.z[k].conj() == Complex64::new(0.0, 0.0) {
+                        f64::NAN
+                    } else {
+                        phase_lag_rad(lr.z[k], z0[k]) / DEG
+                    };
                 }
                 // Mixing with the mode's own drive: cos w0t (mode 1), sin w0t (mode 2).
                 r.single_mixer_dc_v = Some([0.5 * lr.z[0].re, -0.5 * lr.z[1].im]);
@@ -208,6 +303,12 @@ pub fn post_process(
                 for (k, mode) in [Mode::One, Mode::Two].into_iter().enumerate() {
                     let (c, s) = unleak_sidebands(lr.c[k], lr.s[k], leak);
                     let est = sideband_estimate(c, s, mode);
+                    let zero = Complex64::new(0.0, 0.0);
+                    if est.z_plus == zero || est.z_minus == zero {
+                        // A sideband that vanished (or underflowed) has no phase.
+                        r.phase_deg[k] = f64::NAN;
+                        continue;
+                    }
                     // (psi, alpha) and (psi + pi, alpha + pi) give the same sidebands. The
                     // plant's psi lies in (-90, 90) degrees and the chain adds up to 180 more
                     // (the low-pass near its cutoff), so the branch is chosen once the chain
@@ -234,6 +335,63 @@ pub fn post_process(
         }
         out.push(r);
     }
+    // Refuse what no signal supports, and any read-out that is not a finite number.
+    let mut problems = Vec::new();
+    let mut health = Health::default();
+    let reference_dead = match (shape, zero) {
+        (Shape::Coriolis, Some(z)) => dead_channels(cfg, &lanes[z]),
+        _ => Vec::new(),
+    };
+    let mut listed = out.iter_mut();
+    for (i, &rate) in rates.iter().enumerate() {
+        health.add(&lanes[i].health);
+        if !cfg.experiment.rates_dps.contains(&rate) {
+            continue;
+        }
+        let Some(r) = listed.next() else { break };
+        let mut dead = dead_channels(cfg, &lanes[i]);
+        dead.extend(
+            reference_dead
+                .iter()
+                .map(|(k, why)| (*k, format!("{why} (in the zero-rate reference)"))),
+        );
+        let mut refused = [false; 2];
+        for (k, why) in dead {
+            if !refused[k] {
+                refused[k] = true;
+                problems.push(format!(
+                    "point {rate} deg/s, mode {}: no phase: {why}",
+                    k + 1
+                ));
+            }
+        }
+        for k in 0..2 {
+            if !refused[k] && !r.phase_deg[k].is_finite() {
+                refused[k] = true;
+                problems.push(format!(
+                    "point {rate} deg/s, mode {}: the read-out is not a finite number ({}): the chain's values overflowed or underflowed (check the drive amplitudes and gains)",
+                    k + 1,
+                    r.phase_deg[k]
+                ));
+            }
+            if refused[k] {
+                // Every reading of a refused channel goes, not just the headline phase.
+                r.phase_deg[k] = f64::NAN;
+                for v in [
+                    &mut r.paper_i_deg,
+                    &mut r.raw_psi_deg,
+                    &mut r.alpha_deg,
+                    &mut r.table_lag_deg,
+                ]
+                .into_iter()
+                .flatten()
+                {
+                    v[k] = f64::NAN;
+                }
+            }
+        }
+    }
+    let warnings = clipping_warnings(&health);
     let xs: Vec<f64> = out.iter().map(|p| p.rate_dps).collect();
     let fit =
         [0, 1].map(|k| fit_line(&xs, &out.iter().map(|p| p.phase_deg[k]).collect::<Vec<_>>()));
@@ -253,5 +411,8 @@ pub fn post_process(
         fs_out_hz: 0.0,
         samples: 0,
         point_samples: 0,
+        health,
+        problems,
+        warnings,
     })
 }

@@ -20,6 +20,10 @@ pub enum ReportError {
     /// Rendering a figure failed.
     #[error(transparent)]
     Plot(#[from] PlotError),
+    /// The run finished but some of its numbers cannot be trusted (a dead channel, a
+    /// non-finite read-out): the outputs are written with those values null, and this says why.
+    #[error("{0}")]
+    Unreliable(String),
     /// Creating a folder failed.
     #[error("cannot create `{path}`: {source}")]
     Dir {
@@ -36,4 +40,16 @@ pub(crate) fn create_dir(dir: &std::path::Path) -> Result<(), ReportError> {
         path: dir.to_path_buf(),
         source,
     })
+}
+
+/// The problems of a sweep as one error, or nothing when there are none.
+pub fn check_problems(what: &str, problems: &[String]) -> Result<(), ReportError> {
+    if problems.is_empty() {
+        return Ok(());
+    }
+    Err(ReportError::Unreliable(format!(
+        "{what}: {} phase(s) refused, written as NaN/null:\n  {}",
+        problems.len(),
+        problems.join("\n  ")
+    )))
 }

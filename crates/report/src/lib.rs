@@ -8,7 +8,7 @@ pub mod reproduce;
 pub mod selfcal_report;
 pub mod sweep_report;
 
-pub use error::ReportError;
+pub use error::{check_problems, ReportError};
 pub use reproduce::{plan_reproduce, reproduce, ReproducePlan};
 pub use selfcal_report::write_selfcal;
-pub use sweep_report::{run_title, write_run, RUN_FILES};
+pub use sweep_report::{health_json, run_title, write_run, RUN_FILES};

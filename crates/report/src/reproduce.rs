@@ -1,7 +1,7 @@
 //! `gyroemu reproduce`: the paper's Figs. 4, 5, 6, 8 and 9 from the emulated board, on the
 //! embedded presets, with the exact theory beside every point.
 
-use crate::error::{create_dir, ReportError};
+use crate::error::{check_problems, create_dir, ReportError};
 use crate::sweep_report::{sweep_figure, theory_series, write_run};
 use gyroemu_analysis::bandwidth::{bandwidth, BANDWIDTH_AMPLITUDE_DPS, BANDWIDTH_FREQS_HZ};
 use gyroemu_config::presets::preset;
@@ -28,6 +28,22 @@ pub struct ReproducePlan {
     quick: bool,
     /// The configs' warnings, each prefixed with its preset.
     pub warnings: Vec<String>,
+}
+
+impl ReproducePlan {
+    /// The emulation the figures' sweeps will run (the bandwidth sweep adds about 3 %).
+    pub fn work(&self) -> gyroemu_experiment::Work {
+        self.jobs
+            .iter()
+            .map(|j| gyroemu_experiment::sweep_work(&j.cfg))
+            .reduce(|a, b| a.plus(b))
+            .expect("reproduce has jobs")
+    }
+
+    /// A config of the plan (to measure the chain's throughput on).
+    pub fn first_config(&self) -> &Config {
+        &self.jobs[0].cfg
+    }
 }
 
 /// The presets of the figures (with `quick`, Fig. 9 averages 15 s instead of 500 s), each
@@ -88,6 +104,10 @@ pub fn reproduce(
         let r = run_sweep(&job.cfg, &|d, t| progress.update(d, t), None)?;
         progress.finish(Some(r.point_samples));
         files.extend(write_run(&out.join(job.preset), &job.cfg, &r, job.title)?);
+        for w in &r.warnings {
+            reporter.warn(&format!("{}: {w}", job.preset));
+        }
+        check_problems(job.preset, &r.problems)?;
         results.push(r);
     }
     let get = |name: &str| {

@@ -2,6 +2,7 @@
 //! error_vs_tau.*, drift.* for the analyses that ran. Every file is written atomically.
 
 use crate::error::ReportError;
+use crate::sweep_report::health_json;
 use gyroemu_analysis::allan::AllanPoint;
 use gyroemu_analysis::selfcal::SelfcalCore;
 use gyroemu_analysis::selfcal_analyses::{AllanResult, DriftPoint, TauPoint};
@@ -50,6 +51,12 @@ pub fn write_selfcal(
         "rotating_points": core.rotating.points,
         "coriolis_points": core.coriolis.points,
         "compensation_mdeg": core.rotating.compensation,
+        "converter_counts": {
+            "rotating": health_json(&core.rotating.health),
+            "coriolis": health_json(&core.coriolis.health),
+        },
+        "problems": core.rotating.problems.iter().chain(&core.coriolis.problems).collect::<Vec<_>>(),
+        "warnings": core.rotating.warnings.iter().chain(&core.coriolis.warnings).collect::<Vec<_>>(),
         "allan": allan,
         "error_vs_averaging_time": taus,
         "drift": drift,

@@ -2,7 +2,7 @@
 //! compensation), and a paper-style plot. Every file is written atomically.
 
 use crate::error::{create_dir, ReportError};
-use gyroemu_board::Shape;
+use gyroemu_board::{Health, Shape};
 use gyroemu_config::Config;
 use gyroemu_experiment::{theory_deg, SweepResult};
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
@@ -101,7 +101,22 @@ pub fn summary(cfg: &Config, r: &SweepResult) -> serde_json::Value {
         "fs_hz": r.fs_hz,
         "fs_out_hz": r.fs_out_hz,
         "point_samples_emulated": r.point_samples,
+        "converter_counts": health_json(&r.health),
+        "problems": r.problems,
+        "warnings": r.warnings,
         "config": cfg,
+    })
+}
+
+/// The converter and rail counts as JSON (samples counted over every point's whole run).
+pub fn health_json(h: &Health) -> serde_json::Value {
+    json!({
+        "samples": h.samples,
+        "dac_clipped_samples": h.dac_clipped,
+        "dac_zero_samples": h.dac_zero,
+        "tia_rail_samples": h.tia_railed,
+        "adc_clipped_samples": h.adc_clipped,
+        "adc_zero_samples": h.adc_zero,
     })
 }
 

@@ -69,6 +69,22 @@ impl ResonatorParams {
             self.quadrature_coupling_rad2_s2,
         )?;
         finite(STAGE, "transduction_a_s_per_m", self.transduction_a_s_per_m)?;
+        // With damping on both modes and a gyroscopic (skew) Coriolis term, the plant is
+        // asymptotically stable exactly when its stiffness matrix [[w1^2, k12], [k12, w2^2]] is
+        // positive definite (energy decreases; Kelvin-Tait-Chetaev): |k12| < w1 w2. Beyond,
+        // one combination of the modes has a negative stiffness and grows without bound.
+        let [w1, w2] = self.w_rad_s();
+        if self.quadrature_coupling_rad2_s2.abs() >= w1 * w2 {
+            return Err(ParamError::new(
+                STAGE,
+                "quadrature_coupling_rad2_s2",
+                self.quadrature_coupling_rad2_s2,
+                format!(
+                    "must be below w1 w2 = {:e} (rad/s)^2 in magnitude: a larger coupling makes the stiffness matrix indefinite and the plant unstable",
+                    w1 * w2
+                ),
+            ));
+        }
         Ok(())
     }
 
@@ -106,5 +122,53 @@ mod tests {
             p.validate().unwrap_err().param,
             "quadrature_coupling_rad2_s2"
         );
+    }
+
+    /// The free plant integrated by classical RK4 (independent of the exact discretisation):
+    /// its squared displacement plus squared velocity over w1^2 after `t_s`, from a unit
+    /// displacement of mode 1 (a norm of the state: with an indefinite stiffness the energy
+    /// itself can go negative).
+    fn state_norm_after(p: &ResonatorParams, t_s: f64) -> f64 {
+        let [w1, w2] = p.w_rad_s();
+        let k = p.quadrature_coupling_rad2_s2;
+        let f = |x: [f64; 4]| {
+            [
+                x[2],
+                x[3],
+                -w1 * w1 * x[0] - k * x[1] - w1 / p.mode1.q * x[2],
+                -k * x[0] - w2 * w2 * x[1] - w2 / p.mode2.q * x[3],
+            ]
+        };
+        let h = 1.0 / (200.0 * p.mode1.f0_hz);
+        let mut x = [1.0, 0.0, 0.0, 0.0];
+        for _ in 0..(t_s / h) as usize {
+            let add = |a: [f64; 4], b: [f64; 4], s: f64| core::array::from_fn(|i| a[i] + s * b[i]);
+            let k1 = f(x);
+            let k2 = f(add(x, k1, h / 2.0));
+            let k3 = f(add(x, k2, h / 2.0));
+            let k4 = f(add(x, k3, h));
+            x = core::array::from_fn(|i| {
+                x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            });
+        }
+        x[0] * x[0] + x[1] * x[1] + (x[2] * x[2] + x[3] * x[3]) / (w1 * w1)
+    }
+
+    #[test]
+    fn a_coupling_beyond_w1_w2_is_refused_and_is_unstable_where_a_smaller_one_is_not() {
+        let mut p = ResonatorParams::matched(1e3, 50.0, 1.0, 16e3);
+        p.mode2.f0_hz = 1.1e3;
+        let [w1, w2] = p.w_rad_s();
+        let e0 = 1.0;
+        // 0.99 w1 w2: stable, the state decays.
+        p.quadrature_coupling_rad2_s2 = 0.99 * w1 * w2;
+        assert!(p.validate().is_ok());
+        assert!(state_norm_after(&p, 0.5) < e0);
+        // 1.01 w1 w2: refused, and indeed the free response grows.
+        p.quadrature_coupling_rad2_s2 = -1.01 * w1 * w2;
+        let err = p.validate().unwrap_err();
+        assert_eq!(err.param, "quadrature_coupling_rad2_s2");
+        assert!(err.rule.contains("unstable"), "{err}");
+        assert!(state_norm_after(&p, 0.5) > 1e3 * e0);
     }
 }

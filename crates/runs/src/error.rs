@@ -16,7 +16,8 @@ pub enum RunError {
     /// The emulation failed after validation (e.g. the chain overflowed).
     #[error("emulation failed: {0}")]
     Sweep(#[from] SweepError),
-    /// Writing the outputs failed.
+    /// Writing the outputs failed, or they hold numbers that cannot be trusted
+    /// ([`ReportError::Unreliable`]: written as null, the run exits non-zero).
     #[error(transparent)]
     Report(#[from] ReportError),
     /// A file of the output folder could not be read, written or removed.

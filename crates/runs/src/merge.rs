@@ -8,7 +8,7 @@ use crate::manifest::{read_manifest, shard_manifest_paths, Manifest, RUN_MANIFES
 use crate::points::{config_hash, scan_points, PointFile, POINTS_DIR};
 use gyroemu_config::parse_config;
 use gyroemu_experiment::{finish_sweep, Reporter};
-use gyroemu_report::{run_title, write_run};
+use gyroemu_report::{check_problems, run_title, write_run};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -181,5 +181,9 @@ pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunErr
     m.write(&path)?;
     files.push(path);
     reporter.note(&format!("merged {count} shards ({n} points)"));
+    for w in &r.warnings {
+        reporter.warn(w);
+    }
+    check_problems(&dir.display().to_string(), &r.problems)?;
     Ok(files)
 }

@@ -4,7 +4,7 @@
 //! run, a shard, and `gyroemu merge` rebuild the sweep's results from these files; the lane
 //! grouping does not change any bits, so the outputs equal a one-machine run's.
 
-use gyroemu_board::LaneResult;
+use gyroemu_board::{Health, LaneResult};
 use gyroemu_config::Config;
 use gyroemu_core::Complex64;
 use serde::{Deserialize, Serialize};
@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Format tag of a point file.
-pub const POINT_FORMAT: &str = "gyroemu-point/1";
+pub const POINT_FORMAT: &str = "gyroemu-point/2";
 
 /// The folder of the point files inside an output folder.
 pub const POINTS_DIR: &str = "points";
@@ -50,6 +50,45 @@ pub struct PointFile {
     pub c: [String; 4],
     pub s: [String; 4],
     pub table_phase: [String; 4],
+    /// The converters' and rails' counts over the point's run.
+    pub health: HealthCounts,
+}
+
+/// [`Health`] as stored (plain integers, below 2^53 so JSON numbers keep them exact).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HealthCounts {
+    pub samples: u64,
+    pub dac_clipped: [u64; 2],
+    pub dac_zero: [u64; 2],
+    pub tia_railed: [u64; 2],
+    pub adc_clipped: [u64; 2],
+    pub adc_zero: [u64; 2],
+}
+
+impl From<Health> for HealthCounts {
+    fn from(h: Health) -> Self {
+        Self {
+            samples: h.samples,
+            dac_clipped: h.dac_clipped,
+            dac_zero: h.dac_zero,
+            tia_railed: h.tia_railed,
+            adc_clipped: h.adc_clipped,
+            adc_zero: h.adc_zero,
+        }
+    }
+}
+
+impl From<HealthCounts> for Health {
+    fn from(h: HealthCounts) -> Self {
+        Self {
+            samples: h.samples,
+            dac_clipped: h.dac_clipped,
+            dac_zero: h.dac_zero,
+            tia_railed: h.tia_railed,
+            adc_clipped: h.adc_clipped,
+            adc_zero: h.adc_zero,
+        }
+    }
 }
 
 fn enc(v: &[Complex64; 2]) -> [String; 4] {
@@ -79,6 +118,7 @@ impl PointFile {
             c: enc(&lane.c),
             s: enc(&lane.s),
             table_phase: enc(&lane.table_phase),
+            health: lane.health.into(),
         }
     }
 
@@ -89,6 +129,7 @@ impl PointFile {
             c: dec(&self.c)?,
             s: dec(&self.s)?,
             table_phase: dec(&self.table_phase)?,
+            health: self.health.into(),
         })
     }
 
@@ -231,6 +272,14 @@ mod tests {
             c: c(1),
             s: c(2),
             table_phase: c(3),
+            health: Health {
+                samples: 1 << 52,
+                dac_clipped: [3, 0],
+                dac_zero: [0, 7],
+                tia_railed: [11, 13],
+                adc_clipped: [17, 19],
+                adc_zero: [(1 << 52) - 1, 2],
+            },
         };
         let f = PointFile::new("abc", 3, 25.0, &lane);
         let text = serde_json::to_string(&f).unwrap();
@@ -244,6 +293,7 @@ mod tests {
                 .collect::<Vec<_>>()
         };
         assert_eq!(bits(&l2), bits(&lane));
+        assert_eq!(l2.health, lane.health);
     }
 
     #[test]

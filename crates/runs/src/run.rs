@@ -10,8 +10,9 @@ use crate::resume::previous_points;
 use crate::shard::Shard;
 use gyroemu_board::LaneResult;
 use gyroemu_config::Config;
-use gyroemu_experiment::{finish_sweep, run_sweep_with, Reporter, SweepOptions};
-use gyroemu_report::{run_title, write_run};
+use gyroemu_experiment::work::measured_throughput;
+use gyroemu_experiment::{finish_sweep, run_sweep_with, sweep_work, Reporter, SweepOptions, Work};
+use gyroemu_report::{check_problems, run_title, write_run};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -25,7 +26,8 @@ pub struct RunRequest<'a> {
     pub out: &'a Path,
     /// Run only this shard of the points.
     pub shard: Option<Shard>,
-    /// Delete results of another config found in `out` instead of refusing.
+    /// Run even above the cap of [`gyroemu_experiment::MAX_POINT_SAMPLES`], and delete results
+    /// of another config found in `out` instead of refusing.
     pub force: bool,
     /// Raised (Ctrl-C, SIGTERM): the run saves what finished and returns
     /// [`RunError::Interrupted`].
@@ -77,6 +79,15 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         Some(s) => s.points(n),
         None => (0..n).collect(),
     };
+    // Say what this will cost before anything runs; refuse an absurd run unless forced.
+    let whole = sweep_work(cfg);
+    let share = Work {
+        points: mine.len(),
+        point_samples: (whole.point_samples as f64 * mine.len() as f64 / n as f64) as u64,
+        ..whole
+    };
+    share.check_cap(req.force).map_err(RunError::BadInput)?;
+    reporter.note(&share.describe(Some(measured_throughput(cfg))));
     let prev = previous_points(out, &hash, n, req.force, reporter)?;
     let reused = mine.iter().filter(|i| prev.contains_key(i)).count();
     let what = match &req.shard {
@@ -178,5 +189,9 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     let mut files = write_run(out, cfg, &r, &run_title(cfg))?;
     m.write(&manifest_path)?;
     files.push(manifest_path);
+    for w in &r.warnings {
+        reporter.warn(w);
+    }
+    check_problems(&out.display().to_string(), &r.problems)?;
     Ok(RunOutcome::Complete(files))
 }

@@ -4,7 +4,7 @@
 
 use crate::closed_form::{coriolis_theta_rad, rate_table_gain, rotating_psi_rad};
 use gyroemu_core::Complex64;
-use gyroemu_resonator::{continuous_steady_state, ResonatorParams};
+use gyroemu_resonator::{continuous_steady_state, Resonator, ResonatorParams};
 
 const DEG: f64 = core::f64::consts::PI / 180.0;
 
@@ -88,6 +88,55 @@ impl DrivenDevice {
         [0, 1].map(|k| {
             let (mp, mm) = m[k];
             0.5 * ((vm[2 + k] / mm).arg() - (vp[2 + k] / mp).arg())
+        })
+    }
+
+    /// What a board with a zero-order-hold DAC at `self.plant.fs_hz` measures of the Coriolis
+    /// phase: the lag, against zero rate, of the sampled velocity's exact steady state under the
+    /// held drive (the exactly discretised plant's `held_steady_state`). It departs from
+    /// [`DrivenDevice::coriolis_phase_rad`] by the hold's images: negligibly at 16 samples per
+    /// carrier period, by whole degrees as fs nears 2 f0. NaN if the plant cannot be built.
+    pub fn held_coriolis_phase_rad(&self, omega: f64) -> [f64; 2] {
+        let [f1, f2] = self.drive;
+        let shift = (90.0 + self.phase_shifter_error_deg) * DEG;
+        let force = [Complex64::new(f1, 0.0), Complex64::from_polar(f2, -shift)];
+        let v = |w: f64| {
+            Resonator::<f64>::new(&self.plant, w)
+                .map(|r| r.held_steady_state(self.f0(), force))
+                .unwrap_or([Complex64::new(f64::NAN, f64::NAN); 4])
+        };
+        let (x0, x) = (v(0.0), v(omega));
+        [lag_rad(x[2], x0[2]), lag_rad(x[3], x0[3])]
+    }
+
+    /// What a board with a zero-order-hold DAC measures of the rotating psi once the read-out
+    /// has removed the hold's delay (pi fm / fs, sign of Omega): the sideband estimator on the
+    /// held-drive steady states at f0 +- fm.
+    pub fn held_rotating_psi_rad(&self, omega: f64) -> [f64; 2] {
+        if omega == 0.0 {
+            return [0.0; 2];
+        }
+        let fm = omega / core::f64::consts::TAU;
+        let [f1, f2] = self.drive;
+        let j = Complex64::new(0.0, 1.0);
+        let eps = self.phase_shifter_error_deg * DEG;
+        let Ok(plant) = Resonator::<f64>::new(&self.plant, 0.0) else {
+            return [f64::NAN; 2];
+        };
+        let v = |sign: f64| {
+            let turn = Complex64::from_polar(1.0, -sign * eps);
+            let force = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
+            plant.held_steady_state(self.f0() + sign * fm, force)
+        };
+        let (vp, vm) = (v(1.0), v(-1.0));
+        let m = [
+            (Complex64::new(1.0, 0.0), Complex64::new(1.0, 0.0)),
+            (-j, j),
+        ];
+        let hold = core::f64::consts::PI * fm / self.plant.fs_hz;
+        [0, 1].map(|k| {
+            let (mp, mm) = m[k];
+            0.5 * ((vm[2 + k] / mm).arg() - (vp[2 + k] / mp).arg()) - hold
         })
     }
 

@@ -107,6 +107,19 @@ impl Tia<f64> {
     }
 }
 
+impl<S: Sample> Tia<S> {
+    /// 1.0 in the lanes where the output `y` of [`Stage::tick`] sits on a rail (clamped), 0.0
+    /// elsewhere and always without rails: a count of saturated samples.
+    #[inline]
+    pub fn rail_flags(&self, y: S) -> S {
+        if self.has_rails {
+            y.flag_eq(self.hi) + y.flag_eq(self.lo)
+        } else {
+            S::splat(0.0)
+        }
+    }
+}
+
 impl<S: Sample> Stage for Tia<S> {
     type Input = S;
     type Output = S;

@@ -17,6 +17,8 @@ pub fn reproduce_command(out: &Path, quick: bool) -> Result<()> {
     for w in &plan.warnings {
         eprintln!("warning: {w}");
     }
+    let rate = gyroemu_experiment::work::measured_throughput(plan.first_config());
+    eprintln!("{}", plan.work().describe(Some(rate)));
     prepare_out(out)?;
     let files = reproduce(&plan, out, &Terminal)?;
     list_written(out, &files);

@@ -3,15 +3,16 @@
 use crate::input::{list_written, load_config, BadInput};
 use crate::progress::Terminal;
 use anyhow::Result;
-use gyroemu_analysis::run_selfcal;
 use gyroemu_analysis::selfcal::validate_selfcal;
-use gyroemu_report::write_selfcal;
+use gyroemu_analysis::{run_selfcal, selfcal_work};
+use gyroemu_experiment::work::measured_throughput;
+use gyroemu_report::{check_problems, write_selfcal};
 use gyroemu_runs::prepare_out;
 use std::path::Path;
 
 /// The scale factor from the rotating excitation alone, checked against the virtual rate
 /// table on the same board, plus the analyses the config asks for.
-pub fn selfcal_command(config: &Path, out: &Path) -> Result<()> {
+pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
     let cfg = load_config(config)?;
     // load_config printed the config's own warnings; these are the derived sweeps' extra ones.
     let warnings =
@@ -19,9 +20,21 @@ pub fn selfcal_command(config: &Path, out: &Path) -> Result<()> {
     for w in &warnings {
         eprintln!("warning: {}: {w}", config.display());
     }
+    let work = selfcal_work(&cfg);
+    work.check_cap(force).map_err(BadInput)?;
+    eprintln!("{}", work.describe(Some(measured_throughput(&cfg))));
     prepare_out(out)?;
     let report = run_selfcal(&cfg, &Terminal)?;
     let files = write_selfcal(out, &cfg, &report)?;
+    for w in report
+        .core
+        .rotating
+        .warnings
+        .iter()
+        .chain(&report.core.coriolis.warnings)
+    {
+        eprintln!("warning: {w}");
+    }
     let m = report.core.modes[0];
     println!(
         "self-calibration (mode 1): rotating slope {:.9} deg per deg/s x lambda {} = predicted Coriolis {:.9}; \
@@ -35,5 +48,10 @@ pub fn selfcal_command(config: &Path, out: &Path) -> Result<()> {
         cfg.experiment.average_s
     );
     list_written(out, &files);
+    let problems: Vec<String> = [&report.core.rotating, &report.core.coriolis]
+        .iter()
+        .flat_map(|r| r.problems.iter().cloned())
+        .collect();
+    check_problems("selfcal", &problems)?;
     Ok(())
 }

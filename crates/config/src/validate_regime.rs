@@ -1,0 +1,215 @@
+//! Rules about the regime a config puts the board in, checked before any sample: the plant must
+//! be stable, every node's signal must stay far from overflow and underflow, a converter must
+//! not put out a dead (all-zero) signal, and the DAC's hold must not move the measured phase by
+//! more than a stated amount. Each names the key to change.
+
+use crate::config::Config;
+use crate::parse::ConfigError;
+use crate::validate::check;
+use gyroemu_board::Shape;
+use gyroemu_theory::DrivenDevice;
+
+/// Every node's amplitude must lie in this band (in its own unit): products of two stay finite
+/// and normal, and no signal is rounded away in subnormals.
+pub const NODE_RANGE: (f64, f64) = (1e-100, 1e100);
+
+/// Above this hold error (mdeg) the board measures the hold's images more than the carrier:
+/// refused.
+pub const MAX_HOLD_ERROR_MDEG: f64 = 1000.0;
+
+/// Above this hold error (mdeg) it is stated in a warning.
+pub const WARN_HOLD_ERROR_MDEG: f64 = 0.01;
+
+/// The steady-state amplitude at resonance of each node of mode `k` at zero rate: drive,
+/// displacement, velocity, motional current, TIA output (an upper bound for every experiment:
+/// rotation and the rotating envelope only lower it).
+fn node_amplitudes(c: &Config, k: usize) -> [f64; 5] {
+    let p = c.resonator_params();
+    let mode = [p.mode1, p.mode2][k];
+    let w = core::f64::consts::TAU * mode.f0_hz;
+    let f = [c.drive.f1, c.drive.f2][k];
+    let v = f * mode.q / w;
+    let i = c.device.transduction_a_s_per_m * v;
+    let pole = c
+        .board
+        .tia_pole_hz
+        .map_or(1.0, |fp| 1.0 / (1.0 + (mode.f0_hz / fp).powi(2)).sqrt());
+    [f, v / w, v, i, c.board.tia_gain_ohm * i * pole]
+}
+
+impl Config {
+    /// The regime rules; appends warnings, returns the first error.
+    pub(crate) fn validate_regime(&self, warnings: &mut Vec<String>) -> Result<(), ConfigError> {
+        self.resonator_params().validate().map_err(|e| {
+            let key = match e.param {
+                "quadrature_coupling_rad2_s2" => "device.quadrature_coupling_rad2_s2",
+                "mode2.f0_hz" => "device.mode2_f0_offset_hz",
+                "mode2.q" => "device.q_mode2",
+                _ => "device",
+            };
+            ConfigError::key(key, e.value, e.rule)
+        })?;
+        self.validate_node_range()?;
+        self.validate_converters(warnings)?;
+        self.validate_hold(warnings)
+    }
+
+    fn validate_node_range(&self) -> Result<(), ConfigError> {
+        const NODES: [(&str, &str); 5] = [
+            ("drive", "m/s^2"),
+            ("displacement", "m"),
+            ("velocity", "m/s"),
+            ("motional current", "A"),
+            ("TIA output", "V"),
+        ];
+        let (lo, hi) = NODE_RANGE;
+        for k in 0..2 {
+            let a = node_amplitudes(self, k);
+            let drive_key = ["drive.f1", "drive.f2"][k];
+            for (n, (&amp, (node, unit))) in a.iter().zip(NODES).enumerate() {
+                if (lo..=hi).contains(&amp) {
+                    continue;
+                }
+                // The first node out of range names the knob: the drive sets the mechanical
+                // nodes, then the transduction and the TIA gain scale the electrical ones.
+                let (key, value) = match n {
+                    0..=2 => (drive_key, a[0]),
+                    3 => (
+                        "device.transduction_a_s_per_m",
+                        self.device.transduction_a_s_per_m,
+                    ),
+                    _ => ("board.tia_gain_ohm", self.board.tia_gain_ohm),
+                };
+                let what = if amp > hi {
+                    "overflow (products of two values would leave f64's range)"
+                } else {
+                    "underflow (subnormal arithmetic, many times slower, rounds the signal away)"
+                };
+                return Err(ConfigError::key(
+                    key,
+                    value,
+                    format!(
+                        "the {node} of mode {} would be about {amp:e} {unit}, outside {lo:e}..{hi:e}: the chain would {what}",
+                        k + 1
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_converters(&self, warnings: &mut Vec<String>) -> Result<(), ConfigError> {
+        let b = &self.board;
+        let lsb = |bits: u32, full_scale: f64| full_scale / (1u64 << (bits - 1)) as f64;
+        for k in 0..2 {
+            let a = node_amplitudes(self, k);
+            let drive_key = ["drive.f1", "drive.f2"][k];
+            if let Some(bits) = b.dac_bits {
+                let step = lsb(bits, b.dac_full_scale);
+                check(
+                    a[0] >= 0.5 * step,
+                    drive_key,
+                    a[0],
+                    &format!(
+                        "is below half an LSB of the DAC ({step:e} = board.dac_full_scale / 2^(board.dac_bits - 1)): every drive sample would be 0; raise it or board.dac_bits, or lower board.dac_full_scale"
+                    ),
+                )?;
+                if a[0] > b.dac_full_scale - 0.5 * step {
+                    warnings.push(format!(
+                        "{drive_key} = {} exceeds the DAC's range (board.dac_full_scale = {}): the drive's peaks will clip; raise board.dac_full_scale",
+                        a[0], b.dac_full_scale
+                    ));
+                }
+            }
+            let tia_out = a[4];
+            if let Some(bits) = b.adc_bits {
+                let step = lsb(bits, b.adc_full_scale_v);
+                // The amplitude is an estimate at resonance: refuse only a clearly dead ADC.
+                if tia_out < 0.125 * step && self.noise.is_none() {
+                    return Err(ConfigError::key(
+                        "board.adc_bits",
+                        bits,
+                        format!(
+                            "the TIA output of mode {} (about {tia_out:e} V) is far below half an LSB of the ADC ({:e} V): every sample would read 0; raise board.tia_gain_ohm or board.adc_bits, or lower board.adc_full_scale_v",
+                            k + 1,
+                            0.5 * step
+                        ),
+                    ));
+                }
+                if tia_out < 0.5 * step {
+                    warnings.push(format!(
+                        "the TIA output of mode {} (about {tia_out:e} V) is below half an LSB of the ADC ({:e} V): the signal survives only as dither of the noise",
+                        k + 1,
+                        0.5 * step
+                    ));
+                }
+                if tia_out > b.adc_full_scale_v - 0.5 * step {
+                    warnings.push(format!(
+                        "the TIA output of mode {} (about {tia_out:e} V) exceeds the ADC's range (board.adc_full_scale_v = {}): it will clip; raise board.adc_full_scale_v or lower board.tia_gain_ohm",
+                        k + 1,
+                        b.adc_full_scale_v
+                    ));
+                }
+            }
+            if let Some(rail) = b.tia_rail_v {
+                if tia_out > rail {
+                    warnings.push(format!(
+                        "the TIA output of mode {} (about {tia_out:e} V) exceeds board.tia_rail_v = {rail}: it will saturate; raise the rails or lower board.tia_gain_ohm",
+                        k + 1
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The DAC holds each drive sample for a period: the measured phase departs from the
+    /// continuous-drive theory by what the exact held-drive steady state says. Stated when it
+    /// matters, refused when the hold's images dominate.
+    fn validate_hold(&self, warnings: &mut Vec<String>) -> Result<(), ConfigError> {
+        let dev = DrivenDevice {
+            plant: self.resonator_params(),
+            drive: [self.drive.f1, self.drive.f2],
+            phase_shifter_error_deg: self.board.phase_shifter_error_deg,
+        };
+        let deg = core::f64::consts::PI / 180.0;
+        let mut worst: f64 = 0.0;
+        for &r in &self.experiment.rates_dps {
+            let omega = r * deg;
+            let (held, exact) = match self.shape() {
+                Shape::Rotating => (
+                    dev.held_rotating_psi_rad(omega),
+                    dev.rotating_psi_rad(omega),
+                ),
+                // A rate table swings through its amplitude: the Coriolis phase there bounds it.
+                _ => (
+                    dev.held_coriolis_phase_rad(omega),
+                    dev.coriolis_phase_rad(omega),
+                ),
+            };
+            for k in 0..2 {
+                let e = ((held[k] - exact[k]) / deg * 1e3).abs();
+                // A NaN (an unbuildable plant) is reported by the other rules.
+                if e.is_finite() {
+                    worst = worst.max(e);
+                }
+            }
+        }
+        let per_period = self.board.fs_hz / self.device.f0_hz;
+        check(
+            worst <= MAX_HOLD_ERROR_MDEG,
+            "board.fs_hz",
+            self.board.fs_hz,
+            &format!(
+                "at {per_period:.2} samples per carrier period the DAC's zero-order hold moves the measured phase by up to {worst:.3e} mdeg from the continuous-drive theory (its images beside the carrier dominate); raise fs_hz (16 samples per period keeps it near 0.01 mdeg)"
+            ),
+        )?;
+        if worst > WARN_HOLD_ERROR_MDEG {
+            warnings.push(format!(
+                "board.fs_hz = {} ({per_period:.2} samples per carrier period): the DAC's zero-order hold moves the measured phase by up to {worst:.3e} mdeg from the continuous-drive theory at these rates (the exact held-drive steady state); raise fs_hz to shrink it",
+                self.board.fs_hz
+            ));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,86 @@
+//! What a run will cost, said before it starts: the operating-point samples it emulates and
+//! an estimate of the time from the chain's throughput measured on this machine; a cap above
+//! which a run needs the user's explicit consent (`--force`).
+
+use crate::bench::chain;
+use crate::sweep::canonical_work;
+use gyroemu_board::Point;
+use gyroemu_config::Config;
+
+/// Runs above this many operating-point samples are refused unless forced: about 5 to 15
+/// minutes of a 2-core machine (1e11 point-samples at 100 to 300 M point-samples/s), far more
+/// than any figure of the paper needs (the full `reproduce` is 1.3e9).
+pub const MAX_POINT_SAMPLES: u64 = 100_000_000_000;
+
+/// The size of a sweep.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Work {
+    /// Operating points emulated.
+    pub points: usize,
+    /// Operating-point samples emulated (input samples times points per lane group).
+    pub point_samples: u64,
+    /// The longest point's run (settling plus averaging), s.
+    pub longest_s: f64,
+}
+
+impl Work {
+    /// Two pieces of work done one after the other.
+    pub fn plus(self, o: Work) -> Work {
+        Work {
+            points: self.points + o.points,
+            point_samples: self.point_samples + o.point_samples,
+            longest_s: self.longest_s.max(o.longest_s),
+        }
+    }
+
+    /// One line for the user: the plan and, given a throughput, the time it should take.
+    pub fn describe(&self, point_samples_per_s: Option<f64>) -> String {
+        let time = point_samples_per_s.map_or(String::new(), |r| {
+            format!(
+                ", about {:.3} s at the {:.0} M point-samples/s measured here",
+                self.point_samples as f64 / r,
+                r / 1e6
+            )
+        });
+        format!(
+            "plan: {} operating points, {:.3e} point-samples (longest point {:.4} s of signal){time}",
+            self.points, self.point_samples as f64, self.longest_s
+        )
+    }
+
+    /// Refuses work above [`MAX_POINT_SAMPLES`] unless `force`, with what to do.
+    pub fn check_cap(&self, force: bool) -> Result<(), String> {
+        if force || self.point_samples <= MAX_POINT_SAMPLES {
+            return Ok(());
+        }
+        Err(format!(
+            "{}: above the cap of {:.0e} point-samples without --force (a mistyped Q or averaging time would otherwise start a run of days); shorten experiment.average_s or experiment.settle_s (the default settling is 16 mechanical time constants Q/(pi f0)), or add --force to run it anyway",
+            self.describe(None),
+            MAX_POINT_SAMPLES as f64
+        ))
+    }
+}
+
+/// The work of `cfg`'s sweep.
+pub fn sweep_work(cfg: &Config) -> Work {
+    let points: Vec<Point> = cfg
+        .emulated_rates_dps()
+        .iter()
+        .map(|&r| cfg.plan_point(r))
+        .collect();
+    let (_, point_samples) = canonical_work(cfg, &points);
+    let longest = points.iter().map(|p| p.window.samples()).max().unwrap_or(1);
+    Work {
+        points: points.len(),
+        point_samples,
+        longest_s: (cfg.n_settle_out() + longest) as f64 / cfg.fs_out_hz(),
+    }
+}
+
+/// The chain's throughput on this machine and config, point-samples/s on every thread, from a
+/// short timed run (about 2^18 input samples per thread: a few milliseconds).
+pub fn measured_throughput(cfg: &Config) -> f64 {
+    let m = cfg.board.decimation as u64;
+    let n_in = (1u64 << 18).max(8 * m);
+    chain(cfg, n_in, rayon::current_num_threads())
+}

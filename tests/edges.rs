@@ -1,0 +1,104 @@
+//! Issue 11, correctness at the edges: a dead channel, a clipped converter, an overflowing or
+//! underflowing chain never read out as a clean phase. Each refused phase is NaN (null in
+//! JSON), named with its stage and the setting to change; clipping is counted and warned.
+#![allow(clippy::needless_range_loop)]
+
+mod common;
+use common::*;
+use gyroemu::config::Config;
+use std::f64::consts::PI;
+
+/// The M^2-TFG Coriolis board with an 8-bit ADC whose full scale puts the TIA output (about
+/// 20 mV) at `lsbs` LSBs.
+fn with_adc(lsbs: f64) -> Config {
+    let mut c = config("coriolis", 15e3, 2000.0, 1.0, 1.0, &[25.0, 100.0], 0.1);
+    let tia = 1e-6 * 1e6 * 2000.0 / (2.0 * PI * 15e3) / (1.0 + 0.25f64.powi(2)).sqrt();
+    c.board.adc_bits = Some(8);
+    c.board.adc_full_scale_v = tia / lsbs * 128.0;
+    c
+}
+
+#[test]
+fn an_adc_that_reads_only_zeros_gives_no_phase_and_names_the_setting() {
+    // 0.3 LSB: validation warns (below half an LSB), every sample then rounds to 0.
+    let c = with_adc(0.3);
+    let w = c.validate().expect("a warning, not a refusal");
+    assert!(w.iter().any(|w| w.contains("below half an LSB")), "{w:?}");
+    let r = run(&c);
+    assert_eq!(r.problems.len(), 4, "{:?}", r.problems);
+    for p in &r.problems {
+        assert!(
+            p.contains("ADC") && p.contains("board.adc_full_scale_v"),
+            "{p}"
+        );
+    }
+    for p in &r.points {
+        assert!(p.phase_deg.iter().all(|v| v.is_nan()), "{p:?}");
+    }
+    assert!(r.max_abs_error_mdeg(0).is_nan() && r.max_abs_error_mdeg(1).is_nan());
+    // Every sample of both channels was 0: counted over the whole run of every point.
+    let h = r.health;
+    assert!(h.samples > 0 && h.adc_zero == [h.samples; 2], "{h:?}");
+}
+
+#[test]
+fn a_working_adc_counts_no_dead_sample_and_clipping_is_counted_and_warned() {
+    // 40 LSBs: a working channel, phases within the quantisation's reach of theory.
+    let r = run(&with_adc(40.0));
+    assert!(r.problems.is_empty() && r.warnings.is_empty(), "{r:?}");
+    assert!(r.health.adc_zero[0] < r.health.samples / 10);
+    for p in &r.points {
+        assert!(p.phase_deg.iter().all(|v| v.is_finite()));
+    }
+    // 300 LSBs of amplitude on a 128-code half range: the ADC clips, and says how often.
+    let c = with_adc(300.0);
+    assert!(c.validate().unwrap().iter().any(|w| w.contains("clip")));
+    let r = run(&c);
+    let h = r.health;
+    assert!(h.adc_clipped[0] > 0 && h.adc_clipped[1] > 0, "{h:?}");
+    assert!(
+        r.warnings.iter().any(|w| w.contains("the ADC clipped")
+            && w.contains("board.adc_full_scale_v")
+            && w.contains(&format!("of {} samples", h.samples))),
+        "{:?}",
+        r.warnings
+    );
+    // A symmetric clip keeps the fundamental's phase of a pure carrier: still a number.
+    assert!(r.problems.is_empty());
+}
+
+#[test]
+fn a_dead_drive_refuses_both_modes_naming_the_dac_setting() {
+    // Validation refuses a drive below half a DAC LSB; a library user who skips it still gets
+    // no phase: the run counts the all-zero drive and refuses both modes.
+    let mut c = config("rotating", 15e3, 2000.0, 1.0, 1.0, &[50.0, 100.0], 3.6);
+    c.board.dac_bits = Some(8);
+    c.drive.f1 = 1e-3;
+    let e = c.validate().unwrap_err();
+    assert_eq!(e.key.as_deref(), Some("drive.f1"));
+    let r = run(&c);
+    assert_eq!(r.problems.len(), 4, "{:?}", r.problems);
+    assert!(r.problems.iter().all(|p| p.contains("drive.f1")));
+    assert!(r
+        .points
+        .iter()
+        .all(|p| p.phase_deg[0].is_nan() && p.phase_deg[1].is_nan()));
+    assert!(r.points.iter().all(|p| p.paper_i_deg.unwrap()[0].is_nan()));
+}
+
+#[test]
+fn an_underflowing_chain_gives_no_phase_instead_of_zero() {
+    // Far below the refused range the products of the read-out underflow to exact zeros, and
+    // atan2(0, 0) would read as a clean 0 degrees.
+    let mut c = config("coriolis", 15e3, 2000.0, 1.0, 1.0, &[25.0, 100.0], 0.1);
+    c.drive.f1 = 1e-300;
+    c.drive.f2 = 1e-300;
+    assert!(c.validate().is_err());
+    let r = run(&c);
+    assert!(!r.problems.is_empty());
+    assert!(
+        r.points.iter().all(|p| p.phase_deg[0].is_nan()),
+        "{:?}",
+        r.points
+    );
+}
