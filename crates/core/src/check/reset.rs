@@ -8,8 +8,8 @@ use core::fmt::Debug;
 const RUN: usize = 3000;
 
 /// Checks that [`Stage::reset`] returns a stage to the state it was built in: a clone run on
-/// [`RUN`] seeded inputs, reset, then run on [`RUN`] further inputs gives the bits a fresh
-/// clone gives on those further inputs; and a reset of a fresh clone changes nothing.
+/// 3000 seeded inputs, reset, then run on 3000 further inputs gives the bits a fresh clone
+/// gives on those further inputs; and a reset of a fresh clone changes nothing.
 ///
 /// `stage` must be as built (the state `reset` restores); it is cloned, never advanced.
 /// `input` draws one input sample; `view` maps an output to what is compared
