@@ -1,16 +1,14 @@
-//! The drive DAC: optional quantisation plus the zero-order hold's frequency response.
+//! The drive DAC: optional quantisation. Its zero-order hold is realised by the plant.
 
 use crate::Quantizer;
-use gyroemu_core::{detmath, error, ParamResult, Response, Sample, Stage};
-use num_complex::Complex64;
+use gyroemu_core::{error, ParamResult, Sample, Stage};
 
 const STAGE: &str = "dac";
 
-/// The drive DAC. Per sample it only quantises (if configured); the zero-order hold itself is
-/// realised exactly by the plant, whose discretisation assumes the force is held constant
-/// over each sample period (ZOH). [`Response`] reports that hold, `sinc(f Ts) e^{-j pi f Ts}`
-/// (`sinc(x) = sin(pi x)/(pi x)`), and the latency is half a sample, so readout chain terms
-/// (about `Omega Ts / 2` in the rotating phase, THEORY section 6) can be compensated.
+/// The drive DAC. Per sample it only quantises (if configured): memoryless, impulse response
+/// `[1]`. The zero-order hold itself is realised exactly by the plant, whose discretisation
+/// assumes the force is held constant over each sample period; its response is
+/// `gyroemu_resonator::hold_response`.
 #[derive(Clone, Copy, Debug)]
 pub struct Dac<S> {
     fs_hz: f64,
@@ -53,25 +51,4 @@ impl<S: Sample> Stage for Dac<S> {
     }
 
     fn reset(&mut self) {}
-
-    /// The hold delays by half a sample.
-    fn latency_samples(&self) -> f64 {
-        0.5
-    }
-}
-
-impl<S: Sample> Response for Dac<S> {
-    /// The zero-order hold, `sinc(f Ts) e^{-j pi f Ts}` (quantisation is not linear and is
-    /// not included).
-    fn response(&self, f_hz: f64) -> Complex64 {
-        let x = f_hz / self.fs_hz; // f Ts
-                                   // sin(pi x) and e^{-j pi x} from half a turn of x, reduced exactly in turns.
-        let (s, c) = detmath::sin_cos_turns(0.5 * x);
-        let sinc = if x == 0.0 {
-            1.0
-        } else {
-            s / (core::f64::consts::PI * x)
-        };
-        Complex64::new(sinc * c, -sinc * s)
-    }
 }

@@ -2,11 +2,10 @@
 //! frequency response, parameter errors.
 
 use gyroemu_am::{Dac, Quantizer};
-use gyroemu_core::{f64x4, Response, Sample, Stage};
-use num_complex::Complex64;
+use gyroemu_core::{f64x4, Sample, Stage};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 /// A busy signal: three incommensurate tones, peak below 0.95 of full scale.
 fn busy(n: usize, full_scale: f64) -> impl Iterator<Item = f64> {
@@ -72,46 +71,6 @@ fn odd_symmetric_idempotent_and_clipping() {
         assert_eq!(q.quantize(1e9), top);
         assert_eq!(q.quantize(-1e9), -fs);
     }
-}
-
-#[test]
-fn dac_hold_response_matches_the_hold_integral() {
-    let fs = 1e6;
-    let dac = Dac::<f64>::new(fs, None).unwrap();
-    let ts = 1.0 / fs;
-    for f in [
-        0.0, 1.0, 15_000.0, 123_456.7, 499_999.0, -300_000.0, 1.3e6, 2.0e6,
-    ] {
-        let h = dac.response(f);
-        // (1/Ts) * integral_0^Ts e^{-j 2 pi f t} dt, the hold's average, by 20 000-point
-        // midpoint rule, which is exact enough here (error ~ (2 pi f Ts / M)^2 / 24).
-        let m = 20_000;
-        let mut acc = Complex64::new(0.0, 0.0);
-        for i in 0..m {
-            let t = (i as f64 + 0.5) / m as f64 * ts;
-            acc += Complex64::from_polar(1.0, -TAU * f * t);
-        }
-        let want = acc / m as f64;
-        assert!((h - want).norm() < 1e-7, "f = {f}: {h} vs {want}");
-        // And the closed form (1 - e^{-j w Ts}) / (j w Ts)
-        if f != 0.0 {
-            let w = TAU * f * ts;
-            let cf = (Complex64::new(1.0, 0.0) - Complex64::from_polar(1.0, -w))
-                / Complex64::new(0.0, w);
-            // (the closed form cancels at small w, losing ~1e-16 / w)
-            assert!((h - cf).norm() < 1e-13 + 1e-15 / w.abs(), "f = {f}");
-        }
-    }
-    assert_eq!(dac.response(0.0), Complex64::new(1.0, 0.0));
-    assert!(dac.response(fs).norm() < 1e-16); // null at fs
-                                              // Group delay at DC: -d arg H / d omega = Ts/2, i.e. latency_samples().
-    let df = 1.0;
-    let gd = -(dac.response(df).arg() - dac.response(-df).arg()) / (TAU * 2.0 * df) * fs;
-    assert!((gd - dac.latency_samples()).abs() < 1e-9);
-    assert_eq!(dac.latency_samples(), 0.5);
-    // Gain at a 16-samples-per-period carrier: sinc(1/16).
-    let g = dac.response(fs / 16.0).norm();
-    assert!((g - (PI / 16.0).sin() / (PI / 16.0)).abs() < 1e-15);
 }
 
 #[test]

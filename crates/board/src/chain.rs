@@ -2,18 +2,17 @@
 //! that the read-out compensates exactly the chain that produced the data.
 
 use crate::board::modulation_hz;
-use crate::params::{build_dac, build_lowpass, build_tia, BoardParams};
+use crate::params::{build_lowpass, build_tia, BoardParams};
 use crate::point::Point;
-use gyroemu_am::Dac;
 use gyroemu_core::{Complex64, ParamResult, Response};
 use gyroemu_lpf::{KahanSum, LowPass};
 use gyroemu_nco::{phasor_of_word, Nco};
+use gyroemu_resonator::hold_response;
 use gyroemu_tia::Tia;
 
 /// The linear stages between the drive and the stage-2 read-out, as built.
 #[derive(Clone, Debug)]
 pub struct ChainResponse {
-    dac: Dac<f64>,
     tia: Tia<f64>,
     lowpass: LowPass<f64>,
     carrier_hz: f64,
@@ -25,7 +24,6 @@ impl ChainResponse {
     /// The responses of the board `p` describes.
     pub fn new(p: &BoardParams) -> ParamResult<Self> {
         Ok(Self {
-            dac: build_dac(p)?,
             tia: build_tia(p)?,
             lowpass: build_lowpass(p)?,
             carrier_hz: p.carrier_hz,
@@ -34,9 +32,10 @@ impl ChainResponse {
         })
     }
 
-    /// The DAC's zero-order hold at `f_hz` (its quantiser is not linear and is left out).
+    /// The DAC's zero-order hold at `f_hz`, which the plant realises (the DAC's quantiser is
+    /// not linear and is left out).
     pub fn dac_hold(&self, f_hz: f64) -> Complex64 {
-        self.dac.response(f_hz)
+        hold_response(f_hz, self.fs_hz)
     }
 
     /// The TIA at `f_hz`.

@@ -2,6 +2,8 @@
 //! the numeric sample type every stage is generic over, the small interface every stage
 //! shares, the parameter error, and trigonometry that gives the same bits on every platform.
 
+#[cfg(feature = "check")]
+pub mod check;
 pub mod detmath;
 pub mod error;
 pub mod noise;

@@ -13,11 +13,13 @@
 //! exponential is taken per sample.
 
 mod discretise;
+mod hold;
 mod params;
 mod plant;
 mod steady;
 mod thermal;
 
+pub use hold::hold_response;
 pub use params::{ModeParams, ResonatorParams};
 pub use plant::{PlantOutput, Resonator};
 pub use steady::continuous_steady_state;
