@@ -113,33 +113,4 @@ mod tests {
         }
         assert!(worst < 1e-14, "worst deviation {worst}");
     }
-
-    #[test]
-    fn lanes_equal_scalar_and_reset_reproduces() {
-        let ncos: Vec<Nco> = [1.0, 2.0, 3.0, 4.0]
-            .iter()
-            .map(|&f| Nco::new(f * 1e3, 48e3, 0.0).unwrap())
-            .collect();
-        let mut lanes = RotatingNco::<f64x4>::new(&ncos);
-        let mut scalars: Vec<RotatingNco<f64>> = ncos
-            .iter()
-            .map(|n| RotatingNco::new(std::slice::from_ref(n)))
-            .collect();
-        let first: Vec<(f64x4, f64x4)> = (0..1000).map(|_| lanes.tick(())).collect();
-        for (k, (c, s)) in first.iter().enumerate() {
-            let _ = k;
-            for (i, sc) in scalars.iter_mut().enumerate() {
-                let (a, b) = sc.tick(());
-                assert_eq!(
-                    (c.lane(i).to_bits(), s.lane(i).to_bits()),
-                    (a.to_bits(), b.to_bits())
-                );
-            }
-        }
-        lanes.reset();
-        for (c, s) in &first {
-            let (c2, s2) = lanes.tick(());
-            assert_eq!((c.to_array(), s.to_array()), (c2.to_array(), s2.to_array()));
-        }
-    }
 }
