@@ -92,7 +92,7 @@ fn an_underflowing_chain_gives_no_phase_instead_of_zero() {
     // atan2(0, 0) would read as a clean 0 degrees.
     let mut c = config("coriolis", 15e3, 2000.0, 1.0, 1.0, &[25.0, 100.0], 0.1);
     c.drive.f1 = 1e-300;
-    c.drive.f2 = 1e-300;
+    c.drive.f2 = Some(1e-300);
     assert!(c.validate().is_err());
     let r = run(&c);
     assert!(!r.problems.is_empty());

@@ -37,11 +37,11 @@ fn brownian_motion_obeys_equipartition() {
     cfg.device.f0_hz = 1000.0;
     cfg.device.q = 10.0;
     cfg.drive.f1 = 1e-30;
-    cfg.drive.f2 = 1e-30;
-    cfg.board.fs_hz = 16_000.0;
+    cfg.drive.f2 = Some(1e-30);
+    cfg.board.fs_hz = Some(16_000.0);
     cfg.board.tia_pole_hz = Some(4000.0);
-    cfg.board.decimation = 10;
-    cfg.board.lpf_cutoff_hz = 50.0;
+    cfg.board.decimation = Some(10);
+    cfg.board.lpf_cutoff_hz = Some(50.0);
     let (m, t) = (1e-12, 300.0);
     cfg.noise = Some(noise(Some(m), 0.0, 0.0));
     cfg.validate().unwrap();
@@ -125,7 +125,7 @@ fn board_cfg() -> (Config, f64) {
     let d = &cfg.device;
     let w0 = 2.0 * PI * d.f0_hz;
     // Velocity amplitude at resonance F Q / w0, the held drive scaled by sinc(f0 / fs).
-    let v = cfg.drive.f1 * sinc(d.f0_hz / cfg.board.fs_hz) * d.q / w0;
+    let v = cfg.drive.f1 * sinc(d.f0_hz / cfg.fs_hz()) * d.q / w0;
     let i = d.transduction_a_s_per_m * v;
     (cfg, i)
 }
@@ -159,7 +159,7 @@ fn brownian_force_gives_the_snr_phase_noise() {
     let d = &cfg.device;
     // Force per unit mass: 4 k T w0 / (m Q); drive amplitude F sinc(f0 / fs).
     let s = 4.0 * K_B * 300.0 * 2.0 * PI * d.f0_hz / (m * d.q);
-    let f = cfg.drive.f1 * sinc(d.f0_hz / cfg.board.fs_hz);
+    let f = cfg.drive.f1 * sinc(d.f0_hz / cfg.fs_hz());
     let expected = (s / t).sqrt() / f;
     let got = std_dev(&ph);
     assert!(

@@ -17,7 +17,7 @@ fn overflow_names_the_stage_and_the_sample() {
     let (f, t_a) = (1e295, 1e10);
     c.device.transduction_a_s_per_m = t_a;
     c.drive.f1 = f;
-    c.drive.f2 = f;
+    c.drive.f2 = Some(f);
     c.experiment.average_s = 0.1;
     let refused = c.validate().expect_err("the drive is far beyond 1e100");
     assert_eq!(refused.key.as_deref(), Some("drive.f1"), "{refused}");
@@ -38,7 +38,7 @@ fn overflow_names_the_stage_and_the_sample() {
                 e.time_s > 0.95 * t_lo && e.time_s < 1.05 * t_hi,
                 "{e}: expected between {t_lo} and {t_hi} s"
             );
-            assert_eq!(e.sample as f64 / c.board.fs_hz, e.time_s);
+            assert_eq!(e.sample as f64 / c.fs_hz(), e.time_s);
             assert!(e
                 .to_string()
                 .contains(&format!("input sample {}", e.sample)));

@@ -57,7 +57,7 @@ fn check(f0: f64, q: f64, ratio: f64, rates: &[f64]) {
     }
     // Compensated terms are reported for every point, the hold close to Omega Ts / 2.
     for c in &r.compensation {
-        let hold = c.rate_dps * DEG / cfg.board.fs_hz / 2.0 / DEG * 1e3;
+        let hold = c.rate_dps * DEG / cfg.fs_hz() / 2.0 / DEG * 1e3;
         assert!(
             (c.dac_hold_mdeg - hold).abs() < 1e-6 * hold.max(1e-9) + 1e-9,
             "{c:?}"

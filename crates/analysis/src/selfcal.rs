@@ -81,9 +81,9 @@ pub fn mode_selfcal(cfg: &Config, rot: &SweepResult, cor: &SweepResult, k: usize
     let predicted_paper = lambda * rotating_paper_i.slope_deg_per_dps;
     let d = &cfg.device;
     let (own, other) = if k == 0 {
-        (cfg.drive.f1, cfg.drive.f2)
+        (cfg.drive.f1, cfg.f2())
     } else {
-        (cfg.drive.f2, cfg.drive.f1)
+        (cfg.f2(), cfg.drive.f1)
     };
     let w0 = core::f64::consts::TAU * d.f0_hz;
     ModeSelfcal {

@@ -57,7 +57,7 @@ pub fn allan_analysis(
     let streams: [u64; MAX_LANES] = core::array::from_fn(|i| ANALYSIS_STREAM_BASE + i as u64);
     let mut board = Board::<f64x4>::new(&cor.board_params(), &[0.0; MAX_LANES], &streams)?;
     let n_settle = cor.n_settle_out();
-    let total = (n_settle + n_avg + 1) * cor.board.decimation as u64;
+    let total = (n_settle + n_avg + 1) * cor.decimation() as u64;
     let opts = RunOptions {
         series_block: block,
         ..Default::default()

@@ -96,6 +96,9 @@ enum Command {
         /// List the presets.
         #[arg(long)]
         list: bool,
+        /// Print FILE with every key filled in: the derived defaults and their rules.
+        #[arg(long, value_name = "FILE", conflicts_with_all = ["preset", "list"])]
+        resolved: Option<PathBuf>,
     },
 }
 
@@ -185,7 +188,14 @@ fn run_cli() -> ExitCode {
         Command::Selfcal { config, out, force } => {
             cmd::selfcal::selfcal_command(&config, &out, force)
         }
-        Command::Config { preset, list } => cmd::config::config_command(preset.as_deref(), list),
+        Command::Config {
+            preset,
+            list,
+            resolved,
+        } => match resolved {
+            Some(path) => cmd::config::resolved_command(&path),
+            None => cmd::config::config_command(preset.as_deref(), list),
+        },
         Command::Bench {
             preset,
             samples,

@@ -9,6 +9,8 @@ use serde::{Deserialize, Serialize};
 pub struct Config {
     pub device: DeviceConfig,
     pub drive: DriveConfig,
+    /// The readout board (absent: every key at its default).
+    #[serde(default)]
     pub board: BoardConfig,
     pub experiment: ExperimentConfig,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -51,16 +53,20 @@ pub struct DeviceConfig {
 pub struct DriveConfig {
     /// Mode-1 drive amplitude F1 (F0 on mode 1 in the rotating run).
     pub f1: f64,
-    /// Mode-2 drive amplitude F2, 90 degrees after mode 1 (F0 on mode 2 in the rotating run).
-    pub f2: f64,
+    /// Mode-2 drive amplitude F2, 90 degrees after mode 1 (F0 on mode 2 in the rotating run);
+    /// default F1 (filled in by `parse_config`, read it with [`Config::f2`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub f2: Option<f64>,
 }
 
 /// The readout board.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoardConfig {
-    /// Emulation sample rate, Hz (at least 16 samples per carrier period is advised).
-    pub fs_hz: f64,
+    /// Emulation sample rate, Hz; default 16 times the highest f0 (filled in by
+    /// `parse_config`, read it with [`Config::fs_hz`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fs_hz: Option<f64>,
     /// Transimpedance gain, ohm.
     #[serde(default = "default_tia_gain")]
     pub tia_gain_ohm: f64,
@@ -76,10 +82,14 @@ pub struct BoardConfig {
     /// Order of the stage-1 Butterworth low-pass (1 to 8).
     #[serde(default = "default_lpf_order")]
     pub lpf_order: usize,
-    /// Cutoff of the stage-1 low-pass, Hz.
-    pub lpf_cutoff_hz: f64,
-    /// Decimation factor after the stage-1 low-pass.
-    pub decimation: usize,
+    /// Cutoff of the stage-1 low-pass, Hz; default derived from the device and the rates (see
+    /// `Config::resolve`; read it with [`Config::lpf_cutoff_hz`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lpf_cutoff_hz: Option<f64>,
+    /// Decimation factor after the stage-1 low-pass; default from the sample rate and the
+    /// cutoff (read it with [`Config::decimation`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decimation: Option<usize>,
     /// DAC resolution in bits (absent: ideal DAC).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dac_bits: Option<u32>,
@@ -95,6 +105,27 @@ pub struct BoardConfig {
     /// ADC full scale, V (the input range is -full scale to +full scale).
     #[serde(default = "default_adc_full_scale")]
     pub adc_full_scale_v: f64,
+}
+
+impl Default for BoardConfig {
+    /// Every key at the default it has when left out of a `[board]` table.
+    fn default() -> Self {
+        Self {
+            fs_hz: None,
+            tia_gain_ohm: default_tia_gain(),
+            tia_pole_hz: None,
+            tia_inverting: default_true(),
+            tia_rail_v: None,
+            lpf_order: default_lpf_order(),
+            lpf_cutoff_hz: None,
+            decimation: None,
+            dac_bits: None,
+            dac_full_scale: default_full_scale(),
+            phase_shifter_error_deg: 0.0,
+            adc_bits: None,
+            adc_full_scale_v: default_adc_full_scale(),
+        }
+    }
 }
 
 /// White, seeded noise sources (docs/user-guide.md gives the models).
@@ -201,15 +232,20 @@ pub struct ExperimentConfig {
 #[serde(deny_unknown_fields)]
 pub struct DumpConfig {
     /// Which operating point, deg/s (one of the emulated rates: `rates_dps`, plus 0 in a
-    /// constant-rate Coriolis run).
-    pub rate_dps: f64,
-    /// Start of the window, s from the start of the run.
-    pub start_s: f64,
-    /// Length of the window, s.
-    pub duration_s: f64,
+    /// constant-rate Coriolis run); default the largest listed rate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate_dps: Option<f64>,
+    /// Start of the window, s from the start of the run; default the end of settling.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_s: Option<f64>,
+    /// Length of the window, s; default four modulation periods of the dumped point (rotating,
+    /// rate table) or 200 carrier periods (Coriolis), within 1 ms .. 0.5 s and the run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duration_s: Option<f64>,
     /// Nodes to dump: any of `drive`, `displacement`, `velocity`, `tia`, `stage1`
-    /// (full rate), `lowpass`, `stage2` (decimated rate).
-    pub nodes: Vec<String>,
+    /// (full rate), `lowpass`, `stage2` (decimated rate); default all of them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nodes: Option<Vec<String>>,
 }
 
 fn default_transduction() -> f64 {

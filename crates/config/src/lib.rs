@@ -7,6 +7,7 @@ mod config;
 mod parse;
 mod plan;
 pub mod presets;
+mod resolve;
 mod validate;
 mod validate_noise;
 mod validate_regime;
@@ -15,6 +16,7 @@ pub use config::{
     BoardConfig, Config, DeviceConfig, DriveConfig, DumpConfig, ExperimentConfig, ExperimentKind,
     NoiseConfig, RateTable, SelfcalConfig, WindowKind,
 };
-pub use parse::{parse_config, ConfigError};
+pub use parse::{parse_config, parse_config_explained, ConfigError};
+pub use resolve::Derived;
 pub use validate::MAX_RUN_SAMPLES;
 pub use validate_regime::{MAX_HOLD_ERROR_MDEG, NODE_RANGE, WARN_HOLD_ERROR_MDEG};

@@ -2,6 +2,7 @@
 //! name the key, with the line and column where TOML parsing located it.
 
 use crate::config::Config;
+use crate::resolve::Derived;
 use thiserror::Error;
 
 /// A config the emulator refuses.
@@ -39,7 +40,20 @@ fn readable(value: String) -> String {
 }
 
 /// Parses TOML text into a config; unknown keys, wrong types and missing keys are errors.
+/// Keys with derived defaults that the text leaves out are filled in ([`Config::resolve`]).
 pub fn parse_config(text: &str) -> Result<Config, ConfigError> {
+    parse_config_explained(text).map(|(c, _)| c)
+}
+
+/// [`parse_config`], also saying which keys were derived and how.
+pub fn parse_config_explained(text: &str) -> Result<(Config, Vec<Derived>), ConfigError> {
+    let mut cfg = parse_raw(text)?;
+    let derived = cfg.resolve();
+    Ok((cfg, derived))
+}
+
+/// The TOML text as written, nothing derived.
+fn parse_raw(text: &str) -> Result<Config, ConfigError> {
     if text.trim().is_empty() {
         return Err(ConfigError {
             location: None,

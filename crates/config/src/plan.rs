@@ -31,7 +31,7 @@ impl Config {
 
     /// Output rate of the low-pass decimator, Hz.
     pub fn fs_out_hz(&self) -> f64 {
-        self.board.fs_hz / self.board.decimation as f64
+        self.fs_hz() / self.decimation() as f64
     }
 
     /// The settling time used: the configured one, or 16 mechanical time constants (phase
@@ -40,7 +40,7 @@ impl Config {
         self.experiment.settle_s.unwrap_or_else(|| {
             let q = self.device.q.max(self.device.q_mode2.unwrap_or(0.0));
             16.0 * mechanical_tau_s(self.device.f0_hz, q)
-                + 40.0 / (2.0 * core::f64::consts::PI * self.board.lpf_cutoff_hz)
+                + 40.0 / (2.0 * core::f64::consts::PI * self.lpf_cutoff_hz())
         })
     }
 
@@ -64,7 +64,7 @@ impl Config {
             angular_gain: d.angular_gain,
             quadrature_coupling_rad2_s2: d.quadrature_coupling_rad2_s2,
             transduction_a_s_per_m: d.transduction_a_s_per_m,
-            fs_hz: self.board.fs_hz,
+            fs_hz: self.fs_hz(),
         }
     }
 
@@ -72,7 +72,7 @@ impl Config {
     pub fn lowpass_design(&self) -> LowPassDesign {
         LowPassDesign::Butterworth {
             order: self.board.lpf_order,
-            cutoff_hz: self.board.lpf_cutoff_hz,
+            cutoff_hz: self.lpf_cutoff_hz(),
         }
     }
 
@@ -82,7 +82,7 @@ impl Config {
         BoardParams {
             plant: self.resonator_params(),
             carrier_hz: self.device.f0_hz,
-            drive: [self.drive.f1, self.drive.f2],
+            drive: [self.drive.f1, self.f2()],
             phase_shifter_error_deg: b.phase_shifter_error_deg,
             dac: b.dac_bits.map(|bits| Converter {
                 bits,
@@ -93,14 +93,14 @@ impl Config {
                 pole_hz: b.tia_pole_hz,
                 inverting: b.tia_inverting,
                 rail_v: b.tia_rail_v,
-                fs_hz: b.fs_hz,
+                fs_hz: self.fs_hz(),
             },
             adc: b.adc_bits.map(|bits| Converter {
                 bits,
                 full_scale: b.adc_full_scale_v,
             }),
             lowpass: self.lowpass_design(),
-            decimation: b.decimation,
+            decimation: self.decimation(),
             noise: self.noise.as_ref().map(|n| NoiseParams {
                 seed: n.seed,
                 temperature_k: n.temperature_k,

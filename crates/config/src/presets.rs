@@ -66,7 +66,7 @@ mod tests {
             let c = preset(name).unwrap_or_else(|e| panic!("{name}: {e}"));
             c.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
             // At least 16 samples per carrier period on the embedded defaults.
-            assert!(c.board.fs_hz >= 16.0 * c.device.f0_hz, "{name}");
+            assert!(c.fs_hz() >= 16.0 * c.device.f0_hz, "{name}");
         }
     }
 }

@@ -50,6 +50,8 @@ impl Config {
         let d = &self.device;
         let b = &self.board;
         let e = &self.experiment;
+        let (fs_hz, cutoff_hz, decimation) =
+            (self.fs_hz(), self.lpf_cutoff_hz(), self.decimation());
         let mut warnings = Vec::new();
         positive("device.f0_hz", d.f0_hz)?;
         positive("device.q", d.q)?;
@@ -70,25 +72,25 @@ impl Config {
         )?;
         positive("device.transduction_a_s_per_m", d.transduction_a_s_per_m)?;
         positive("drive.f1", self.drive.f1)?;
-        positive("drive.f2", self.drive.f2)?;
+        positive("drive.f2", self.f2())?;
 
-        positive("board.fs_hz", b.fs_hz)?;
+        positive("board.fs_hz", fs_hz)?;
         let f_max = d.f0_hz.max(self.f0_mode2_hz());
         check(
-            b.fs_hz > 2.0 * f_max,
+            fs_hz > 2.0 * f_max,
             "board.fs_hz",
-            b.fs_hz,
+            fs_hz,
             &format!("must be above 2*f0 = {} Hz", 2.0 * f_max),
         )?;
         positive("board.tia_gain_ohm", b.tia_gain_ohm)?;
         if let Some(p) = b.tia_pole_hz {
             check(
-                p.is_finite() && p > 0.0 && p < 0.5 * b.fs_hz,
+                p.is_finite() && p > 0.0 && p < 0.5 * fs_hz,
                 "board.tia_pole_hz",
                 p,
                 &format!(
                     "must be > 0 and below Nyquist (fs_hz/2 = {} Hz)",
-                    0.5 * b.fs_hz
+                    0.5 * fs_hz
                 ),
             )?;
         }
@@ -102,31 +104,31 @@ impl Config {
             "must be an integer from 1 to 8",
         )?;
         check(
-            b.decimation >= 1,
+            decimation >= 1,
             "board.decimation",
-            b.decimation,
+            decimation,
             "must be an integer >= 1",
         )?;
         let nyq_out = 0.5 * self.fs_out_hz();
         check(
-            b.lpf_cutoff_hz.is_finite() && b.lpf_cutoff_hz > 0.0 && b.lpf_cutoff_hz < nyq_out,
+            cutoff_hz.is_finite() && cutoff_hz > 0.0 && cutoff_hz < nyq_out,
             "board.lpf_cutoff_hz",
-            b.lpf_cutoff_hz,
+            cutoff_hz,
             &format!(
                 "must be > 0 and below the Nyquist rate after decimation (fs_hz/decimation/2 = {nyq_out} Hz)"
             ),
         )?;
         check(
-            b.lpf_cutoff_hz < d.f0_hz,
+            cutoff_hz < d.f0_hz,
             "board.lpf_cutoff_hz",
-            b.lpf_cutoff_hz,
+            cutoff_hz,
             "must be below f0_hz so the low-pass removes the 2*f0 mixing product",
         )?;
         // The design itself: f64 must realise it with its poles inside the unit circle.
-        gyroemu_lpf::LowPass::<f64>::new(self.lowpass_design(), b.fs_hz).map_err(|e| {
+        gyroemu_lpf::LowPass::<f64>::new(self.lowpass_design(), fs_hz).map_err(|e| {
             ConfigError::key(
                 "board.lpf_cutoff_hz",
-                b.lpf_cutoff_hz,
+                cutoff_hz,
                 format!("the stage-1 low-pass cannot be built: {}", e.rule),
             )
         })?;
@@ -157,12 +159,12 @@ impl Config {
             if e.kind == ExperimentKind::Rotating {
                 let f_mod = r.abs() / 360.0;
                 check(
-                    f_mod < b.lpf_cutoff_hz,
+                    f_mod < cutoff_hz,
                     &format!("experiment.rates_dps[{i}]"),
                     r,
                     &format!(
                         "the modulation frequency |rate|/360 must be below board.lpf_cutoff_hz = {} Hz",
-                        b.lpf_cutoff_hz
+                        cutoff_hz
                     ),
                 )?;
             }
@@ -188,7 +190,7 @@ impl Config {
             ),
         )?;
         // Sample indices and counts must stay exact in f64 (and far from u64 overflow).
-        let run_samples = (self.settle_s() + e.average_s) * b.fs_hz;
+        let run_samples = (self.settle_s() + e.average_s) * fs_hz;
         check(
             run_samples <= MAX_RUN_SAMPLES,
             if e.settle_s.is_some_and(|s| s > e.average_s) {
@@ -199,7 +201,7 @@ impl Config {
             e.settle_s.filter(|&s| s > e.average_s).unwrap_or(e.average_s),
             &format!(
                 "settling plus averaging must span at most 2^53 = {MAX_RUN_SAMPLES:e} input samples per point (here {run_samples:e} at fs_hz = {})",
-                b.fs_hz
+                fs_hz
             ),
         )?;
         if e.kind == ExperimentKind::Rotating {
@@ -247,12 +249,12 @@ impl Config {
                     ));
                 };
                 check(
-                    ft.is_finite() && ft > 0.0 && ft < b.lpf_cutoff_hz,
+                    ft.is_finite() && ft > 0.0 && ft < cutoff_hz,
                     "experiment.table_freq_hz",
                     ft,
                     &format!(
                         "must be > 0 and below board.lpf_cutoff_hz = {} Hz",
-                        b.lpf_cutoff_hz
+                        cutoff_hz
                     ),
                 )?;
                 check(
@@ -285,45 +287,51 @@ impl Config {
         }
         self.validate_noise_adc_selfcal(&mut warnings)?;
         self.validate_regime(&mut warnings)?;
-        if let Some(dump) = &self.dump {
+        if let Some(dump) = self.dump_resolved() {
+            let (rate_dps, start_s, duration_s) = (
+                dump.rate_dps.unwrap_or(f64::NAN),
+                dump.start_s.unwrap_or(f64::NAN),
+                dump.duration_s.unwrap_or(f64::NAN),
+            );
+            let nodes = dump.nodes.unwrap_or_default();
             let emulated = self.emulated_rates_dps();
             check(
-                emulated.contains(&dump.rate_dps),
+                emulated.contains(&rate_dps),
                 "dump.rate_dps",
-                dump.rate_dps,
+                rate_dps,
                 &format!("must be one of the emulated rates {emulated:?}"),
             )?;
-            non_negative("dump.start_s", dump.start_s)?;
-            positive("dump.duration_s", dump.duration_s)?;
+            non_negative("dump.start_s", start_s)?;
+            positive("dump.duration_s", duration_s)?;
             // The point runs settling plus its own averaging window (whole half periods).
-            let p = self.plan_point(dump.rate_dps);
+            let p = self.plan_point(rate_dps);
             let n_out = self
                 .n_settle_out()
                 .saturating_add(p.n_avg())
                 .saturating_add(1);
             let total = n_out as f64 / self.fs_out_hz();
             check(
-                dump.start_s + dump.duration_s <= total,
+                start_s + duration_s <= total,
                 "dump.duration_s",
-                dump.duration_s,
+                duration_s,
                 &format!(
                     "the window start_s + duration_s must end within that point's run ({total} s)"
                 ),
             )?;
-            let frames = dump.duration_s * b.fs_hz;
+            let frames = duration_s * fs_hz;
             check(
                 frames <= 5e7,
                 "dump.duration_s",
-                dump.duration_s,
+                duration_s,
                 "the window must hold at most 5e7 full-rate samples (keep dumps small)",
             )?;
             check(
-                !dump.nodes.is_empty(),
+                !nodes.is_empty(),
                 "dump.nodes",
                 "[]",
                 "must list at least one node",
             )?;
-            for (i, n) in dump.nodes.iter().enumerate() {
+            for (i, n) in nodes.iter().enumerate() {
                 check(
                     DUMP_NODES.contains(&n.as_str()),
                     &format!("dump.nodes[{i}]"),

@@ -45,7 +45,7 @@ impl Config {
             }
         }
         if let Some(s) = &self.selfcal {
-            let max_s = MAX_RUN_SAMPLES / b.fs_hz;
+            let max_s = MAX_RUN_SAMPLES / self.fs_hz();
             if let Some(t) = s.allan_record_s {
                 let min = (10.0 / self.fs_out_hz()).max(10.0);
                 check(

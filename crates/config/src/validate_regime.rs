@@ -27,7 +27,7 @@ fn node_amplitudes(c: &Config, k: usize) -> [f64; 5] {
     let p = c.resonator_params();
     let mode = [p.mode1, p.mode2][k];
     let w = core::f64::consts::TAU * mode.f0_hz;
-    let f = [c.drive.f1, c.drive.f2][k];
+    let f = [c.drive.f1, c.f2()][k];
     let v = f * mode.q / w;
     let i = c.device.transduction_a_s_per_m * v;
     let pole = c
@@ -169,7 +169,7 @@ impl Config {
     fn validate_hold(&self, warnings: &mut Vec<String>) -> Result<(), ConfigError> {
         let dev = DrivenDevice {
             plant: self.resonator_params(),
-            drive: [self.drive.f1, self.drive.f2],
+            drive: [self.drive.f1, self.f2()],
             phase_shifter_error_deg: self.board.phase_shifter_error_deg,
         };
         let deg = core::f64::consts::PI / 180.0;
@@ -195,11 +195,11 @@ impl Config {
                 }
             }
         }
-        let per_period = self.board.fs_hz / self.device.f0_hz;
+        let per_period = self.fs_hz() / self.device.f0_hz;
         check(
             worst <= MAX_HOLD_ERROR_MDEG,
             "board.fs_hz",
-            self.board.fs_hz,
+            self.fs_hz(),
             &format!(
                 "at {per_period:.2} samples per carrier period the DAC's zero-order hold moves the measured phase by up to {worst:.3e} mdeg from the continuous-drive theory (its images beside the carrier dominate); raise fs_hz (16 samples per period keeps it near 0.01 mdeg)"
             ),
@@ -207,7 +207,7 @@ impl Config {
         if worst > WARN_HOLD_ERROR_MDEG {
             warnings.push(format!(
                 "board.fs_hz = {} ({per_period:.2} samples per carrier period): the DAC's zero-order hold moves the measured phase by up to {worst:.3e} mdeg from the continuous-drive theory at these rates (the exact held-drive steady state); raise fs_hz to shrink it",
-                self.board.fs_hz
+                self.fs_hz()
             ));
         }
         Ok(())

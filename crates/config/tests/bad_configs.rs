@@ -292,10 +292,16 @@ fn cases() -> Vec<Case> {
             &["device.f0_hz", "missing field `f0_hz`"],
         ),
         case(
-            "missing decimation",
-            remove(&c, "board", "decimation"),
+            "missing angular_gain",
+            remove(&c, "device", "angular_gain"),
             Parse,
-            &["board.decimation", "missing field `decimation`"],
+            &["device.angular_gain", "missing field `angular_gain`"],
+        ),
+        case(
+            "missing f1",
+            remove(&c, "drive", "f1"),
+            Parse,
+            &["drive.f1", "missing field `f1`"],
         ),
         case(
             "missing rates",
@@ -310,10 +316,10 @@ fn cases() -> Vec<Case> {
             &["drive", "missing field `drive`"],
         ),
         case(
-            "dump without nodes",
-            remove(&dumped, "dump", "nodes"),
+            "missing average_s",
+            remove(&c, "experiment", "average_s"),
             Parse,
-            &["dump.nodes", "missing field `nodes`"],
+            &["experiment.average_s", "missing field `average_s`"],
         ),
         case(
             "only a comment",

@@ -85,16 +85,16 @@ fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
     let w0 = std::f64::consts::TAU * f0;
     c.device.quadrature_coupling_rad2_s2 = k12 * w0 * w0;
     c.drive.f1 = f1;
-    c.drive.f2 = f2;
+    c.drive.f2 = Some(f2);
 
     let (fs_mult, dec, cut, order, pole, gain, inverting, dac, adc, shift) = b;
     let f_max = f0.max(c.f0_mode2_hz());
-    c.board.fs_hz = fs_mult * f_max;
-    c.board.decimation = dec;
-    let nyq_out = 0.5 * c.board.fs_hz / dec as f64;
-    c.board.lpf_cutoff_hz = cut * nyq_out.min(f0);
+    c.board.fs_hz = Some(fs_mult * f_max);
+    c.board.decimation = Some(dec);
+    let nyq_out = 0.5 * c.fs_hz() / dec as f64;
+    c.board.lpf_cutoff_hz = Some(cut * nyq_out.min(f0));
     c.board.lpf_order = order;
-    c.board.tia_pole_hz = pole.map(|p| p * 0.5 * c.board.fs_hz);
+    c.board.tia_pole_hz = pole.map(|p| p * 0.5 * c.fs_hz());
     c.board.tia_gain_ohm = gain;
     c.board.tia_inverting = inverting;
     c.board.dac_bits = dac;
@@ -108,7 +108,8 @@ fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
     c.board.phase_shifter_error_deg = shift;
 
     let (kind, rates, avg_mult, hann, settle, noise, selfcal) = e;
-    let cutoff = c.board.lpf_cutoff_hz;
+    let cutoff = c.lpf_cutoff_hz();
+    let fs = c.fs_hz();
     let x = &mut c.experiment;
     x.window = if hann {
         WindowKind::Hann
@@ -116,7 +117,7 @@ fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
         WindowKind::Boxcar
     };
     x.settle_s = settle;
-    let out_period = dec as f64 / c.board.fs_hz;
+    let out_period = dec as f64 / fs;
     match kind {
         0 => {
             x.kind = ExperimentKind::Coriolis;
@@ -180,7 +181,7 @@ proptest! {
         cfg.validate().unwrap_or_else(|err| panic!("{err}\n{text}"));
 
         // About 1e4 input samples: settling plus window plus the one extra output sample.
-        let n_out = (10_000 / cfg.board.decimation as u64).max(3);
+        let n_out = (10_000 / cfg.decimation() as u64).max(3);
         let n_settle = n_out / 2;
         let rate_rad_s = cfg.experiment.rates_dps[0].to_radians();
         let point = Point {

@@ -45,7 +45,7 @@ fn run_groups(b: Bencher, noise: bool, groups: usize) {
         .iter()
         .map(|r| r.to_radians())
         .collect();
-    let m = cfg.board.decimation as u64;
+    let m = cfg.decimation() as u64;
     let n_out = N_IN / m;
     let point = |r: f64| Point {
         rate_rad_s: r,

@@ -48,7 +48,7 @@ fn lane_rates(cfg: &Config) -> Vec<f64> {
 pub fn chain(cfg: &Config, n_in: u64, groups: usize) -> f64 {
     let rates = lane_rates(cfg);
     let params = cfg.board_params();
-    let m = cfg.board.decimation as u64;
+    let m = cfg.decimation() as u64;
     let n_out = n_in / m;
     let points: Vec<Point> = rates
         .iter()
@@ -141,7 +141,7 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
         push_n("whole chain", threads, &mut || chain(cfg, n_in, threads));
     }
     let x = |i: u64| f64x4::splat((i & 1023) as f64 * 1e-3);
-    let fs = cfg.board.fs_hz;
+    let fs = cfg.fs_hz();
     let mut push = |name: &str, measure: Box<dyn Fn(usize) -> f64 + '_>| {
         push_n(name, 1, &mut || measure(1));
         if threads > 1 {
@@ -213,7 +213,7 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     );
     let design = LowPassDesign::Butterworth {
         order: cfg.board.lpf_order,
-        cutoff_hz: cfg.board.lpf_cutoff_hz,
+        cutoff_hz: cfg.lpf_cutoff_hz(),
     };
     let lp = LowPass::<f64x4>::new(design, fs).expect("valid");
     push(

@@ -201,7 +201,7 @@ fn fold_half_turn(x: f64) -> (f64, bool) {
 pub fn driven_device(cfg: &Config) -> DrivenDevice {
     DrivenDevice {
         plant: cfg.resonator_params(),
-        drive: [cfg.drive.f1, cfg.drive.f2],
+        drive: [cfg.drive.f1, cfg.f2()],
         phase_shifter_error_deg: cfg.board.phase_shifter_error_deg,
     }
 }

@@ -78,7 +78,7 @@ pub struct SweepRun {
 
 /// Input samples a lane group of `points` runs: settling plus its longest window.
 pub fn group_samples(cfg: &Config, points: &[Point]) -> u64 {
-    let m = cfg.board.decimation as u64;
+    let m = cfg.decimation() as u64;
     (cfg.n_settle_out() + points.iter().map(|p| p.window.samples()).max().unwrap_or(1)) * m
 }
 
@@ -136,9 +136,12 @@ pub fn run_sweep_with(
         |g: &[usize]| group_samples(cfg, &g.iter().map(|&i| plan(i)).collect::<Vec<_>>());
     let total: u64 = groups.iter().map(|g| samples_of(g)).sum();
     let done = AtomicU64::new(0);
-    let dump = cfg.dump.as_ref().map(|d| {
-        let idx = rates.iter().position(|&r| r == d.rate_dps).unwrap_or(0);
-        (idx, d)
+    let dump = cfg.dump_resolved().map(|d| {
+        let rate = d.rate_dps.unwrap_or(f64::NAN);
+        let idx = rates.iter().position(|&r| r == rate).unwrap_or(0);
+        let nodes = d.nodes.clone().unwrap_or_default();
+        let window = (d.start_s.unwrap_or(0.0), d.duration_s.unwrap_or(0.0));
+        (idx, nodes, window)
     });
     // Raised by the caller's flag (copied at each progress report) or by a failed group.
     let stop = Arc::new(AtomicBool::new(false));
@@ -170,18 +173,20 @@ pub fn run_sweep_with(
                 return None;
             }
             let points: Vec<Point> = g.iter().map(|&i| plan(i)).collect();
-            let mut probe = dump.and_then(|(idx, d)| {
-                g.iter().position(|&i| i == idx).map(|lane| {
-                    Probe::new(
-                        &d.nodes,
-                        cfg.board.fs_hz,
-                        cfg.board.decimation,
-                        d.start_s,
-                        d.duration_s,
-                        lane,
-                    )
-                })
-            });
+            let mut probe = dump
+                .as_ref()
+                .and_then(|(idx, nodes, (start_s, duration_s))| {
+                    g.iter().position(|i| i == idx).map(|lane| {
+                        Probe::new(
+                            nodes,
+                            cfg.fs_hz(),
+                            cfg.decimation(),
+                            *start_s,
+                            *duration_s,
+                            lane,
+                        )
+                    })
+                });
             let last = AtomicU64::new(0);
             let report = |n: u64| {
                 add_group_progress(&done, &last, n, total, progress);
@@ -264,7 +269,7 @@ pub fn finish_sweep(
     let res = post_process(cfg, &rates, &points, &lane_results)?;
     Ok(SweepResult {
         settle_s: cfg.settle_s(),
-        fs_hz: cfg.board.fs_hz,
+        fs_hz: cfg.fs_hz(),
         fs_out_hz: cfg.fs_out_hz(),
         samples,
         point_samples,

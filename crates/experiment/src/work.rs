@@ -80,7 +80,7 @@ pub fn sweep_work(cfg: &Config) -> Work {
 /// The chain's throughput on this machine and config, point-samples/s on every thread, from a
 /// short timed run (about 2^18 input samples per thread: a few milliseconds).
 pub fn measured_throughput(cfg: &Config) -> f64 {
-    let m = cfg.board.decimation as u64;
+    let m = cfg.decimation() as u64;
     let n_in = (1u64 << 18).max(8 * m);
     chain(cfg, n_in, rayon::current_num_threads())
 }

@@ -167,7 +167,7 @@ pub fn sweep_figure(cfg: &Config, r: &SweepResult, title: &str) -> Figure {
         "exact theory, mode 1"
     };
     fig = fig.with(theory_series(cfg, x_max, 0, 1.0, theory_name));
-    if (cfg.drive.f1 - cfg.drive.f2).abs() > 0.0 {
+    if (cfg.drive.f1 - cfg.f2()).abs() > 0.0 {
         fig = fig.with(theory_series(cfg, x_max, 1, 1.0, "exact theory, mode 2"));
     }
     let f = r.fit[0];

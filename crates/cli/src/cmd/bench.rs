@@ -9,16 +9,16 @@ pub fn bench_command(preset_name: &str, samples: u64, repeats: usize) -> Result<
     if repeats == 0 {
         return Err(BadInput("--repeats = 0: must be at least 1".into()).into());
     }
-    if samples < 100 * cfg.board.decimation as u64 {
+    if samples < 100 * cfg.decimation() as u64 {
         return Err(BadInput(format!(
             "--samples = {samples}: must be at least 100 decimation blocks ({})",
-            100 * cfg.board.decimation
+            100 * cfg.decimation()
         ))
         .into());
     }
     eprintln!(
         "bench: preset {preset_name}, fs = {} Hz, {samples} input samples per lane group, 4 operating points per group, best and median of {repeats} runs",
-        cfg.board.fs_hz
+        cfg.fs_hz()
     );
     print_out(&format!(
         "{:<48} {:>7} {:>10} {:>10}\n",

@@ -1,0 +1,214 @@
+//! Defaults a user should not have to choose, derived from the device and the rates: the
+//! sample rate, the second drive, the stage-1 low-pass and the decimation, and a dump's window.
+//! `parse_config` fills them in, so a config is always complete once parsed; `gyroemu config
+//! --resolved FILE` prints the result with the rule behind each derived value.
+
+use crate::config::{Config, DumpConfig};
+use gyroemu_board::{Shape, DUMP_NODES};
+
+/// Samples per carrier period of the default sample rate (the DAC's hold then moves the
+/// phase by about 0.01 mdeg or less).
+pub const DEFAULT_SAMPLES_PER_PERIOD: f64 = 16.0;
+/// The default cutoff sits this many times above the highest modulation frequency...
+pub const CUTOFF_OVER_MODULATION: f64 = 10.0;
+/// ...and at least f0 over this (a 4th-order low-pass then takes the 2 f0 mixer product down
+/// by 1e-9 or more)...
+pub const F0_OVER_MIN_CUTOFF: f64 = 100.0;
+/// ...and at most f0 over this.
+pub const F0_OVER_MAX_CUTOFF: f64 = 10.0;
+/// The default decimation keeps this many output samples per cutoff period.
+pub const OUTPUT_SAMPLES_PER_CUTOFF: f64 = 20.0;
+/// A default dump holds at most this many full-rate frames (small files).
+pub const DEFAULT_DUMP_FRAMES: f64 = 50_000.0;
+
+/// A key the config left out, filled with a derived value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Derived {
+    /// Dotted key, e.g. `board.fs_hz`.
+    pub key: &'static str,
+    /// The value, as TOML would write it.
+    pub value: String,
+    /// How it was derived.
+    pub rule: String,
+}
+
+impl Config {
+    /// The highest f0 of the two modes, Hz.
+    fn f0_max_hz(&self) -> f64 {
+        self.device.f0_hz.max(self.f0_mode2_hz())
+    }
+
+    /// Sample rate, Hz (set, or 16 times the highest f0).
+    pub fn fs_hz(&self) -> f64 {
+        self.board
+            .fs_hz
+            .unwrap_or(DEFAULT_SAMPLES_PER_PERIOD * self.f0_max_hz())
+    }
+
+    /// Mode-2 drive amplitude F2 (set, or F1).
+    pub fn f2(&self) -> f64 {
+        self.drive.f2.unwrap_or(self.drive.f1)
+    }
+
+    /// The highest frequency the read-out must pass, Hz: the fastest modulation of a rotating
+    /// run, ten harmonics of a rate table (large swings), 0 for a constant rate.
+    pub fn modulation_max_hz(&self) -> f64 {
+        let finite_max =
+            |v: &mut dyn Iterator<Item = f64>| v.filter(|x| x.is_finite()).fold(0.0, f64::max);
+        match self.shape() {
+            Shape::Rotating => {
+                finite_max(&mut self.experiment.rates_dps.iter().map(|r| r.abs() / 360.0))
+            }
+            Shape::RateTable { freq_hz } if freq_hz.is_finite() => 10.0 * freq_hz,
+            _ => 0.0,
+        }
+    }
+
+    /// Stage-1 low-pass cutoff, Hz (set, or ten times the highest modulation frequency, at
+    /// least f0/100 and at most f0/10).
+    pub fn lpf_cutoff_hz(&self) -> f64 {
+        self.board.lpf_cutoff_hz.unwrap_or_else(|| {
+            let f0 = self.device.f0_hz;
+            (CUTOFF_OVER_MODULATION * self.modulation_max_hz())
+                .max(f0 / F0_OVER_MIN_CUTOFF)
+                .min(f0 / F0_OVER_MAX_CUTOFF)
+        })
+    }
+
+    /// Decimation after the low-pass (set, or the largest that keeps 20 output samples per
+    /// cutoff period, at least 1).
+    pub fn decimation(&self) -> usize {
+        self.board.decimation.unwrap_or_else(|| {
+            let m = (self.fs_hz() / (OUTPUT_SAMPLES_PER_CUTOFF * self.lpf_cutoff_hz())).floor();
+            if m.is_finite() && m >= 1.0 {
+                m as usize
+            } else {
+                1
+            }
+        })
+    }
+
+    /// The dump with every key filled in (see [`DumpConfig`] for the defaults), if any.
+    pub fn dump_resolved(&self) -> Option<DumpConfig> {
+        let d = self.dump.as_ref()?;
+        let rate = d.rate_dps.unwrap_or_else(|| {
+            self.experiment
+                .rates_dps
+                .iter()
+                .copied()
+                .filter(|r| r.is_finite())
+                .fold(0.0, |a: f64, r| if r.abs() > a.abs() { r } else { a })
+        });
+        let fs = self.fs_hz();
+        let start = d.start_s.unwrap_or_else(|| self.settle_s());
+        let duration = d.duration_s.unwrap_or_else(|| {
+            let f0 = self.device.f0_hz;
+            let want = match self.shape() {
+                Shape::Rotating if rate != 0.0 => 4.0 * 360.0 / rate.abs(),
+                Shape::RateTable { freq_hz } => 4.0 / freq_hz,
+                _ => 200.0 / f0,
+            };
+            // Within the point's run: settling plus its averaging window.
+            let p = self.plan_point(rate);
+            let total = (self.n_settle_out() + p.window.samples()) as f64 / self.fs_out_hz();
+            want.min(DEFAULT_DUMP_FRAMES / fs)
+                .max(20.0 / f0)
+                .min(total - start)
+        });
+        Some(DumpConfig {
+            rate_dps: Some(rate),
+            start_s: Some(start),
+            duration_s: Some(duration),
+            nodes: Some(
+                d.nodes
+                    .clone()
+                    .unwrap_or_else(|| DUMP_NODES.iter().map(|n| n.to_string()).collect()),
+            ),
+        })
+    }
+
+    /// Fills every key left out with its derived value (idempotent) and says what it derived.
+    pub fn resolve(&mut self) -> Vec<Derived> {
+        let mut out = Vec::new();
+        let f0 = self.device.f0_hz;
+        if self.drive.f2.is_none() {
+            self.drive.f2 = Some(self.drive.f1);
+            out.push(Derived {
+                key: "drive.f2",
+                value: fmt(self.drive.f1),
+                rule: "equal to drive.f1".into(),
+            });
+        }
+        if self.board.fs_hz.is_none() {
+            let fs = self.fs_hz();
+            self.board.fs_hz = Some(fs);
+            out.push(Derived {
+                key: "board.fs_hz",
+                value: fmt(fs),
+                rule: format!(
+                    "{DEFAULT_SAMPLES_PER_PERIOD} samples per period of the highest f0 ({} Hz)",
+                    self.f0_max_hz()
+                ),
+            });
+        }
+        if self.board.lpf_cutoff_hz.is_none() {
+            let c = self.lpf_cutoff_hz();
+            self.board.lpf_cutoff_hz = Some(c);
+            out.push(Derived {
+                key: "board.lpf_cutoff_hz",
+                value: fmt(c),
+                rule: format!(
+                    "{CUTOFF_OVER_MODULATION} x the highest modulation frequency ({} Hz), at least f0/{F0_OVER_MIN_CUTOFF} = {} Hz and at most f0/{F0_OVER_MAX_CUTOFF} = {} Hz",
+                    self.modulation_max_hz(),
+                    f0 / F0_OVER_MIN_CUTOFF,
+                    f0 / F0_OVER_MAX_CUTOFF
+                ),
+            });
+        }
+        if self.board.decimation.is_none() {
+            let m = self.decimation();
+            self.board.decimation = Some(m);
+            out.push(Derived {
+                key: "board.decimation",
+                value: m.to_string(),
+                rule: format!(
+                    "floor(fs_hz / ({OUTPUT_SAMPLES_PER_CUTOFF} x lpf_cutoff_hz)): {OUTPUT_SAMPLES_PER_CUTOFF} output samples per cutoff period or more"
+                ),
+            });
+        }
+        if let (Some(given), Some(full)) = (self.dump.clone(), self.dump_resolved()) {
+            let pairs = [
+                ("dump.rate_dps", given.rate_dps.is_none(), "the largest listed rate"),
+                ("dump.start_s", given.start_s.is_none(), "the end of settling"),
+                (
+                    "dump.duration_s",
+                    given.duration_s.is_none(),
+                    "4 modulation periods (200 carrier periods at a constant rate), at most 50 000 frames",
+                ),
+                ("dump.nodes", given.nodes.is_none(), "every node"),
+            ];
+            for (key, derived, rule) in pairs {
+                if derived {
+                    let value = match key {
+                        "dump.rate_dps" => fmt(full.rate_dps.unwrap_or(0.0)),
+                        "dump.start_s" => fmt(full.start_s.unwrap_or(0.0)),
+                        "dump.duration_s" => fmt(full.duration_s.unwrap_or(0.0)),
+                        _ => format!("{:?}", full.nodes.clone().unwrap_or_default()),
+                    };
+                    out.push(Derived {
+                        key,
+                        value,
+                        rule: rule.into(),
+                    });
+                }
+            }
+            self.dump = Some(full);
+        }
+        out
+    }
+}
+
+/// A number as TOML writes it.
+fn fmt(x: f64) -> String {
+    toml::Value::Float(x).to_string()
+}
