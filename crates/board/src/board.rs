@@ -9,7 +9,7 @@ use gyroemu_am::{AmModulator, Dac, DrivePattern, Quantizer};
 use gyroemu_core::noise::{held_white_sigma, stream_seed, NoiseRng};
 use gyroemu_core::{ParamError, Sample};
 use gyroemu_lpf::LowPassBank;
-use gyroemu_mixer::{Stage1Mixer, Stage2Mixer};
+use gyroemu_mixer::{Stage1Mixer, Stage2Mixer, TableMixer};
 use gyroemu_nco::{Nco, PhaseShifter, RotatingNco};
 use gyroemu_resonator::{thermomechanical_accel_psd, Resonator};
 use gyroemu_tia::{input_referred_noise_a_per_rthz, Tia};
@@ -86,6 +86,14 @@ pub(crate) fn table_nco(p: &BoardParams) -> Result<Nco, ParamError> {
     Nco::new(f, p.fs_hz(), core::f64::consts::PI * f / p.fs_hz())
 }
 
+/// The table harmonics a board demodulates (none but the mean outside rate-table runs).
+pub(crate) fn table_harmonics(p: &BoardParams) -> usize {
+    match p.shape {
+        Shape::RateTable { .. } => p.table_harmonics,
+        _ => 0,
+    }
+}
+
 /// The phase shifter of the drive's quadrature copy (the nominal one is exactly -j: cos ->
 /// sin with no rounding).
 pub(crate) fn shifter(p: &BoardParams) -> Result<PhaseShifter, ParamError> {
@@ -127,6 +135,8 @@ pub struct Board<S: Sample> {
     pub(crate) lp: LowPassBank<S, 4>,
     pub(crate) decimation: usize,
     pub(crate) mix2: Stage2Mixer<S>,
+    /// Demodulation at the table harmonics (rate-table runs).
+    pub(crate) table_mix: TableMixer<S>,
     pub(crate) fs_hz: f64,
     pub(crate) table_f_hz: f64,
     /// Phase-shifter error on the modulation's quadrature copy (rotating runs): (cos, sin).
@@ -203,6 +213,7 @@ impl<S: Sample> Board<S> {
             lp: LowPassBank::new(&build_lowpass(p)?),
             decimation: p.decimation,
             mix2: Stage2Mixer::default(),
+            table_mix: TableMixer::new(table_harmonics(p))?,
             fs_hz: fs,
             mod_shift,
             noise: NoiseState {

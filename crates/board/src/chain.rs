@@ -1,11 +1,12 @@
 //! The responses of the board's own linear stages, built by the same code the board runs, so
 //! that the read-out compensates exactly the chain that produced the data.
 
-use crate::board::modulation_hz;
+use crate::board::{modulation_hz, table_nco};
 use crate::params::{build_lowpass, build_tia, BoardParams};
 use crate::point::Point;
 use gyroemu_core::{Complex64, ParamResult, Response};
 use gyroemu_lpf::{KahanSum, LowPass};
+use gyroemu_mixer::table_reference;
 use gyroemu_nco::{phasor_of_word, Nco};
 use gyroemu_resonator::hold_response;
 use gyroemu_tia::Tia;
@@ -18,6 +19,8 @@ pub struct ChainResponse {
     carrier_hz: f64,
     fs_hz: f64,
     decimation: usize,
+    /// The table frequency as the board's table oscillator realises it, Hz (0: no table).
+    table_hz: f64,
 }
 
 impl ChainResponse {
@@ -29,6 +32,7 @@ impl ChainResponse {
             carrier_hz: p.carrier_hz,
             fs_hz: p.fs_hz(),
             decimation: p.decimation,
+            table_hz: table_nco(p)?.f_hz(),
         })
     }
 
@@ -81,6 +85,49 @@ impl ChainResponse {
             wsum.add(w);
         }
         Ok(Complex64::new(sum.value(), sum_im.value()) / wsum.value())
+    }
+
+    /// The rate-table window's leak between table harmonics: `K(d) = sum_j w_j e^{j d theta_j}
+    /// / sum_j w_j` for `d = -2N ..= 2N` (index `d + 2N`), over the point's averaging window,
+    /// with `theta_j` the table phase at each averaged output's instant (input index
+    /// `(n_settle + j) M + M - 1`), taken as the board takes it ([`table_reference`]). The
+    /// average of `z e^{-j n theta}` is then `A_n = sum_m Z_m K(m - n)` for the harmonics
+    /// `Z_m` of `z`; [`unleak_table_harmonics`] solves it.
+    pub fn table_leak(&self, point: &Point, n_settle: u64, harmonics: usize) -> Vec<Complex64> {
+        let m = self.decimation as u64;
+        let nd = 4 * harmonics + 1;
+        let mut sum: Vec<[KahanSum<f64>; 2]> = vec![[KahanSum::new(), KahanSum::new()]; nd];
+        let mut wsum = KahanSum::<f64>::new();
+        for j in 0..point.window.samples() {
+            let w = point.window.weight(j);
+            if w == 0.0 {
+                continue;
+            }
+            let n = (n_settle + j) * m + m - 1;
+            let e = table_reference(n, self.table_hz, self.fs_hz).conj();
+            // e^{j d theta} for d = 0 ..= 2N, the negative ones as conjugates.
+            let mut p = Complex64::new(w, 0.0);
+            for d in 0..=2 * harmonics {
+                for (idx, v) in [(2 * harmonics + d, p), (2 * harmonics - d, p.conj())] {
+                    sum[idx][0].add(v.re);
+                    sum[idx][1].add(v.im);
+                }
+                p *= e;
+            }
+            wsum.add(w);
+        }
+        let mut k: Vec<Complex64> = sum
+            .iter()
+            .map(|[re, im]| Complex64::new(re.value(), im.value()) / wsum.value())
+            .collect();
+        // d = 0 was added twice.
+        k[2 * harmonics] *= 0.5;
+        k
+    }
+
+    /// The table frequency the board realises, Hz (0 outside rate-table runs).
+    pub fn table_hz(&self) -> f64 {
+        self.table_hz
     }
 
     /// The carrier frequency, Hz.
@@ -143,4 +190,19 @@ pub fn unleak_sidebands(c: Complex64, s: Complex64, w: Complex64) -> (Complex64,
     let zp = (b - w.conj() * a) / det;
     let zm = (a - w * b) / det;
     (zp + zm, j * (zp - zm))
+}
+
+/// The harmonics `Z_{-N} .. Z_N` of a rate-table point's `z` from its window averages `A_n` of
+/// `z e^{-j n theta}` and the window's leak `K` ([`ChainResponse::table_leak`]): solves
+/// `A_n = sum_m Z_m K(m - n)` exactly (a window of not quite whole table periods mixes the
+/// harmonics a little). NaN if the system is singular.
+pub fn unleak_table_harmonics(a: &[Complex64], leak: &[Complex64]) -> Vec<Complex64> {
+    let nb = a.len();
+    let h = nb / 2;
+    let mat = nalgebra::DMatrix::from_fn(nb, nb, |n, m| leak[m + 2 * h - n]);
+    let rhs = nalgebra::DVector::from_column_slice(a);
+    match mat.lu().solve(&rhs) {
+        Some(x) => x.iter().copied().collect(),
+        None => vec![Complex64::new(f64::NAN, f64::NAN); nb],
+    }
 }

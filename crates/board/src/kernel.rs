@@ -9,9 +9,12 @@ use crate::params::Shape;
 use crate::point::{LaneResult, Point, RunOptions, RunOutput};
 use crate::probe::Probe;
 use gyroemu_am::AmInput;
-use gyroemu_core::{detmath, Complex64, Sample, Stage};
+use gyroemu_core::{Complex64, Sample, Stage};
 use gyroemu_lpf::Averager;
-use gyroemu_mixer::{Iq, Stage1Mixer};
+use gyroemu_mixer::{
+    table_channel, table_reference, Iq, Stage1Mixer, MAX_TABLE_HARMONIC, TABLE_CHANNELS,
+    TABLE_HARMONICS,
+};
 use std::sync::atomic::Ordering;
 
 /// Input samples between progress reports (and cancel checks).
@@ -92,8 +95,16 @@ impl<S: Sample> Board<S> {
         let channels = if K == ROTATING { 8 } else { 4 };
         let mut avg = Averager::<S, 8>::new(&windows, channels)
             .expect("the points' windows are valid and one per lane");
-        let mut prev_z = [Iq::<S>::default(); 2];
-        let mut unwrapped = [S::splat(0.0); 2];
+        let mut table_avg = Averager::<S, TABLE_CHANNELS>::new(
+            &windows,
+            if K == RATE_TABLE {
+                self.table_mix.channels()
+            } else {
+                0
+            },
+        )
+        .expect("the points' windows are valid and one per lane");
+        let mut tx = [S::splat(0.0); TABLE_CHANNELS];
         let report_every = (REPORT_EVERY_IN / m).max(1);
         let mut read_next = vec![0usize; lanes];
         let mut early: Vec<Vec<LaneResult>> = vec![Vec::new(); lanes];
@@ -151,7 +162,6 @@ impl<S: Sample> Board<S> {
                 }
             }
             if k < n_settle {
-                prev_z = z;
                 continue;
             }
             let j = k - n_settle;
@@ -165,22 +175,10 @@ impl<S: Sample> Board<S> {
                     }
                 }
                 RATE_TABLE => {
-                    // Phase lag of z, unwrapped, demodulated at the table frequency, with the
-                    // reference at the input sample this output stands for.
-                    let n_in = (n0 + m - 1) as f64;
-                    let (ts, tc) = detmath::sin_cos_turns(n_in * self.table_f_hz / self.fs_hz);
-                    for md in 0..2 {
-                        let d = S::from_fn(|i| {
-                            let a = z[md].lane(i);
-                            let b = prev_z[md].lane(i);
-                            // arg(b/a): the lag accrued since the previous sample.
-                            (b * a.conj()).arg()
-                        });
-                        unwrapped[md] += d;
-                        x[2 * md] = unwrapped[md] * S::splat(2.0 * tc);
-                        x[2 * md + 1] = unwrapped[md] * S::splat(-2.0 * ts);
-                    }
-                    prev_z = z;
+                    // z at every table harmonic, against the table phase of the input sample
+                    // this output stands for.
+                    let base = table_reference(n0 + m - 1, self.table_f_hz, self.fs_hz);
+                    tx = self.table_mix.tick((z, base));
                 }
                 _ => {
                     for (base, zm) in [(0, z[0]), (4, z[1])] {
@@ -197,7 +195,16 @@ impl<S: Sample> Board<S> {
                     if n != j {
                         break;
                     }
-                    early[i].push(lane_result::<K>(&avg.mean_if_ended(i, frac, &x)));
+                    let table = if K == RATE_TABLE {
+                        table_avg.mean_if_ended(i, frac, &tx)
+                    } else {
+                        [0.0; TABLE_CHANNELS]
+                    };
+                    early[i].push(lane_result::<K>(
+                        &avg.mean_if_ended(i, frac, &x),
+                        &table,
+                        self.table_mix.harmonics(),
+                    ));
                     read_next[i] += 1;
                 }
             }
@@ -214,13 +221,16 @@ impl<S: Sample> Board<S> {
                 }
             }
             avg.push(&x);
+            if K == RATE_TABLE {
+                table_avg.push(&tx);
+            }
         }
         progress(n_out * m);
         Ok(RunOutput {
             lanes: (0..lanes)
                 .map(|i| LaneResult {
                     health: health[i],
-                    ..lane_result::<K>(&avg.mean(i))
+                    ..lane_result::<K>(&avg.mean(i), &table_avg.mean(i), self.table_mix.harmonics())
                 })
                 .collect(),
             early_reads: early,
@@ -375,8 +385,9 @@ impl<S: Sample> Board<S> {
     }
 }
 
-/// A lane's averaged channels as the result of its experiment shape.
-pub(crate) fn lane_result<const K: u8>(v: &[f64; 8]) -> LaneResult {
+/// A lane's averaged channels as the result of its experiment shape (`table`: the averaged
+/// `TableMixer` channels of a rate-table run, of harmonics `-n ..= n`).
+pub(crate) fn lane_result<const K: u8>(v: &[f64; 8], table: &[f64], n: usize) -> LaneResult {
     let ph = |c: usize| Complex64::new(v[c], v[c + 1]);
     match K {
         CORIOLIS => LaneResult {
@@ -384,7 +395,7 @@ pub(crate) fn lane_result<const K: u8>(v: &[f64; 8]) -> LaneResult {
             ..Default::default()
         },
         RATE_TABLE => LaneResult {
-            table_phase: [ph(0), ph(2)],
+            table_z: table_harmonics_of(table, n),
             ..Default::default()
         },
         _ => LaneResult {
@@ -393,4 +404,19 @@ pub(crate) fn lane_result<const K: u8>(v: &[f64; 8]) -> LaneResult {
             ..Default::default()
         },
     }
+}
+
+/// The per-mode harmonics `-MAX ..= MAX` of averaged `TableMixer` channels of harmonics
+/// `-n ..= n` (zero beyond `n`).
+pub(crate) fn table_harmonics_of(table: &[f64], n: usize) -> [[Complex64; TABLE_HARMONICS]; 2] {
+    core::array::from_fn(|md| {
+        core::array::from_fn(|i| {
+            let h = i as isize - MAX_TABLE_HARMONIC as isize;
+            if h.unsigned_abs() > n {
+                return Complex64::new(0.0, 0.0);
+            }
+            let ch = table_channel(h, md, n);
+            Complex64::new(table[ch], table[ch + 1])
+        })
+    })
 }

@@ -17,7 +17,7 @@ mod probe;
 pub mod reference;
 
 pub use board::{Board, MAX_LANES};
-pub use chain::{unleak_sidebands, ChainResponse, RotatingTerms};
+pub use chain::{unleak_sidebands, unleak_table_harmonics, ChainResponse, RotatingTerms};
 pub use fault::NonFinite;
 pub use health::Health;
 pub use params::{BoardParams, Converter, NoiseParams, Shape};

@@ -83,6 +83,10 @@ pub struct BoardParams {
     pub noise: Option<NoiseParams>,
     /// The experiment.
     pub shape: Shape,
+    /// Rate-table runs: the table harmonics `-N ..= N` demodulated per mode (1 to
+    /// [`gyroemu_mixer::MAX_TABLE_HARMONIC`]; enough that the envelope has nothing beyond).
+    /// Not used by the other shapes.
+    pub table_harmonics: usize,
 }
 
 impl BoardParams {
@@ -119,6 +123,15 @@ impl BoardParams {
         }
         if let Shape::RateTable { freq_hz } = self.shape {
             positive(STAGE, "table_freq_hz", freq_hz)?;
+            let n = self.table_harmonics;
+            if !(1..=gyroemu_mixer::MAX_TABLE_HARMONIC).contains(&n) {
+                return Err(ParamError::new(
+                    STAGE,
+                    "table_harmonics",
+                    n,
+                    format!("must be 1 to {}", gyroemu_mixer::MAX_TABLE_HARMONIC),
+                ));
+            }
         }
         if let Some(n) = &self.noise {
             positive(STAGE, "noise.temperature_k", n.temperature_k)?;

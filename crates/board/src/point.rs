@@ -5,6 +5,7 @@ use crate::health::Health;
 use crate::probe::Probe;
 use gyroemu_core::Complex64;
 use gyroemu_lpf::Window;
+use gyroemu_mixer::TABLE_HARMONICS;
 
 /// One operating point: the rate in rad/s (rotation rate, excitation rate, or rate-table
 /// amplitude) and its averaging window in decimated samples after settling.
@@ -37,8 +38,10 @@ pub struct LaneResult {
     pub c: [Complex64; 2],
     /// Stage-2 averages S per mode (rotating).
     pub s: [Complex64; 2],
-    /// Rate-table run: complex amplitude of the phase (lag) at the table frequency, per mode.
-    pub table_phase: [Complex64; 2],
+    /// Rate-table run: the mean of `z e^{-j n theta}` per mode at every table harmonic
+    /// `n = -MAX ..= MAX` (index `n + MAX`, `MAX` = [`gyroemu_mixer::MAX_TABLE_HARMONIC`];
+    /// zero beyond the board's `table_harmonics`), `theta` the table phase.
+    pub table_z: [[Complex64; TABLE_HARMONICS]; 2],
     /// The converters' and rails' counts over the point's run.
     pub health: Health,
 }

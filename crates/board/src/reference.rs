@@ -4,15 +4,18 @@
 //! factors, no decoupled plant step, no low-pass bank, no skipped shifter). Each shortcut is
 //! exact, so the fused board must give every lane these bits.
 
-use crate::board::{modulation_hz, noise_sigmas, pattern, plant_rate, shifter, table_nco};
+use crate::board::{
+    modulation_hz, noise_sigmas, pattern, plant_rate, shifter, table_harmonics, table_nco,
+};
 use crate::health::Health;
+use crate::kernel::table_harmonics_of;
 use crate::params::{build_adc, build_dac, build_tia, BoardParams, Shape};
 use crate::point::{LaneResult, Point};
 use gyroemu_am::{AmInput, AmModulator};
 use gyroemu_core::noise::{stream_seed, NoiseRng};
-use gyroemu_core::{detmath, Complex64, ParamResult, Sample, Stage};
+use gyroemu_core::{Complex64, ParamResult, Sample, Stage};
 use gyroemu_lpf::{Averager, DecimateMode, Decimator};
-use gyroemu_mixer::{Iq, Stage1Mixer, Stage2Mixer};
+use gyroemu_mixer::{table_reference, Iq, Stage1Mixer, Stage2Mixer, TableMixer, TABLE_CHANNELS};
 use gyroemu_nco::{Nco, RotatingNco};
 use gyroemu_resonator::Resonator;
 
@@ -49,6 +52,9 @@ pub fn run_reference(
         Decimator::new(design, m, fs)?,
     ];
     let mut mix2 = Stage2Mixer::<f64>::new();
+    let mut table_mix = TableMixer::<f64>::new(table_harmonics(p))?;
+    let mut table_avg =
+        Averager::<f64, TABLE_CHANNELS>::new(&[point.window], table_mix.channels())?;
     let channels = if p.shape.is_rotating() { 8 } else { 4 };
     let mut avg = Averager::<f64, 8>::new(&[point.window], channels)?;
     let seed = p.noise.map_or(0, |n| n.seed);
@@ -61,8 +67,6 @@ pub fn run_reference(
         samples: n_out * m as u64,
         ..Default::default()
     };
-    let mut prev_z = [Complex64::default(); 2];
-    let mut unwrapped = [0.0f64; 2];
     for n in 0..n_out * m as u64 {
         let (c_re, c_im) = carrier.tick(());
         let cq = shift.tick(Complex64::new(c_re, c_im)).re;
@@ -128,7 +132,6 @@ pub fn run_reference(
         let k = n / m as u64;
         let zk = [Complex64::new(i1, q1), Complex64::new(i2, q2)];
         if k < n_settle {
-            prev_z = zk;
             continue;
         }
         let mut x = [0.0f64; 8];
@@ -137,13 +140,8 @@ pub fn run_reference(
                 x[..4].copy_from_slice(&[i1, q1, i2, q2]);
             }
             Shape::RateTable { .. } => {
-                let (ts, tc) = detmath::sin_cos_turns(n as f64 * table_f_hz / fs);
-                for md in 0..2 {
-                    unwrapped[md] += (prev_z[md] * zk[md].conj()).arg();
-                    x[2 * md] = unwrapped[md] * (2.0 * tc);
-                    x[2 * md + 1] = unwrapped[md] * (-2.0 * ts);
-                }
-                prev_z = zk;
+                let z = zk.map(|v| Iq::new(v.re, v.im));
+                table_avg.push(&table_mix.tick((z, table_reference(n, table_f_hz, fs))));
             }
             Shape::Rotating => {
                 for (md, zm) in zk.iter().enumerate() {
@@ -162,7 +160,7 @@ pub fn run_reference(
             ..Default::default()
         },
         Shape::RateTable { .. } => LaneResult {
-            table_phase: [ph(0), ph(2)],
+            table_z: table_harmonics_of(&table_avg.mean(0), table_mix.harmonics()),
             ..Default::default()
         },
         Shape::Rotating => LaneResult {

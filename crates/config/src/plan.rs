@@ -4,11 +4,16 @@
 use crate::config::{Config, ExperimentKind, RateTable, WindowKind};
 use gyroemu_board::{BoardParams, Converter, NoiseParams, Point, Shape};
 use gyroemu_lpf::{LowPassDesign, Window};
+use gyroemu_mixer::MAX_TABLE_HARMONIC;
 use gyroemu_resonator::{ModeParams, ResonatorParams};
-use gyroemu_theory::mechanical_tau_s;
+use gyroemu_theory::{mechanical_tau_s, DrivenDevice};
 use gyroemu_tia::TiaParams;
 
 const DEG: f64 = core::f64::consts::PI / 180.0;
+
+/// A rate-table run demodulates every table harmonic of the envelope above this fraction of
+/// its largest one (what it leaves out moves the phase by about as many radians).
+pub const TABLE_HARMONIC_REL: f64 = 1e-10;
 
 impl Config {
     /// The experiment's shape: the `kind` and `rate_table` keys read once (validation refuses
@@ -68,6 +73,49 @@ impl Config {
         }
     }
 
+    /// The device and its drive, for the theory.
+    pub fn driven_device(&self) -> DrivenDevice {
+        DrivenDevice {
+            plant: self.resonator_params(),
+            drive: [self.drive.f1, self.f2()],
+            phase_shifter_error_deg: self.board.phase_shifter_error_deg,
+        }
+    }
+
+    /// The largest listed rate magnitude, rad/s (0 if none is finite).
+    pub fn max_rate_rad_s(&self) -> f64 {
+        self.experiment
+            .rates_dps
+            .iter()
+            .filter(|r| r.is_finite())
+            .fold(0.0, |a: f64, r| a.max(r.abs()))
+            * DEG
+    }
+
+    /// Rate-table runs: the table harmonics `-N ..= N` the board demodulates, the fewest that
+    /// leave nothing above [`TABLE_HARMONIC_REL`] of the envelope at the largest amplitude
+    /// (from the plant's exact periodic steady state), at most [`MAX_TABLE_HARMONIC`]; `None`
+    /// when the swing needs more. 0 for the other shapes.
+    pub fn table_harmonics_needed(&self) -> Option<usize> {
+        let Shape::RateTable { freq_hz } = self.shape() else {
+            return Some(0);
+        };
+        self.driven_device()
+            .rate_table_harmonics_needed(
+                self.max_rate_rad_s(),
+                freq_hz,
+                self.device.f0_hz,
+                TABLE_HARMONIC_REL,
+                MAX_TABLE_HARMONIC,
+            )
+            .map(|n| n.max(1))
+    }
+
+    /// [`Config::table_harmonics_needed`], or all the board has (validation warns).
+    pub fn table_harmonics(&self) -> usize {
+        self.table_harmonics_needed().unwrap_or(MAX_TABLE_HARMONIC)
+    }
+
     /// The stage-1 low-pass.
     pub fn lowpass_design(&self) -> LowPassDesign {
         LowPassDesign::Butterworth {
@@ -109,6 +157,7 @@ impl Config {
                 tia_voltage_noise_v_per_rthz: n.tia_voltage_noise_v_per_rthz,
             }),
             shape: self.shape(),
+            table_harmonics: self.table_harmonics(),
         }
     }
 

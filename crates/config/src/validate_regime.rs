@@ -51,7 +51,37 @@ impl Config {
         })?;
         self.validate_node_range()?;
         self.validate_converters(warnings)?;
+        self.validate_table_harmonics(warnings);
         self.validate_hold(warnings)
+    }
+
+    /// A rate table whose swing has more harmonics than the board demodulates: the read-out
+    /// leaves the rest out (each moves the phase by about its relative size, in radians).
+    fn validate_table_harmonics(&self, warnings: &mut Vec<String>) {
+        if self.table_harmonics_needed().is_some() {
+            return;
+        }
+        let Shape::RateTable { freq_hz } = self.shape() else {
+            return;
+        };
+        let n = gyroemu_mixer::MAX_TABLE_HARMONIC;
+        let env = self.driven_device().rate_table_envelopes(
+            self.max_rate_rad_s(),
+            freq_hz,
+            self.device.f0_hz,
+            n + 1,
+        );
+        let peak = env.iter().flatten().map(|v| v.norm()).fold(0.0, f64::max);
+        let left = env
+            .iter()
+            .flat_map(|h| [h[0], h[2 * n + 2]])
+            .map(|v| v.norm() / peak)
+            .fold(0.0, f64::max);
+        warnings.push(format!(
+            "experiment.rates_dps: the largest rate-table amplitude swings the phase so far that its envelope has harmonics of the table frequency beyond the {n} the board demodulates (harmonic {} is {left:.1e} of the largest): expect read-out errors of order {:.1e} mdeg; lower the amplitude or raise experiment.table_freq_hz",
+            n + 1,
+            left.to_degrees() * 1e3
+        ));
     }
 
     fn validate_node_range(&self) -> Result<(), ConfigError> {

@@ -199,8 +199,14 @@ proptest! {
             .lanes;
         prop_assert_eq!(lanes.len(), 1);
         let r = &lanes[0];
-        for (name, v) in [("z", &r.z), ("c", &r.c), ("s", &r.s), ("table_phase", &r.table_phase)] {
+        for (name, v) in [("z", &r.z), ("c", &r.c), ("s", &r.s)] {
             prop_assert!(all_finite(v), "{} = {:?}\n{}", name, v, text);
+        }
+        for (md, h) in r.table_z.iter().enumerate() {
+            prop_assert!(
+                h.iter().all(|v| v.re.is_finite() && v.im.is_finite()),
+                "table_z[{}] = {:?}\n{}", md, h, text
+            );
         }
     }
 }

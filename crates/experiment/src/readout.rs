@@ -3,11 +3,15 @@
 //! the paper's best linear fit.
 
 use crate::fit::{fit_line, LineFit};
-use gyroemu_board::{unleak_sidebands, ChainResponse, Health, LaneResult, Point, Shape};
+use gyroemu_board::{
+    unleak_sidebands, unleak_table_harmonics, ChainResponse, Health, LaneResult, Point, Shape,
+};
 use gyroemu_config::Config;
 use gyroemu_core::{Complex64, ParamError};
-use gyroemu_mixer::{paper_i_channel_psi_rad, phase_lag_rad, sideband_estimate, wrap_pi, Mode};
-use gyroemu_theory::DrivenDevice;
+use gyroemu_mixer::{
+    paper_i_channel_psi_rad, phase_fundamental, phase_lag_rad, sideband_estimate, wrap_pi, Mode,
+    MAX_TABLE_HARMONIC,
+};
 use serde::Serialize;
 
 const DEG: f64 = core::f64::consts::PI / 180.0;
@@ -18,7 +22,7 @@ pub struct PointResult {
     /// Rate (rotation, excitation, or rate-table amplitude), deg/s.
     pub rate_dps: f64,
     /// Measured phase per mode: Coriolis shift against zero rate, compensated psi (rotating),
-    /// or the phase amplitude at the table frequency (rate table).
+    /// or the amplitude of the phase's fundamental at the table frequency (rate table).
     pub phase_deg: [f64; 2],
     /// Exact theory for the same quantity.
     pub theory_deg: [f64; 2],
@@ -32,8 +36,8 @@ pub struct PointResult {
     pub single_mixer_dc_v: Option<[f64; 2]>,
     /// Rate table: lag of the phase response behind the table, degrees (theory beside).
     pub table_lag_deg: Option<[f64; 2]>,
-    /// Rate table: theory of that lag.
-    pub table_lag_theory_deg: Option<f64>,
+    /// Rate table: exact theory of that lag per mode (the plant's periodic steady state).
+    pub table_lag_theory_deg: Option<[f64; 2]>,
     /// Averaging time actually used, s.
     pub averaged_s: f64,
 }
@@ -137,7 +141,7 @@ fn dead_channels(cfg: &Config, lr: &LaneResult) -> Vec<(usize, String)> {
     for k in 0..2 {
         let silent = match cfg.shape() {
             Shape::Coriolis => lr.z[k] == zero,
-            Shape::RateTable { .. } => lr.table_phase[k] == zero,
+            Shape::RateTable { .. } => lr.table_z[k].iter().all(|&v| v == zero),
             Shape::Rotating => lr.c[k] == zero && lr.s[k] == zero,
         };
         if silent && !dead.iter().any(|d| d.0 == k) {
@@ -197,26 +201,52 @@ fn fold_half_turn(x: f64) -> (f64, bool) {
     (y, odd)
 }
 
-/// The device and drive of a config, for the theory.
-pub fn driven_device(cfg: &Config) -> DrivenDevice {
-    DrivenDevice {
-        plant: cfg.resonator_params(),
-        drive: [cfg.drive.f1, cfg.f2()],
-        phase_shifter_error_deg: cfg.board.phase_shifter_error_deg,
-    }
-}
-
-/// The exact theory of the quantity a sweep measures at `rate_dps`, per mode, degrees (the
-/// rate-table case is the small-signal first-order model of THEORY.md section 3).
+/// The exact theory of the quantity a sweep measures at `rate_dps`, per mode, degrees (a rate
+/// table: the amplitude of the phase's fundamental in the plant's periodic steady state, at
+/// any swing).
 pub fn theory_deg(cfg: &Config, rate_dps: f64) -> [f64; 2] {
     let omega = rate_dps * DEG;
-    let dev = driven_device(cfg);
+    let dev = cfg.driven_device();
     let rad = match cfg.shape() {
         Shape::Coriolis => dev.coriolis_phase_rad(omega),
-        Shape::RateTable { freq_hz } => dev.rate_table_gain(freq_hz).map(|g| g * omega),
+        Shape::RateTable { freq_hz } => dev.rate_table_response(omega, freq_hz).0,
         Shape::Rotating => dev.rotating_psi_rad(omega),
     };
     rad.map(|r| r / DEG)
+}
+
+/// The rate-table read-out of one point: each harmonic of `z` freed of the window's leak, the
+/// low-pass `L(n f_t)` and the TIA `H(f_c + n f_t)` divided out of it (the chain acts on `z`,
+/// not on its phase), then the fundamental of the phase lag of the envelope they make. Writes
+/// the amplitude into `phase_deg` and returns the lag, degrees per mode.
+fn table_phase_readout(
+    chain: &ChainResponse,
+    lr: &LaneResult,
+    point: &Point,
+    n_settle: u64,
+    n: usize,
+    phase_deg: &mut [f64; 2],
+) -> [f64; 2] {
+    let ft = chain.table_hz();
+    let fc = chain.carrier_hz();
+    let leak = chain.table_leak(point, n_settle, n);
+    let mut lag = [0.0; 2];
+    for k in 0..2 {
+        let avg = &lr.table_z[k][MAX_TABLE_HARMONIC - n..=MAX_TABLE_HARMONIC + n];
+        let v: Vec<Complex64> = unleak_table_harmonics(avg, &leak)
+            .into_iter()
+            .enumerate()
+            .map(|(i, z)| {
+                let f = (i as f64 - n as f64) * ft;
+                z / (chain.lowpass(f) * chain.tia(fc + f))
+            })
+            .collect();
+        let x = phase_fundamental(&v);
+        phase_deg[k] = x.norm() / DEG;
+        // A lag a sin(w_t t - l) has the complex amplitude -j a e^{-j l}.
+        lag[k] = -(x * Complex64::new(0.0, 1.0)).arg() / DEG;
+    }
+    lag
 }
 
 /// Turns each emulated point's lane averages into phases, compensation, theory and fits (the
@@ -228,11 +258,11 @@ pub fn post_process(
     points: &[Point],
     lanes: &[LaneResult],
 ) -> Result<SweepResult, ParamError> {
-    let d = &cfg.device;
     let fs_out = cfg.fs_out_hz();
     let shape = cfg.shape();
     let chain = ChainResponse::new(&cfg.board_params())?;
-    let dev = driven_device(cfg);
+    let dev = cfg.driven_device();
+    let table_harmonics = cfg.table_harmonics();
     let mut out = Vec::new();
     let mut comp = Vec::new();
     let zero = rates.iter().position(|&r| r == 0.0);
@@ -243,10 +273,18 @@ pub fn post_process(
         }
         let lr = &lanes[i];
         let omega = rate * DEG;
+        // A rate table's theory gives the lag too: solved once.
+        let table_theory = match shape {
+            Shape::RateTable { freq_hz } => Some(dev.rate_table_response(omega, freq_hz)),
+            _ => None,
+        };
         let mut r = PointResult {
             rate_dps: rate,
             phase_deg: [0.0; 2],
-            theory_deg: theory_deg(cfg, rate),
+            theory_deg: match table_theory {
+                Some((amp, _)) => amp.map(|a| a / DEG),
+                None => theory_deg(cfg, rate),
+            },
             paper_i_deg: None,
             raw_psi_deg: None,
             alpha_deg: None,
@@ -269,20 +307,16 @@ pub fn post_process(
                 // Mixing with the mode's own drive: cos w0t (mode 1), sin w0t (mode 2).
                 r.single_mixer_dc_v = Some([0.5 * lr.z[0].re, -0.5 * lr.z[1].im]);
             }
-            Shape::RateTable { freq_hz: ft } => {
-                let l = chain.lowpass(ft);
-                let mut lag = [0.0; 2];
-                for k in 0..2 {
-                    // The phase passed through the stage-1 low-pass: divide its response out.
-                    let x = lr.table_phase[k] / l;
-                    r.phase_deg[k] = x.norm().to_degrees();
-                    // Response to A sin(wt) has complex amplitude -j A e^{-j lag}.
-                    lag[k] = -(x * Complex64::new(0.0, 1.0)).arg().to_degrees();
-                }
-                let (_, ph) =
-                    gyroemu_theory::rate_table_gain(d.f0_hz, d.q, d.angular_gain, 1.0, 1.0, ft);
-                r.table_lag_theory_deg = Some(ph.to_degrees());
-                r.table_lag_deg = Some(lag);
+            Shape::RateTable { .. } => {
+                r.table_lag_theory_deg = table_theory.map(|(_, lag)| lag.map(|l| l / DEG));
+                r.table_lag_deg = Some(table_phase_readout(
+                    &chain,
+                    lr,
+                    &points[i],
+                    cfg.n_settle_out(),
+                    table_harmonics,
+                    &mut r.phase_deg,
+                ));
             }
             Shape::Rotating => {
                 let terms = chain.rotating_terms(omega / core::f64::consts::TAU);

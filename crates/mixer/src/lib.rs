@@ -6,12 +6,15 @@
 //!   Its I channel is the paper's single real mixer `2 y cos(w0 t + phi)` (DC
 //!   `A cos(theta + phi)`), so that reading needs no mixer of its own.
 //! * [`Stage2Mixer`]: demodulation of `z` at the modulation rate Omega, giving the C and S terms.
+//! * [`TableMixer`]: demodulation of `z` at the harmonics of a rate table's frequency, and
+//!   [`phase_fundamental`], the exact phase read-out from them.
 //! * [`sideband_estimate`], [`paper_i_channel_psi_rad`], [`phase_lag_rad`]: the read-outs.
 
 mod estimate;
 mod iq;
 mod stage1;
 mod stage2;
+mod table;
 
 pub use estimate::{
     paper_i_channel_psi_rad, phase_lag_rad, sideband_estimate, Mode, SidebandEstimate,
@@ -19,6 +22,10 @@ pub use estimate::{
 pub use iq::Iq;
 pub use stage1::Stage1Mixer;
 pub use stage2::{Stage2Mixer, Stage2Out};
+pub use table::{
+    phase_fundamental, table_channel, table_reference, TableMixer, MAX_TABLE_HARMONIC,
+    TABLE_CHANNELS, TABLE_HARMONICS,
+};
 
 /// Wraps an angle into `(-pi, pi]` (the branch every read-out here uses).
 #[inline]

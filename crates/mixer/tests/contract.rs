@@ -4,7 +4,9 @@
 
 use gyroemu_core::check::{self, Gen};
 use gyroemu_core::{f64x4, Complex64, Sample, Stage};
-use gyroemu_mixer::{Iq, Stage1Mixer, Stage2Mixer, Stage2Out};
+use gyroemu_mixer::{
+    table_channel, Iq, Stage1Mixer, Stage2Mixer, Stage2Out, TableMixer, MAX_TABLE_HARMONIC,
+};
 
 fn stage1_input<S: Sample>(g: &mut Gen) -> (S, Complex64) {
     (g.sample(-3.0, 3.0), g.phasor())
@@ -70,4 +72,39 @@ fn stage2_blocks_reset_lanes_and_latency() {
     let lat = m.latency_samples();
     let path = |x: f64| (Iq::new(x, 0.0), [1.0, 0.0]);
     check::latency_matches("mixer.stage2", lat, |x| m.tick(path(x)).c.i, 8, 0.0);
+}
+
+fn table_input<S: Sample>(g: &mut Gen) -> ([Iq<S>; 2], Complex64) {
+    let z = [
+        Iq::new(g.sample(-3.0, 3.0), g.sample(-3.0, 3.0)),
+        Iq::new(g.sample(-3.0, 3.0), g.sample(-3.0, 3.0)),
+    ];
+    (z, g.phasor())
+}
+
+#[test]
+fn table_mixer_blocks_reset_lanes_and_latency() {
+    for n in [0, 3, MAX_TABLE_HARMONIC] {
+        let s = TableMixer::<f64>::new(n).unwrap();
+        let v = TableMixer::<f64x4>::new(n).unwrap();
+        check::tick_vs_process("mixer.table", &s, table_input, |o| *o);
+        check::reset_restores("mixer.table", &s, table_input, |o| *o);
+        check::tick_vs_process("mixer.table<f64x4>", &v, table_input, |o| *o);
+        check::lanes_match(
+            "mixer.table",
+            &v,
+            &[s; 4],
+            table_input,
+            |(z, r), l| (z.map(|zm| Iq::new(zm.i.lane(l), zm.q.lane(l))), *r),
+            |o, l| o.map(|x| x.lane(l)),
+            |o| *o,
+        );
+        // Re z1 to harmonic 0's real channel at a reference of 1: `[1]`, no delay.
+        let mut m = s;
+        let lat = m.latency_samples();
+        let zero = Iq::new(0.0, 0.0);
+        let path = |x: f64| ([Iq::new(x, 0.0), zero], Complex64::new(1.0, 0.0));
+        let ch = table_channel(0, 0, n);
+        check::latency_matches("mixer.table", lat, |x| m.tick(path(x))[ch], 8, 0.0);
+    }
 }

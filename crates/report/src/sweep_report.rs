@@ -26,7 +26,10 @@ pub fn results_table(r: &SweepResult) -> CsvTable {
         Shape::RateTable { .. } => headers.extend([
             "table_lag_mode1_deg",
             "table_lag_mode2_deg",
-            "table_lag_theory_deg",
+            "table_lag_theory_mode1_deg",
+            "table_lag_theory_mode2_deg",
+            "table_lag_error_mode1_mdeg",
+            "table_lag_error_mode2_mdeg",
         ]),
         Shape::Rotating => headers.extend([
             "paper_i_mode1_deg",
@@ -62,8 +65,9 @@ pub fn results_table(r: &SweepResult) -> CsvTable {
             {
                 row.extend(pair);
             }
-            if let Some(t) = p.table_lag_theory_deg {
-                row.push(t);
+            if let (Some(lag), Some(t)) = (p.table_lag_deg, p.table_lag_theory_deg) {
+                row.extend(t);
+                row.extend((0..2).map(|k| (lag[k] - t[k]) * 1e3));
             }
             row.push(p.averaged_s);
             row.into_iter().map(CsvCell::F64).collect()

@@ -7,13 +7,14 @@
 use gyroemu_board::{Health, LaneResult};
 use gyroemu_config::Config;
 use gyroemu_core::Complex64;
+use gyroemu_mixer::{MAX_TABLE_HARMONIC, TABLE_HARMONICS};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Format tag of a point file.
-pub const POINT_FORMAT: &str = "gyroemu-point/2";
+pub const POINT_FORMAT: &str = "gyroemu-point/3";
 
 /// The folder of the point files inside an output folder.
 pub const POINTS_DIR: &str = "points";
@@ -44,12 +45,15 @@ pub struct PointFile {
     pub index: usize,
     /// The point's rate, deg/s (for people reading the file).
     pub rate_dps: f64,
-    /// The lane averages, each f64 as 16 hex digits of its bits: z, c, s, table_phase, each
-    /// as [re mode 1, im mode 1, re mode 2, im mode 2].
+    /// The lane averages, each f64 as 16 hex digits of its bits: z, c, s, each as [re mode 1,
+    /// im mode 1, re mode 2, im mode 2].
     pub z: [String; 4],
     pub c: [String; 4],
     pub s: [String; 4],
-    pub table_phase: [String; 4],
+    /// Rate-table runs: the table harmonics `-N ..= N` of z (the board's `table_z` without
+    /// its zero ends), each as the four values above; empty for the other shapes.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub table_z: Vec<[String; 4]>,
     /// The converters' and rails' counts over the point's run.
     pub health: HealthCounts,
 }
@@ -106,6 +110,37 @@ fn dec(v: &[String; 4]) -> Result<[Complex64; 2], String> {
     Ok([Complex64::new(x[0], x[1]), Complex64::new(x[2], x[3])])
 }
 
+/// The harmonics of `table_z` out to the last non-zero one, per harmonic both modes.
+fn enc_table(t: &[[Complex64; TABLE_HARMONICS]; 2]) -> Vec<[String; 4]> {
+    let zero = Complex64::new(0.0, 0.0);
+    let h = MAX_TABLE_HARMONIC;
+    let Some(n) = (0..=h).rev().find(|&n| {
+        [h - n, h + n]
+            .iter()
+            .any(|&i| t[0][i] != zero || t[1][i] != zero)
+    }) else {
+        return Vec::new();
+    };
+    (h - n..=h + n).map(|i| enc(&[t[0][i], t[1][i]])).collect()
+}
+
+fn dec_table(v: &[[String; 4]]) -> Result<[[Complex64; TABLE_HARMONICS]; 2], String> {
+    if v.len() > TABLE_HARMONICS || v.len().is_multiple_of(2) && !v.is_empty() {
+        return Err(format!(
+            "table_z holds {} harmonics: must be an odd number up to {TABLE_HARMONICS}",
+            v.len()
+        ));
+    }
+    let mut t = [[Complex64::new(0.0, 0.0); TABLE_HARMONICS]; 2];
+    let first = MAX_TABLE_HARMONIC - v.len() / 2;
+    for (i, s) in v.iter().enumerate() {
+        let [a, b] = dec(s)?;
+        t[0][first + i] = a;
+        t[1][first + i] = b;
+    }
+    Ok(t)
+}
+
 impl PointFile {
     /// The record of point `index` of the sweep named by `hash`.
     pub fn new(hash: &str, index: usize, rate_dps: f64, lane: &LaneResult) -> Self {
@@ -117,7 +152,7 @@ impl PointFile {
             z: enc(&lane.z),
             c: enc(&lane.c),
             s: enc(&lane.s),
-            table_phase: enc(&lane.table_phase),
+            table_z: enc_table(&lane.table_z),
             health: lane.health.into(),
         }
     }
@@ -128,7 +163,7 @@ impl PointFile {
             z: dec(&self.z)?,
             c: dec(&self.c)?,
             s: dec(&self.s)?,
-            table_phase: dec(&self.table_phase)?,
+            table_z: dec_table(&self.table_z)?,
             health: self.health.into(),
         })
     }
@@ -271,7 +306,12 @@ mod tests {
             z: c(0),
             c: c(1),
             s: c(2),
-            table_phase: c(3),
+            table_z: core::array::from_fn(|md| {
+                core::array::from_fn(|i| match i {
+                    13..=17 => c(3)[md] * (i as f64 - 12.0),
+                    _ => Complex64::new(0.0, 0.0),
+                })
+            }),
             health: Health {
                 samples: 1 << 52,
                 dac_clipped: [3, 0],
@@ -282,13 +322,15 @@ mod tests {
             },
         };
         let f = PointFile::new("abc", 3, 25.0, &lane);
+        assert_eq!(f.table_z.len(), 5, "only harmonics -2..=2 are stored");
         let text = serde_json::to_string(&f).unwrap();
         let back: PointFile = serde_json::from_str(&text).unwrap();
         let l2 = back.lane().unwrap();
         let bits = |l: &LaneResult| {
-            [l.z, l.c, l.s, l.table_phase]
+            [l.z, l.c, l.s]
                 .iter()
                 .flat_map(|v| [v[0].re, v[0].im, v[1].re, v[1].im])
+                .chain(l.table_z.iter().flatten().flat_map(|v| [v.re, v.im]))
                 .map(f64::to_bits)
                 .collect::<Vec<_>>()
         };

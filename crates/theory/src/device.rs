@@ -4,7 +4,10 @@
 
 use crate::closed_form::{coriolis_theta_rad, rate_table_gain, rotating_psi_rad};
 use gyroemu_core::Complex64;
-use gyroemu_resonator::{continuous_steady_state, Resonator, ResonatorParams};
+use gyroemu_mixer::phase_fundamental;
+use gyroemu_resonator::{
+    continuous_steady_state, rate_table_steady_state, Resonator, ResonatorParams,
+};
 
 const DEG: f64 = core::f64::consts::PI / 180.0;
 
@@ -97,9 +100,7 @@ impl DrivenDevice {
     /// [`DrivenDevice::coriolis_phase_rad`] by the hold's images: negligibly at 16 samples per
     /// carrier period, by whole degrees as fs nears 2 f0. NaN if the plant cannot be built.
     pub fn held_coriolis_phase_rad(&self, omega: f64) -> [f64; 2] {
-        let [f1, f2] = self.drive;
-        let shift = (90.0 + self.phase_shifter_error_deg) * DEG;
-        let force = [Complex64::new(f1, 0.0), Complex64::from_polar(f2, -shift)];
+        let force = self.coriolis_force();
         let v = |w: f64| {
             Resonator::<f64>::new(&self.plant, w)
                 .map(|r| r.held_steady_state(self.f0(), force))
@@ -138,6 +139,80 @@ impl DrivenDevice {
             let (mp, mm) = m[k];
             0.5 * ((vm[2 + k] / mm).arg() - (vp[2 + k] / mp).arg()) - hold
         })
+    }
+
+    /// The force phasors of the Coriolis drives: `F1` on mode 1, `F2` after the phase shifter.
+    fn coriolis_force(&self) -> [Complex64; 2] {
+        let [f1, f2] = self.drive;
+        let shift = (90.0 + self.phase_shifter_error_deg) * DEG;
+        [Complex64::new(f1, 0.0), Complex64::from_polar(f2, -shift)]
+    }
+
+    /// The velocity envelopes of both modes on the rate table `amplitude sin(2 pi table_hz t)`
+    /// (rad/s), driven at `carrier_hz`: harmonics `-harmonics ..= harmonics` of `V_k(t)` in
+    /// `v_k = Re{V_k(t) e^{j w_c t}}`, from the plant's exact periodic steady state (harmonic
+    /// balance, THEORY.md section 3).
+    pub fn rate_table_envelopes(
+        &self,
+        amplitude_rad_s: f64,
+        table_hz: f64,
+        carrier_hz: f64,
+        harmonics: usize,
+    ) -> [Vec<Complex64>; 2] {
+        let x = rate_table_steady_state(
+            &self.plant,
+            amplitude_rad_s,
+            table_hz,
+            carrier_hz,
+            self.coriolis_force(),
+            harmonics,
+        );
+        [0, 1].map(|k| x.iter().map(|xn| xn[2 + k]).collect())
+    }
+
+    /// The smallest `N` such that every envelope harmonic beyond `N` is below `rel` of the
+    /// largest (both modes), searched up to `max`; `None` when even `max` leaves more.
+    pub fn rate_table_harmonics_needed(
+        &self,
+        amplitude_rad_s: f64,
+        table_hz: f64,
+        carrier_hz: f64,
+        rel: f64,
+        max: usize,
+    ) -> Option<usize> {
+        let n = max + 8;
+        let env = self.rate_table_envelopes(amplitude_rad_s, table_hz, carrier_hz, n);
+        let peak = env.iter().flatten().map(|v| v.norm()).fold(0.0, f64::max);
+        let beyond = |k: usize| {
+            env.iter()
+                .flat_map(|h| [h[n - k], h[n + k]])
+                .map(|v| v.norm())
+                .fold(0.0, f64::max)
+        };
+        (0..=max).find(|&m| (m + 1..=n).all(|k| beyond(k) <= rel * peak))
+    }
+
+    /// The exact phase response of each mode to the rate table `amplitude sin(2 pi table_hz
+    /// t)` (rad/s) with the drive at f0: the fundamental of the phase lag of the velocity's
+    /// periodic steady state (harmonic balance, at any swing), as `(amplitude rad, lag rad)`
+    /// per mode, a lag `a sin(w_t t - l)` read as `(a, l)`. NaN when the envelope passes
+    /// through 0 (no continuous phase).
+    pub fn rate_table_response(&self, amplitude_rad_s: f64, table_hz: f64) -> ([f64; 2], [f64; 2]) {
+        // Enough harmonics that the rest is below f64's resolution of the envelope: 24 for
+        // swings up to tens of degrees, 48 beyond.
+        let f0 = self.f0();
+        let mut env = self.rate_table_envelopes(amplitude_rad_s, table_hz, f0, 24);
+        let peak = env.iter().flatten().map(|v| v.norm()).fold(0.0, f64::max);
+        if env
+            .iter()
+            .any(|h| h[2].norm().max(h[46].norm()) > 1e-17 * peak)
+        {
+            env = self.rate_table_envelopes(amplitude_rad_s, table_hz, f0, 48);
+        }
+        let x = env.map(|h| phase_fundamental(&h));
+        let amp = x.map(|x| x.norm());
+        let lag = x.map(|x| -(x * Complex64::new(0.0, 1.0)).arg());
+        (amp, lag)
     }
 
     /// Small-signal phase amplitude per unit rate-table amplitude at `table_hz`, per mode

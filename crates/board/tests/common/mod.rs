@@ -43,6 +43,7 @@ pub fn m2tfg(shape: Shape) -> BoardParams {
         decimation: 100,
         noise: None,
         shape,
+        table_harmonics: 6,
     }
 }
 

@@ -1,0 +1,148 @@
+//! Demodulation of a rate-table run at the harmonics of the table frequency, and the exact
+//! read-out of the phase response from those harmonics (THEORY.md section 3).
+//!
+//! With the table at `Omega(t) = A sin(w_t t)` the plant settles to a periodic envelope
+//! `V(t) = sum_n V_n e^{j n w_t t}` on the carrier. The low-pass acts on the complex `z`, not on
+//! its phase, so each harmonic reaches the read-out as `V_n L(n f_t) H(f_c + n f_t)` (low-pass
+//! and TIA). [`TableMixer`] demodulates `z` at every harmonic `n = -N..N`; averaged over whole
+//! table periods that gives the harmonics themselves. The read-out divides the chain out of
+//! each harmonic and only then takes the phase ([`phase_fundamental`]), which is exact at any
+//! swing, where dividing the fundamental of the phase by `L(f_t)` is exact only for small ones.
+
+use crate::Iq;
+use core::marker::PhantomData;
+use gyroemu_core::detmath::sin_cos_turns;
+use gyroemu_core::{Complex64, Sample, Stage};
+
+/// Highest table harmonic a board demodulates.
+pub const MAX_TABLE_HARMONIC: usize = 15;
+
+/// Harmonics `-MAX .. MAX`.
+pub const TABLE_HARMONICS: usize = 2 * MAX_TABLE_HARMONIC + 1;
+
+/// Real channels of [`TableMixer`]'s output: `(re, im)` of both modes at every harmonic.
+pub const TABLE_CHANNELS: usize = 4 * TABLE_HARMONICS;
+
+/// The channel of `(re, im)` of mode `mode` at harmonic `n` (`-N ..= N`) in the output of a
+/// [`TableMixer`] of `harmonics` = N: `4 (n + N) + 2 mode`, imaginary part next (so the
+/// channels in use come first).
+pub const fn table_channel(n: isize, mode: usize, harmonics: usize) -> usize {
+    4 * (n + harmonics as isize) as usize + 2 * mode
+}
+
+/// `z_k e^{-j n theta}` of both modes at harmonics `n = -N..N`, with `theta` the table phase
+/// given as `e^{-j theta}`; channels beyond harmonic `N` stay zero.
+#[derive(Clone, Copy, Debug)]
+pub struct TableMixer<S> {
+    harmonics: usize,
+    _s: PhantomData<S>,
+}
+
+impl<S: Sample> TableMixer<S> {
+    /// A mixer of harmonics `-harmonics ..= harmonics` (at most [`MAX_TABLE_HARMONIC`]).
+    pub fn new(harmonics: usize) -> gyroemu_core::ParamResult<Self> {
+        if harmonics > MAX_TABLE_HARMONIC {
+            return Err(gyroemu_core::ParamError::new(
+                "mixer",
+                "table_harmonics",
+                harmonics,
+                format!("must be at most {MAX_TABLE_HARMONIC}"),
+            ));
+        }
+        Ok(Self {
+            harmonics,
+            _s: PhantomData,
+        })
+    }
+
+    /// The highest harmonic demodulated.
+    pub fn harmonics(&self) -> usize {
+        self.harmonics
+    }
+
+    /// Real channels in use, `4 (2N + 1)` (the first ones of the output).
+    pub fn channels(&self) -> usize {
+        4 * (2 * self.harmonics + 1)
+    }
+}
+
+/// `e^{-j theta}` for the table phase `theta = 2 pi n_in f_t / fs` of input sample `n_in`,
+/// by the deterministic sine (the same bits on every platform).
+#[inline]
+pub fn table_reference(n_in: u64, table_hz: f64, fs_hz: f64) -> Complex64 {
+    let (s, c) = sin_cos_turns(n_in as f64 * table_hz / fs_hz);
+    Complex64::new(c, -s)
+}
+
+impl<S: Sample> Stage for TableMixer<S> {
+    /// The low-passed stage-1 outputs of both modes and `e^{-j theta}`.
+    type Input = ([Iq<S>; 2], Complex64);
+    type Output = [S; TABLE_CHANNELS];
+
+    #[inline]
+    fn tick(&mut self, (z, base): Self::Input) -> Self::Output {
+        let mut out = [S::splat(0.0); TABLE_CHANNELS];
+        // p = e^{-j n theta} by repeated multiplication (n <= 15 roundings: negligible).
+        let mut p = Complex64::new(1.0, 0.0);
+        for n in 0..=self.harmonics as isize {
+            for sign in [1, -1] {
+                if n == 0 && sign < 0 {
+                    continue;
+                }
+                let r = if sign > 0 { p } else { p.conj() };
+                let (c, s) = (S::splat(r.re), S::splat(r.im));
+                for (md, zm) in z.iter().enumerate() {
+                    let ch = table_channel(sign * n, md, self.harmonics);
+                    out[ch] = zm.i * c - zm.q * s;
+                    out[ch + 1] = zm.i * s + zm.q * c;
+                }
+            }
+            p *= base;
+        }
+        out
+    }
+
+    fn reset(&mut self) {}
+}
+
+/// The complex amplitude of the fundamental of the phase lag `phi(theta) = -arg V(theta)` of
+/// the periodic envelope `V(theta) = sum_n h[n + N] e^{j n theta}` (`h` holds harmonics
+/// `-N..=N`): `(1/pi) int_0^{2 pi} phi e^{-j theta} d theta`, so a lag `a sin(theta - l)`
+/// gives `-j a e^{-j l}`. Evaluated on 1024 points (the rectangle rule is exact for a periodic
+/// function's harmonics below 512). NaN when `V` winds around 0 (no continuous phase).
+pub fn phase_fundamental(h: &[Complex64]) -> Complex64 {
+    const G: usize = 1024;
+    let nh = (h.len() / 2) as isize;
+    let mut acc = Complex64::new(0.0, 0.0);
+    let mut prev = f64::NAN;
+    let mut unwrapped = 0.0;
+    let mut first = 0.0;
+    for g in 0..=G {
+        let (s, c) = sin_cos_turns(g as f64 / G as f64);
+        let base = Complex64::new(c, s);
+        // V(theta) by Horner in e^{j theta}, starting from the highest harmonic.
+        let mut v = Complex64::new(0.0, 0.0);
+        for x in h.iter().rev() {
+            v = v * base + x;
+        }
+        v *= Complex64::new(c, -s).powi(nh as i32);
+        let ph = -v.arg();
+        unwrapped = if prev.is_nan() {
+            ph
+        } else {
+            unwrapped + crate::wrap_pi(ph - prev)
+        };
+        prev = ph;
+        if g == 0 {
+            first = unwrapped;
+        }
+        if g < G {
+            acc += unwrapped * Complex64::new(c, -s);
+        }
+    }
+    // A whole turn of the phase over the period: V went around 0.
+    if (unwrapped - first).abs() > core::f64::consts::PI || !acc.is_finite() {
+        return Complex64::new(f64::NAN, f64::NAN);
+    }
+    acc * (2.0 / G as f64)
+}
