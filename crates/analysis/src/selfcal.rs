@@ -127,9 +127,11 @@ pub fn drifted(cfg: &Config, delta_t_k: f64) -> Config {
 }
 
 /// Validates every config `selfcal` will run (both sweeps, and each drifted device) before
-/// any sample is computed; returns the warnings they add to those of `cfg.validate()`.
+/// any sample is computed; returns the warnings they add to those of `cfg.validate()`, or
+/// every problem in one error. The derived configs are validated only once `cfg` itself is
+/// valid (they would repeat its problems).
 pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
-    let base = cfg.validate()?;
+    let base = cfg.validate();
     // A slope needs two distinct rates besides zero, and its 95 % interval a third (the
     // residual scatter has points - 2 degrees of freedom).
     let mut distinct: Vec<f64> = Vec::new();
@@ -138,47 +140,63 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
             distinct.push(r);
         }
     }
-    if distinct.len() < 3 {
-        return Err(ConfigError::key(
+    let rates = (distinct.len() < 3).then(|| {
+        ConfigError::key(
             "experiment.rates_dps",
             format!("{:?}", cfg.experiment.rates_dps),
             format!(
                 "selfcal needs at least 3 distinct non-zero rates (here {}): 2 for the slope of each sweep and a third for its 95 % confidence interval",
                 distinct.len()
             ),
-        ));
-    }
-    let mut warnings = Vec::new();
-    let (rot, cor) = sweep_configs(cfg);
-    let tag = |what: &str, e: ConfigError| ConfigError {
-        detail: format!("{} (in the {what} of selfcal)", e.detail),
-        ..e
-    };
-    let mut add = |w: Vec<String>| {
-        for x in w {
-            if !base.contains(&x) && !warnings.contains(&x) {
-                warnings.push(x);
+        )
+    });
+    let base = match (base, rates) {
+        (Ok(w), None) => w,
+        (Ok(_), Some(e)) => return Err(e),
+        // Its own problems first; the rates rule only if it names another key's problem.
+        (Err(e), rates) => {
+            let mut list = e.problems();
+            if !list
+                .iter()
+                .any(|p| p.key.as_deref() == Some("experiment.rates_dps"))
+            {
+                list.extend(rates);
             }
+            return Err(ConfigError::from_problems(list).unwrap_or(e));
         }
     };
-    add(rot.validate().map_err(|e| tag("rotating sweep", e))?);
-    add(cor.validate().map_err(|e| tag("rate-table sweep", e))?);
+    let mut warnings = Vec::new();
+    let mut problems = Vec::new();
+    let (rot, cor) = sweep_configs(cfg);
+    let mut add = |what: &str, r: Result<Vec<String>, ConfigError>| match r {
+        Ok(w) => {
+            for x in w {
+                if !base.contains(&x) && !warnings.contains(&x) {
+                    warnings.push(x);
+                }
+            }
+        }
+        Err(e) => problems.push(e.map_details(|d| format!("{d} (in the {what} of selfcal)"))),
+    };
+    add("rotating sweep", rot.validate());
+    add("rate-table sweep", cor.validate());
     if let Some(s) = &cfg.selfcal {
         for &dt in &s.drift_delta_t_k {
             let (r, c) = sweep_configs(&drifted(cfg, dt));
             let what = format!("drift scenario at {dt} K");
-            add(r.validate().map_err(|e| tag(&what, e))?);
-            add(c.validate().map_err(|e| tag(&what, e))?);
+            add(&what, r.validate());
+            add(&what, c.validate());
         }
         if let Some(t) = s.tau_max_s {
             let mut r = rot.clone();
             r.experiment.average_s = t;
-            add(r
-                .validate()
-                .map_err(|e| tag("averaging-time analysis", e))?);
+            add("averaging-time analysis", r.validate());
         }
     }
-    Ok(warnings)
+    match ConfigError::from_problems(problems) {
+        Some(e) => Err(e),
+        None => Ok(warnings),
+    }
 }
 
 /// Both sweeps and their comparison.

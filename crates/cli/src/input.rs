@@ -2,7 +2,7 @@
 //! printing to a stdout that a reader may close early.
 
 use anyhow::Result;
-use gyroemu_config::{parse_config, Config};
+use gyroemu_config::{parse_config, Config, ConfigError};
 use std::path::Path;
 
 /// A refusal of the user's input (exit code 2), as opposed to a failure while running.
@@ -10,16 +10,27 @@ use std::path::Path;
 #[error("{0}")]
 pub struct BadInput(pub String);
 
-/// Reads, parses and validates a config file; prints its warnings.
-pub fn load_config(path: &Path) -> Result<Config> {
+/// Reads and parses a config file (every problem of its text in one refusal), not yet
+/// validated; returns it with its text.
+pub fn read_config(path: &Path) -> Result<(Config, String)> {
     let bytes = std::fs::read(path)
         .map_err(|e| BadInput(format!("cannot read config `{}`: {e}", path.display())))?;
     let text = String::from_utf8(bytes)
         .map_err(|_| BadInput(format!("config `{}` is not UTF-8 text", path.display())))?;
     let cfg = parse_config(&text).map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
-    let warnings = cfg
-        .validate()
-        .map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    Ok((cfg, text))
+}
+
+/// The refusal of a config that parsed but broke rules: each problem located in its text.
+pub fn refused(path: &Path, text: &str, e: ConfigError) -> BadInput {
+    BadInput(format!("{}: {}", path.display(), e.with_locations(text)))
+}
+
+/// Reads, parses and validates a config file (every broken rule in one refusal); prints its
+/// warnings.
+pub fn load_config(path: &Path) -> Result<Config> {
+    let (cfg, text) = read_config(path)?;
+    let warnings = cfg.validate().map_err(|e| refused(path, &text, e))?;
     for w in warnings {
         eprintln!("warning: {}: {w}", path.display());
     }

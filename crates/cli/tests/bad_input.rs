@@ -97,7 +97,12 @@ fn unreadable_configs_exit_2_and_write_nothing() {
                 "t.toml",
                 GOOD.replace("q = 1000.0", "q = \"x\"").as_bytes(),
             ),
-            vec!["t.toml", "line 4, column 5", "device.q", "expected f64"],
+            vec![
+                "t.toml",
+                "line 4, column 5",
+                "device.q",
+                "expected a number",
+            ],
         ),
         (
             "misspelt key",
@@ -106,7 +111,12 @@ fn unreadable_configs_exit_2_and_write_nothing() {
                 "k.toml",
                 GOOD.replace("decimation", "decimaton").as_bytes(),
             ),
-            vec!["k.toml", "board.decimaton", "unknown field", "`decimation`"],
+            vec![
+                "k.toml",
+                "board.decimaton",
+                "unknown key",
+                "did you mean `decimation`?",
+            ],
         ),
         (
             "output-rate Nyquist",
@@ -123,6 +133,77 @@ fn unreadable_configs_exit_2_and_write_nothing() {
         refused(what, &config, &out, &needles);
         assert!(!out.exists(), "{what}: --out was created");
     }
+}
+
+/// Runs the case and checks exit code 2, one `error:` message listing every problem (a count,
+/// then one indented line each holding its needles, in order), and that `out` was not created.
+fn refused_all(what: &str, config: &Path, out: &Path, problems: &[&[&str]]) {
+    let o = run(config, out);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{what}: {err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1 + problems.len(), "{what}: {err}");
+    assert!(
+        lines[0].starts_with("error: ")
+            && lines[0].ends_with(&format!("config error: {} problems:", problems.len())),
+        "{what}: {err}"
+    );
+    for (line, needles) in lines[1..].iter().zip(problems) {
+        assert!(line.starts_with("  "), "{what}: {err}");
+        for n in *needles {
+            assert!(line.contains(n), "{what}: `{n}` missing from: {line}");
+        }
+    }
+    assert!(!out.exists(), "{what}: --out was created");
+}
+
+#[test]
+fn every_problem_of_a_config_is_refused_in_one_message() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("out");
+    // Parsing: a wrong type, a misspelt key and a missing section.
+    let text = GOOD
+        .replace("q = 1000.0", "q = \"x\"")
+        .replace("decimation", "decimaton")
+        .replace("[drive]\nf1 = 1.0\nf2 = 1.0\n", "");
+    let parse = write(d, "parse.toml", text.as_bytes());
+    refused_all(
+        "parse problems",
+        &parse,
+        &out,
+        &[
+            &[
+                "line 4, column 5",
+                "device.q",
+                "= \"x\"",
+                "expected a number",
+            ],
+            &["line 9, column 1", "board.decimaton", "unknown key"],
+            // A missing section has no line: it closes the list, named as itself.
+            &["  key `drive` is missing: the config requires the section [drive]"],
+        ],
+    );
+    // Validation: three values out of range, each at its line.
+    let text = GOOD
+        .replace("q = 1000.0", "q = -1.0")
+        .replace("f1 = 1.0", "f1 = 0.0")
+        .replace("average_s = 0.1", "average_s = -3.0");
+    let invalid = write(d, "invalid.toml", text.as_bytes());
+    refused_all(
+        "invalid values",
+        &invalid,
+        &out,
+        &[
+            &["line 4, column 5", "key `device.q` = -1: ", "> 0"],
+            &["line 7, column 6", "key `drive.f1` = 0: ", "> 0"],
+            &[
+                "line 16, column 13",
+                "key `experiment.average_s` = -3: ",
+                "> 0",
+            ],
+        ],
+    );
 }
 
 #[test]

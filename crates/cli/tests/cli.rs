@@ -99,7 +99,7 @@ fn bad_configs_exit_2_naming_key_value_and_rule_and_write_nothing() {
         ),
         (
             SMALL.replace("q = 1000.0", "q = \"high\""),
-            vec!["line 4", "expected f64"],
+            vec!["line 4", "expected a number"],
         ),
         (
             SMALL.replace("angular_gain = 1.0\n", ""),

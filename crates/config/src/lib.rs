@@ -1,13 +1,18 @@
 //! The experiment description of gyroemu: a TOML config with units in every key, unknown keys
 //! rejected and documented defaults; its parsing, its validation before any sample is
-//! computed (every error names the key, the value and the rule), the embedded presets, and
-//! what it implies ([`Config::board_params`], [`Config::plan_point`]).
+//! computed (every error names the key, the value and the rule, and a file's problems are
+//! reported all at once), the embedded presets, and what it implies
+//! ([`Config::board_params`], [`Config::plan_point`]).
 
 mod config;
+mod document;
+mod error;
 mod parse;
 mod plan;
 pub mod presets;
 mod resolve;
+mod rules;
+mod schema;
 mod validate;
 mod validate_noise;
 mod validate_regime;
@@ -16,7 +21,8 @@ pub use config::{
     BoardConfig, Config, DeviceConfig, DriveConfig, DumpConfig, ExperimentConfig, ExperimentKind,
     NoiseConfig, RateTable, SelfcalConfig, WindowKind,
 };
-pub use parse::{parse_config, parse_config_explained, ConfigError};
+pub use error::ConfigError;
+pub use parse::{parse_config, parse_config_explained, plain_words};
 pub use resolve::Derived;
 pub use validate::MAX_RUN_SAMPLES;
 pub use validate_regime::{MAX_HOLD_ERROR_MDEG, NODE_RANGE, WARN_HOLD_ERROR_MDEG};

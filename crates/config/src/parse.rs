@@ -1,46 +1,17 @@
-//! Parsing TOML into a [`Config`]: unknown keys, wrong types and missing keys are errors that
-//! name the key, with the line and column where TOML parsing located it.
+//! Parsing TOML into a [`Config`]: syntax errors, unknown keys, wrong types and missing keys
+//! are all reported at once, each naming the key with the line and column where the text
+//! shows it.
 
 use crate::config::Config;
+use crate::document::{check_document, location};
+use crate::error::ConfigError;
 use crate::resolve::Derived;
-use thiserror::Error;
+use serde::Deserialize;
+use toml::de::DeTable;
 
-/// A config the emulator refuses.
-#[derive(Debug, Clone, PartialEq, Error)]
-#[error("config error: {}{}{}", .location.as_ref().map(|l| format!("{l}: ")).unwrap_or_default(), .key.as_ref().map(|k| format!("key `{k}`")).unwrap_or_default(), .detail)]
-pub struct ConfigError {
-    /// `line L, column C` where TOML parsing knows it.
-    pub location: Option<String>,
-    /// Dotted key path, e.g. `device.q`.
-    pub key: Option<String>,
-    /// What is wrong and the allowed range.
-    pub detail: String,
-}
-
-impl ConfigError {
-    /// An error about one key's value.
-    pub fn key(key: &str, value: impl std::fmt::Display, rule: impl std::fmt::Display) -> Self {
-        Self {
-            location: None,
-            key: Some(key.to_string()),
-            detail: format!(" = {}: {rule}", readable(value.to_string())),
-        }
-    }
-}
-
-/// A number as the user would write it: very large or very small magnitudes in exponent
-/// form (`1e300`, `-1e-9`) instead of hundreds of digits; anything else unchanged.
-fn readable(value: String) -> String {
-    match value.parse::<f64>() {
-        Ok(x) if x.is_finite() && x != 0.0 && !(1e-5..1e16).contains(&x.abs()) => {
-            format!("{x:e}")
-        }
-        _ => value,
-    }
-}
-
-/// Parses TOML text into a config; unknown keys, wrong types and missing keys are errors.
-/// Keys with derived defaults that the text leaves out are filled in ([`Config::resolve`]).
+/// Parses TOML text into a config; unknown keys, wrong types and missing keys are errors (all
+/// of the file's, in one [`ConfigError`]). Keys with derived defaults that the text leaves
+/// out are filled in ([`Config::resolve`]).
 pub fn parse_config(text: &str) -> Result<Config, ConfigError> {
     parse_config_explained(text).map(|(c, _)| c)
 }
@@ -55,61 +26,79 @@ pub fn parse_config_explained(text: &str) -> Result<(Config, Vec<Derived>), Conf
 /// The TOML text as written, nothing derived.
 fn parse_raw(text: &str) -> Result<Config, ConfigError> {
     if text.trim().is_empty() {
-        return Err(ConfigError {
-            location: None,
-            key: None,
-            detail: "the config file is empty".into(),
-        });
+        return Err(ConfigError::message("the config file is empty"));
     }
-    toml::from_str::<Config>(text).map_err(|e| {
-        let message = e.message().trim().to_string();
-        let Some(span) = e.span() else {
-            return ConfigError {
-                location: None,
-                key: None,
-                detail: message,
-            };
-        };
-        let start = floor_char_boundary(text, span.start);
-        let before = &text[..start];
-        let line = before.matches('\n').count() + 1;
-        let col = before[before.rfind('\n').map(|i| i + 1).unwrap_or(0)..]
-            .chars()
-            .count()
-            + 1;
-        ConfigError {
-            location: Some(format!("line {line}, column {col}")),
-            key: Some(key_at(text, start, &message)),
-            detail: format!(": {message}"),
-        }
-    })
+    // A syntax error can make the keys after it look missing or mistyped: report only the
+    // syntax errors then.
+    let (doc, syntax) = DeTable::parse_recoverable(text);
+    if let Some(e) =
+        ConfigError::from_problems(syntax.iter().map(|e| toml_error(text, e)).collect())
+    {
+        return Err(e);
+    }
+    if let Some(e) = ConfigError::from_problems(check_document(text, doc.get_ref())) {
+        return Err(e);
+    }
+    // The schema accepts what serde does (tested), so this fails only if they drift apart.
+    Config::deserialize(toml::de::Deserializer::from(doc)).map_err(|e| toml_error(text, &e))
 }
 
-/// The largest char boundary at or below `i` (TOML spans are byte offsets).
-fn floor_char_boundary(text: &str, i: usize) -> usize {
-    let mut i = i.min(text.len());
-    while !text.is_char_boundary(i) {
-        i -= 1;
+/// A TOML error as a located problem in the user's words.
+fn toml_error(text: &str, e: &toml::de::Error) -> ConfigError {
+    let detail = format!(": {}", plain_words(e.message().trim()));
+    match e.span() {
+        Some(span) => ConfigError {
+            location: Some(location(text, span.start)),
+            key: Some(key_at(text, span.start)),
+            ..ConfigError::message(detail)
+        },
+        None => ConfigError::message(detail),
     }
-    i
 }
 
-/// The dotted key a TOML error at byte `offset` is about: the table header above it plus the
-/// key of its line (or of the nearest `key =` line above, for a multi-line value), or the
-/// field a "missing field" / "unknown field" message names. Best effort: it only labels
-/// the message, the line and column stay exact.
-fn key_at(text: &str, offset: usize, message: &str) -> String {
+/// A serde or TOML message with its Rust type names (`expected usize`, `as i128`) put in the
+/// user's words.
+pub fn plain_words(message: &str) -> String {
+    const WORDS: [(&str, &str); 20] = [
+        (" as i128", ""),
+        (" as u128", ""),
+        ("expected usize", "expected a non-negative integer"),
+        ("expected u64", "expected a non-negative integer"),
+        ("expected u32", "expected an integer from 0 to 4294967295"),
+        ("expected u16", "expected an integer from 0 to 65535"),
+        ("expected u8", "expected an integer from 0 to 255"),
+        ("expected i128", "expected an integer"),
+        ("expected i64", "expected an integer"),
+        ("expected i32", "expected an integer"),
+        ("expected isize", "expected an integer"),
+        ("expected f64", "expected a number"),
+        ("expected f32", "expected a number"),
+        ("expected a boolean", "expected true or false"),
+        ("expected a sequence", "expected a list"),
+        ("expected a map", "expected a table"),
+        ("floating point `", "number `"),
+        ("boolean `", "`"),
+        ("invalid type: sequence", "invalid type: list"),
+        ("invalid type: map", "invalid type: table"),
+    ];
+    WORDS
+        .iter()
+        .fold(message.to_string(), |m, (from, to)| m.replace(from, to))
+}
+
+/// The dotted key a TOML syntax error at byte `offset` is about: the table header above it
+/// plus the key of its line (or of the nearest `key =` line above, for a multi-line value).
+/// Best effort: it only labels the message, the line and column stay exact.
+fn key_at(text: &str, offset: usize) -> String {
     let mut table = String::new();
     let mut key = None;
-    let mut on_header = false;
     let mut line_start = 0;
     for raw in text.split_inclusive('\n') {
         if line_start > offset {
             break;
         }
         let l = raw.split('#').next().unwrap_or("").trim();
-        on_header = l.starts_with('[');
-        if on_header {
+        if l.starts_with('[') {
             table = l.trim_matches(|c| c == '[' || c == ']').trim().to_string();
             key = None;
         } else if let Some((k, _)) = l.split_once('=') {
@@ -120,21 +109,69 @@ fn key_at(text: &str, offset: usize, message: &str) -> String {
         }
         line_start += raw.len();
     }
-    let named = ["missing field `", "unknown field `"]
-        .iter()
-        .find_map(|p| message.strip_prefix(p))
-        .and_then(|rest| rest.split('`').next())
-        .map(str::to_string);
-    // A missing field's span is its table, so the key is the table's child.
-    let leaf = named.or(key);
-    // An unknown table is reported at its own header: the key is the table itself.
-    if on_header && leaf.as_deref() == table.rsplit('.').next() {
-        return table;
-    }
-    match (table.is_empty(), leaf) {
+    match (table.is_empty(), key) {
         (true, Some(k)) => k,
         (false, Some(k)) => format!("{table}.{k}"),
         (false, None) => table,
         (true, None) => "(top level)".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Debug, Deserialize)]
+    #[allow(dead_code)]
+    struct Every {
+        a: usize,
+        b: u64,
+        c: u32,
+        d: u8,
+        e: i64,
+        f: f64,
+        g: bool,
+        h: Vec<f64>,
+    }
+
+    #[test]
+    fn serde_messages_lose_their_rust_type_names() {
+        let ok = [
+            "a = 1", "b = 1", "c = 1", "d = 1", "e = 1", "f = 1.0", "g = true", "h = []",
+        ];
+        let bad = [
+            "-1",
+            "1.5",
+            "\"x\"",
+            "99999999999999999999",
+            "4294967296",
+            "[1]",
+            "true",
+        ];
+        let mut seen = 0;
+        for i in 0..ok.len() {
+            for v in bad {
+                let mut lines = ok.to_vec();
+                let line = format!("{} = {v}", &ok[i][..1]);
+                lines[i] = &line;
+                let Err(e) = toml::from_str::<Every>(&lines.join("\n")) else {
+                    continue;
+                };
+                let raw = e.message().to_string();
+                let words = plain_words(&raw);
+                for t in [
+                    "usize", "u64", "u32", "u8", "i64", "i128", "f64", "boolean", "sequence",
+                ] {
+                    assert!(
+                        !words
+                            .split(|c: char| !c.is_ascii_alphanumeric())
+                            .any(|w| w == t),
+                        "{raw} -> {words}"
+                    );
+                }
+                seen += 1;
+            }
+        }
+        assert!(seen >= 40, "{seen}");
     }
 }

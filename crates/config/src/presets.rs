@@ -2,7 +2,8 @@
 //! one, and `gyroemu reproduce` runs them.
 
 use crate::config::Config;
-use crate::parse::{parse_config, ConfigError};
+use crate::error::ConfigError;
+use crate::parse::parse_config;
 
 /// (name, what it reproduces, TOML text).
 pub const PRESETS: [(&str, &str, &str); 6] = [
@@ -45,13 +46,11 @@ pub fn preset_text(name: &str) -> Option<&'static str> {
 
 /// A preset parsed into a config.
 pub fn preset(name: &str) -> Result<Config, ConfigError> {
-    let text = preset_text(name).ok_or_else(|| ConfigError {
-        location: None,
-        key: None,
-        detail: format!(
+    let text = preset_text(name).ok_or_else(|| {
+        ConfigError::message(format!(
             "unknown preset `{name}`; presets: {}",
             PRESETS.iter().map(|p| p.0).collect::<Vec<_>>().join(", ")
-        ),
+        ))
     })?;
     parse_config(text)
 }

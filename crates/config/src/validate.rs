@@ -1,7 +1,10 @@
-//! Validation before any sample is computed: every rule names the key, the value and the rule.
+//! Validation before any sample is computed: every rule names the key, the value and the rule,
+//! and every broken rule of a config is reported (a rule whose inputs already broke one is
+//! skipped: see [`Rules`]).
 
 use crate::config::{Config, ExperimentKind, RateTable, WindowKind};
-use crate::parse::ConfigError;
+use crate::error::ConfigError;
+use crate::rules::Rules;
 use gyroemu_board::{Shape, DUMP_NODES};
 use gyroemu_theory::mechanical_tau_s;
 
@@ -9,202 +12,253 @@ use gyroemu_theory::mechanical_tau_s;
 /// is exact as an f64.
 pub const MAX_RUN_SAMPLES: f64 = 9_007_199_254_740_992.0;
 
-pub(crate) fn check(
-    ok: bool,
-    key: &str,
-    value: impl std::fmt::Display,
-    rule: &str,
-) -> Result<(), ConfigError> {
-    if ok {
-        Ok(())
-    } else {
-        Err(ConfigError::key(key, value, rule))
-    }
-}
-
-pub(crate) fn positive(key: &str, v: f64) -> Result<(), ConfigError> {
-    check(
-        v.is_finite() && v > 0.0,
-        key,
-        v,
-        "must be a finite number > 0",
-    )
-}
-
-fn finite(key: &str, v: f64) -> Result<(), ConfigError> {
-    check(v.is_finite(), key, v, "must be a finite number")
-}
-
-pub(crate) fn non_negative(key: &str, v: f64) -> Result<(), ConfigError> {
-    check(
-        v.is_finite() && v >= 0.0,
-        key,
-        v,
-        "must be a finite number >= 0",
-    )
+/// The same f64, bit for bit (a derived value equals its derivation exactly).
+fn same(a: f64, b: f64) -> bool {
+    a.to_bits() == b.to_bits()
 }
 
 impl Config {
-    /// Checks every rule that does not need the stages built; returns warnings.
+    /// Checks every rule that does not need the stages built; returns the warnings, or every
+    /// broken rule in one error.
     pub fn validate(&self) -> Result<Vec<String>, ConfigError> {
+        let mut p = Rules::default();
+        let mut warnings = Vec::new();
+        self.link_derived(&mut p);
+        self.validate_device_board(&mut p);
+        self.validate_experiment(&mut p, &mut warnings);
+        self.validate_noise_adc_selfcal(&mut p, &mut warnings);
+        // The regime rules weigh the whole chain: only once its keys are each valid.
+        if ["device", "drive", "board"]
+            .iter()
+            .all(|s| p.section_clean(s))
+            && p.clean(&["experiment.rates_dps"])
+        {
+            self.validate_regime(&mut p, &mut warnings);
+        }
+        self.validate_dump(&mut p);
+        p.finish().map(|()| warnings)
+    }
+
+    /// Declares the keys `parse_config` derived (their value is exactly the derivation's), so
+    /// that a bad source is reported once, not again through what was derived from it.
+    fn link_derived(&self, p: &mut Rules) {
+        let raw = |f: &dyn Fn(&mut Config)| {
+            let mut c = self.clone();
+            f(&mut c);
+            c
+        };
+        if same(raw(&|c| c.drive.f2 = None).f2(), self.f2()) {
+            p.derived_from("drive.f2", "drive.f1");
+        }
+        if same(raw(&|c| c.board.fs_hz = None).fs_hz(), self.fs_hz()) {
+            p.derived_from("board.fs_hz", "device.f0_hz");
+            p.derived_from("board.fs_hz", "device.mode2_f0_offset_hz");
+        }
+        // Clamped to f0/100 .. f0/10: only f0 can make it bad.
+        if same(
+            raw(&|c| c.board.lpf_cutoff_hz = None).lpf_cutoff_hz(),
+            self.lpf_cutoff_hz(),
+        ) {
+            p.derived_from("board.lpf_cutoff_hz", "device.f0_hz");
+        }
+        if raw(&|c| c.board.decimation = None).decimation() == self.decimation() {
+            p.derived_from("board.decimation", "board.fs_hz");
+            p.derived_from("board.decimation", "board.lpf_cutoff_hz");
+        }
+    }
+
+    fn validate_device_board(&self, p: &mut Rules) {
         let d = &self.device;
         let b = &self.board;
-        let e = &self.experiment;
-        let (fs_hz, cutoff_hz, decimation) =
-            (self.fs_hz(), self.lpf_cutoff_hz(), self.decimation());
-        let mut warnings = Vec::new();
-        positive("device.f0_hz", d.f0_hz)?;
-        positive("device.q", d.q)?;
-        positive("device.angular_gain", d.angular_gain)?;
-        finite("device.mode2_f0_offset_hz", d.mode2_f0_offset_hz)?;
-        check(
-            self.f0_mode2_hz() > 0.0,
-            "device.mode2_f0_offset_hz",
-            d.mode2_f0_offset_hz,
-            "mode-2 resonance f0_hz + offset must stay > 0",
-        )?;
-        if let Some(q2) = d.q_mode2 {
-            positive("device.q_mode2", q2)?;
+        let (fs_hz, cutoff_hz) = (self.fs_hz(), self.lpf_cutoff_hz());
+        p.positive("device.f0_hz", d.f0_hz);
+        p.positive("device.q", d.q);
+        p.positive("device.angular_gain", d.angular_gain);
+        if p.finite("device.mode2_f0_offset_hz", d.mode2_f0_offset_hz) && p.clean(&["device.f0_hz"])
+        {
+            p.check(
+                self.f0_mode2_hz() > 0.0,
+                "device.mode2_f0_offset_hz",
+                d.mode2_f0_offset_hz,
+                "mode-2 resonance f0_hz + offset must stay > 0",
+            );
         }
-        finite(
+        if let Some(q2) = d.q_mode2 {
+            p.positive("device.q_mode2", q2);
+        }
+        p.finite(
             "device.quadrature_coupling_rad2_s2",
             d.quadrature_coupling_rad2_s2,
-        )?;
-        positive("device.transduction_a_s_per_m", d.transduction_a_s_per_m)?;
-        positive("drive.f1", self.drive.f1)?;
-        positive("drive.f2", self.f2())?;
+        );
+        p.positive("device.transduction_a_s_per_m", d.transduction_a_s_per_m);
+        p.positive("drive.f1", self.drive.f1);
+        p.positive("drive.f2", self.f2());
 
-        positive("board.fs_hz", fs_hz)?;
+        p.positive("board.fs_hz", fs_hz);
         let f_max = d.f0_hz.max(self.f0_mode2_hz());
-        check(
-            fs_hz > 2.0 * f_max,
-            "board.fs_hz",
-            fs_hz,
-            &format!("must be above 2*f0 = {} Hz", 2.0 * f_max),
-        )?;
-        positive("board.tia_gain_ohm", b.tia_gain_ohm)?;
-        if let Some(p) = b.tia_pole_hz {
-            check(
-                p.is_finite() && p > 0.0 && p < 0.5 * fs_hz,
-                "board.tia_pole_hz",
-                p,
-                &format!(
-                    "must be > 0 and below Nyquist (fs_hz/2 = {} Hz)",
-                    0.5 * fs_hz
-                ),
-            )?;
+        if p.clean(&["device.f0_hz", "device.mode2_f0_offset_hz"]) {
+            p.check(
+                fs_hz > 2.0 * f_max,
+                "board.fs_hz",
+                fs_hz,
+                format!("must be above 2*f0 = {} Hz", 2.0 * f_max),
+            );
+        }
+        p.positive("board.tia_gain_ohm", b.tia_gain_ohm);
+        if let Some(pole) = b.tia_pole_hz {
+            if p.clean(&["board.fs_hz"]) {
+                p.check(
+                    pole.is_finite() && pole > 0.0 && pole < 0.5 * fs_hz,
+                    "board.tia_pole_hz",
+                    pole,
+                    format!(
+                        "must be > 0 and below Nyquist (fs_hz/2 = {} Hz)",
+                        0.5 * fs_hz
+                    ),
+                );
+            } else {
+                p.positive("board.tia_pole_hz", pole);
+            }
         }
         if let Some(r) = b.tia_rail_v {
-            positive("board.tia_rail_v", r)?;
+            p.positive("board.tia_rail_v", r);
         }
-        check(
+        p.check(
             (1..=8).contains(&b.lpf_order),
             "board.lpf_order",
             b.lpf_order,
             "must be an integer from 1 to 8",
-        )?;
-        check(
+        );
+        let decimation = self.decimation();
+        p.check(
             decimation >= 1,
             "board.decimation",
             decimation,
             "must be an integer >= 1",
-        )?;
-        let nyq_out = 0.5 * self.fs_out_hz();
-        check(
-            cutoff_hz.is_finite() && cutoff_hz > 0.0 && cutoff_hz < nyq_out,
-            "board.lpf_cutoff_hz",
-            cutoff_hz,
-            &format!(
-                "must be > 0 and below the Nyquist rate after decimation (fs_hz/decimation/2 = {nyq_out} Hz)"
-            ),
-        )?;
-        check(
-            cutoff_hz < d.f0_hz,
-            "board.lpf_cutoff_hz",
-            cutoff_hz,
-            "must be below f0_hz so the low-pass removes the 2*f0 mixing product",
-        )?;
-        // The design itself: f64 must realise it with its poles inside the unit circle.
-        gyroemu_lpf::LowPass::<f64>::new(self.lowpass_design(), fs_hz).map_err(|e| {
-            ConfigError::key(
+        );
+        if p.clean(&["board.fs_hz", "board.decimation"]) {
+            let nyq_out = 0.5 * self.fs_out_hz();
+            p.check(
+                cutoff_hz.is_finite() && cutoff_hz > 0.0 && cutoff_hz < nyq_out,
                 "board.lpf_cutoff_hz",
                 cutoff_hz,
-                format!("the stage-1 low-pass cannot be built: {}", e.rule),
-            )
-        })?;
+                format!(
+                    "must be > 0 and below the Nyquist rate after decimation (fs_hz/decimation/2 = {nyq_out} Hz)"
+                ),
+            );
+        } else {
+            p.positive("board.lpf_cutoff_hz", cutoff_hz);
+        }
+        if p.clean(&["device.f0_hz"]) {
+            p.check(
+                cutoff_hz < d.f0_hz,
+                "board.lpf_cutoff_hz",
+                cutoff_hz,
+                "must be below f0_hz so the low-pass removes the 2*f0 mixing product",
+            );
+        }
+        // The design itself: f64 must realise it with its poles inside the unit circle.
+        if p.clean(&["board.lpf_cutoff_hz", "board.fs_hz", "board.lpf_order"]) {
+            if let Err(e) = gyroemu_lpf::LowPass::<f64>::new(self.lowpass_design(), fs_hz) {
+                p.push(ConfigError::key(
+                    "board.lpf_cutoff_hz",
+                    cutoff_hz,
+                    format!("the stage-1 low-pass cannot be built: {}", e.rule),
+                ));
+            }
+        }
         if let Some(bits) = b.dac_bits {
-            check(
+            p.check(
                 (2..=32).contains(&bits),
                 "board.dac_bits",
                 bits,
                 "must be an integer from 2 to 32",
-            )?;
+            );
         }
-        positive("board.dac_full_scale", b.dac_full_scale)?;
-        check(
+        p.positive("board.dac_full_scale", b.dac_full_scale);
+        p.check(
             b.phase_shifter_error_deg.is_finite() && b.phase_shifter_error_deg.abs() < 90.0,
             "board.phase_shifter_error_deg",
             b.phase_shifter_error_deg,
             "must be finite and within (-90, 90) degrees",
-        )?;
+        );
+    }
 
-        check(
+    fn validate_experiment(&self, p: &mut Rules, warnings: &mut Vec<String>) {
+        let d = &self.device;
+        let e = &self.experiment;
+        let (fs_hz, cutoff_hz) = (self.fs_hz(), self.lpf_cutoff_hz());
+        let device_ok = p.clean(&["device.f0_hz", "device.q", "device.q_mode2"]);
+        p.check(
             !e.rates_dps.is_empty(),
             "experiment.rates_dps",
             "[]",
             "must list at least one rate",
-        )?;
+        );
         for (i, &r) in e.rates_dps.iter().enumerate() {
-            finite(&format!("experiment.rates_dps[{i}]"), r)?;
-            if e.kind == ExperimentKind::Rotating {
+            let key = format!("experiment.rates_dps[{i}]");
+            if p.finite(&key, r)
+                && e.kind == ExperimentKind::Rotating
+                && p.clean(&["board.lpf_cutoff_hz"])
+            {
                 let f_mod = r.abs() / 360.0;
-                check(
+                p.check(
                     f_mod < cutoff_hz,
-                    &format!("experiment.rates_dps[{i}]"),
+                    &key,
                     r,
-                    &format!(
+                    format!(
                         "the modulation frequency |rate|/360 must be below board.lpf_cutoff_hz = {} Hz",
                         cutoff_hz
                     ),
-                )?;
+                );
             }
         }
         if let Some(s) = e.settle_s {
-            non_negative("experiment.settle_s", s)?;
-            let tau = mechanical_tau_s(d.f0_hz, d.q.max(d.q_mode2.unwrap_or(0.0)));
-            if s < 10.6 * tau {
-                warnings.push(format!(
-                    "experiment.settle_s = {s} is shorter than 10.6 mechanical time constants ({} s): phase errors above 1 mdeg remain",
-                    10.6 * tau
-                ));
+            if p.non_negative("experiment.settle_s", s) && device_ok {
+                let tau = mechanical_tau_s(d.f0_hz, d.q.max(d.q_mode2.unwrap_or(0.0)));
+                if s < 10.6 * tau {
+                    warnings.push(format!(
+                        "experiment.settle_s = {s} is shorter than 10.6 mechanical time constants ({} s): phase errors above 1 mdeg remain",
+                        10.6 * tau
+                    ));
+                }
             }
         }
-        positive("experiment.average_s", e.average_s)?;
-        check(
-            e.average_s >= 1.0 / self.fs_out_hz(),
-            "experiment.average_s",
-            e.average_s,
-            &format!(
-                "must cover at least one output sample period ({} s)",
-                1.0 / self.fs_out_hz()
-            ),
-        )?;
-        // Sample indices and counts must stay exact in f64 (and far from u64 overflow).
-        let run_samples = (self.settle_s() + e.average_s) * fs_hz;
-        check(
-            run_samples <= MAX_RUN_SAMPLES,
-            if e.settle_s.is_some_and(|s| s > e.average_s) {
-                "experiment.settle_s"
-            } else {
-                "experiment.average_s"
-            },
-            e.settle_s.filter(|&s| s > e.average_s).unwrap_or(e.average_s),
-            &format!(
-                "settling plus averaging must span at most 2^53 = {MAX_RUN_SAMPLES:e} input samples per point (here {run_samples:e} at fs_hz = {})",
-                fs_hz
-            ),
-        )?;
-        if e.kind == ExperimentKind::Rotating {
+        p.positive("experiment.average_s", e.average_s);
+        if p.clean(&["board.fs_hz", "board.decimation"]) {
+            p.check(
+                e.average_s >= 1.0 / self.fs_out_hz(),
+                "experiment.average_s",
+                e.average_s,
+                format!(
+                    "must cover at least one output sample period ({} s)",
+                    1.0 / self.fs_out_hz()
+                ),
+            );
+        }
+        // Sample indices and counts must stay exact in f64 (and far from u64 overflow). The
+        // default settling comes from the device and the low-pass.
+        let settle_ok = match e.settle_s {
+            Some(_) => p.clean(&["experiment.settle_s"]),
+            None => device_ok && p.clean(&["board.lpf_cutoff_hz"]),
+        };
+        if settle_ok && p.clean(&["experiment.average_s", "board.fs_hz"]) {
+            let run_samples = (self.settle_s() + e.average_s) * fs_hz;
+            p.check(
+                run_samples <= MAX_RUN_SAMPLES,
+                if e.settle_s.is_some_and(|s| s > e.average_s) {
+                    "experiment.settle_s"
+                } else {
+                    "experiment.average_s"
+                },
+                e.settle_s.filter(|&s| s > e.average_s).unwrap_or(e.average_s),
+                format!(
+                    "settling plus averaging must span at most 2^53 = {MAX_RUN_SAMPLES:e} input samples per point (here {run_samples:e} at fs_hz = {})",
+                    fs_hz
+                ),
+            );
+        }
+        if e.kind == ExperimentKind::Rotating && p.clean(&["experiment.rates_dps"]) {
             if let Some(min) = e
                 .rates_dps
                 .iter()
@@ -213,57 +267,62 @@ impl Config {
                 .reduce(f64::min)
             {
                 let half_period = 180.0 / min;
-                check(
+                p.check(
                     e.average_s >= half_period,
                     "experiment.average_s",
                     e.average_s,
-                    &format!(
+                    format!(
                         "must cover at least half a modulation period of the slowest rate ({min} deg/s: {half_period} s)"
                     ),
-                )?;
+                );
             }
         }
         match (e.rate_table, e.kind) {
             (RateTable::Constant, _) => {
-                if e.table_freq_hz.is_some() {
-                    return Err(ConfigError::key(
+                if let Some(ft) = e.table_freq_hz {
+                    p.push(ConfigError::key(
                         "experiment.table_freq_hz",
-                        e.table_freq_hz.unwrap_or_default(),
+                        ft,
                         "only applies with rate_table = \"sinusoid\"",
                     ));
                 }
             }
-            (RateTable::Sinusoid, ExperimentKind::Rotating) => {
-                return Err(ConfigError::key(
-                    "experiment.rate_table",
-                    "\"sinusoid\"",
-                    "a rate table applies to kind = \"coriolis\" only",
-                ))
-            }
-            (RateTable::Sinusoid, ExperimentKind::Coriolis) => {
-                let Some(ft) = e.table_freq_hz else {
-                    return Err(ConfigError::key(
-                        "experiment.table_freq_hz",
-                        "(missing)",
-                        "is required with rate_table = \"sinusoid\"",
-                    ));
-                };
-                check(
-                    ft.is_finite() && ft > 0.0 && ft < cutoff_hz,
+            (RateTable::Sinusoid, ExperimentKind::Rotating) => p.push(ConfigError::key(
+                "experiment.rate_table",
+                "\"sinusoid\"",
+                "a rate table applies to kind = \"coriolis\" only",
+            )),
+            (RateTable::Sinusoid, ExperimentKind::Coriolis) => match e.table_freq_hz {
+                None => p.push(ConfigError::key(
                     "experiment.table_freq_hz",
-                    ft,
-                    &format!(
-                        "must be > 0 and below board.lpf_cutoff_hz = {} Hz",
-                        cutoff_hz
-                    ),
-                )?;
-                check(
-                    e.average_s * ft >= 1.0,
-                    "experiment.average_s",
-                    e.average_s,
-                    &format!("must cover at least one rate-table period ({} s)", 1.0 / ft),
-                )?;
-            }
+                    "(missing)",
+                    "is required with rate_table = \"sinusoid\"",
+                )),
+                Some(ft) => {
+                    let key = "experiment.table_freq_hz";
+                    if p.clean(&["board.lpf_cutoff_hz"]) {
+                        p.check(
+                            ft.is_finite() && ft > 0.0 && ft < cutoff_hz,
+                            key,
+                            ft,
+                            format!(
+                                "must be > 0 and below board.lpf_cutoff_hz = {} Hz",
+                                cutoff_hz
+                            ),
+                        );
+                    } else {
+                        p.positive(key, ft);
+                    }
+                    if p.clean(&[key]) {
+                        p.check(
+                            e.average_s * ft >= 1.0,
+                            "experiment.average_s",
+                            e.average_s,
+                            format!("must cover at least one rate-table period ({} s)", 1.0 / ft),
+                        );
+                    }
+                }
+            },
         }
         if e.window == WindowKind::Hann {
             let slowest_hz = match self.shape() {
@@ -285,61 +344,86 @@ impl Config {
                 }
             }
         }
-        self.validate_noise_adc_selfcal(&mut warnings)?;
-        self.validate_regime(&mut warnings)?;
-        if let Some(dump) = self.dump_resolved() {
-            let (rate_dps, start_s, duration_s) = (
-                dump.rate_dps.unwrap_or(f64::NAN),
-                dump.start_s.unwrap_or(f64::NAN),
-                dump.duration_s.unwrap_or(f64::NAN),
-            );
-            let nodes = dump.nodes.unwrap_or_default();
+    }
+
+    /// The dump's rules. Its window is weighed against the point's run only when the rest of
+    /// the config is valid (the run's length depends on nearly every key), and a window key
+    /// derived from the run is judged only then.
+    fn validate_dump(&self, p: &mut Rules) {
+        let (Some(given), Some(dump)) = (&self.dump, self.dump_resolved()) else {
+            return;
+        };
+        let upstream_ok = p.is_empty();
+        let (rate_dps, start_s, duration_s) = (
+            dump.rate_dps.unwrap_or(f64::NAN),
+            dump.start_s.unwrap_or(f64::NAN),
+            dump.duration_s.unwrap_or(f64::NAN),
+        );
+        // A key is the user's own unless it equals what the dump's defaults derive.
+        let derived = |clear: &dyn Fn(&mut crate::config::DumpConfig)| {
+            let mut raw = self.clone();
+            let mut d = given.clone();
+            clear(&mut d);
+            raw.dump = Some(d);
+            raw.dump_resolved().unwrap_or(dump.clone())
+        };
+        let own = |v: f64, derived: Option<f64>| !derived.is_some_and(|d| same(v, d));
+        let own_start = own(start_s, derived(&|d| d.start_s = None).start_s);
+        let own_duration = own(duration_s, derived(&|d| d.duration_s = None).duration_s);
+        if p.clean(&["experiment.rates_dps"]) {
             let emulated = self.emulated_rates_dps();
-            check(
+            p.check(
                 emulated.contains(&rate_dps),
                 "dump.rate_dps",
                 rate_dps,
-                &format!("must be one of the emulated rates {emulated:?}"),
-            )?;
-            non_negative("dump.start_s", start_s)?;
-            positive("dump.duration_s", duration_s)?;
+                format!("must be one of the emulated rates {emulated:?}"),
+            );
+        }
+        if own_start || upstream_ok {
+            p.non_negative("dump.start_s", start_s);
+        }
+        if own_duration || upstream_ok {
+            p.positive("dump.duration_s", duration_s);
+        }
+        if upstream_ok && p.is_empty() {
             // The point runs settling plus its own averaging window (whole half periods).
-            let p = self.plan_point(rate_dps);
+            let pt = self.plan_point(rate_dps);
             let n_out = self
                 .n_settle_out()
-                .saturating_add(p.n_avg())
+                .saturating_add(pt.n_avg())
                 .saturating_add(1);
             let total = n_out as f64 / self.fs_out_hz();
-            check(
+            p.check(
                 start_s + duration_s <= total,
                 "dump.duration_s",
                 duration_s,
-                &format!(
+                format!(
                     "the window start_s + duration_s must end within that point's run ({total} s)"
                 ),
-            )?;
-            let frames = duration_s * fs_hz;
-            check(
-                frames <= 5e7,
+            );
+        }
+        if p.clean(&["board.fs_hz"]) {
+            p.check(
+                duration_s * self.fs_hz() <= 5e7,
                 "dump.duration_s",
                 duration_s,
                 "the window must hold at most 5e7 full-rate samples (keep dumps small)",
-            )?;
-            check(
-                !nodes.is_empty(),
-                "dump.nodes",
-                "[]",
-                "must list at least one node",
-            )?;
-            for (i, n) in nodes.iter().enumerate() {
-                check(
-                    DUMP_NODES.contains(&n.as_str()),
-                    &format!("dump.nodes[{i}]"),
-                    format!("\"{n}\""),
-                    &format!("must be one of {DUMP_NODES:?}"),
-                )?;
-            }
+            );
         }
-        Ok(warnings)
+        let nodes = dump.nodes.unwrap_or_default();
+        p.check(
+            !nodes.is_empty(),
+            "dump.nodes",
+            "[]",
+            "must list at least one node",
+        );
+        for (i, n) in nodes.iter().enumerate() {
+            p.check(
+                DUMP_NODES.contains(&n.as_str()),
+                &format!("dump.nodes[{i}]"),
+                format!("\"{n}\""),
+                format!("must be one of {DUMP_NODES:?}"),
+            );
+        }
     }
 }

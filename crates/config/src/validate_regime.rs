@@ -4,8 +4,8 @@
 //! more than a stated amount. Each names the key to change.
 
 use crate::config::Config;
-use crate::parse::ConfigError;
-use crate::validate::check;
+use crate::error::ConfigError;
+use crate::rules::Rules;
 use gyroemu_board::Shape;
 use gyroemu_theory::DrivenDevice;
 
@@ -38,21 +38,27 @@ fn node_amplitudes(c: &Config, k: usize) -> [f64; 5] {
 }
 
 impl Config {
-    /// The regime rules; appends warnings, returns the first error.
-    pub(crate) fn validate_regime(&self, warnings: &mut Vec<String>) -> Result<(), ConfigError> {
-        self.resonator_params().validate().map_err(|e| {
+    /// The regime rules, for a config whose keys are each valid; appends warnings. An
+    /// unstable plant or a node out of range stops them (the rest would weigh a chain that
+    /// cannot run).
+    pub(crate) fn validate_regime(&self, p: &mut Rules, warnings: &mut Vec<String>) {
+        if let Err(e) = self.resonator_params().validate() {
             let key = match e.param {
                 "quadrature_coupling_rad2_s2" => "device.quadrature_coupling_rad2_s2",
                 "mode2.f0_hz" => "device.mode2_f0_offset_hz",
                 "mode2.q" => "device.q_mode2",
                 _ => "device",
             };
-            ConfigError::key(key, e.value, e.rule)
-        })?;
-        self.validate_node_range()?;
-        self.validate_converters(warnings)?;
+            p.push(ConfigError::key(key, e.value, e.rule));
+            return;
+        }
+        if let Err(e) = self.validate_node_range() {
+            p.push(e);
+            return;
+        }
+        self.validate_converters(p, warnings);
         self.validate_table_harmonics(warnings);
-        self.validate_hold(warnings)
+        self.validate_hold(p, warnings);
     }
 
     /// A rate table whose swing has more harmonics than the board demodulates: the read-out
@@ -84,6 +90,7 @@ impl Config {
         ));
     }
 
+    /// The first node out of range (one knob to turn), if any.
     fn validate_node_range(&self) -> Result<(), ConfigError> {
         const NODES: [(&str, &str); 5] = [
             ("drive", "m/s^2"),
@@ -111,7 +118,7 @@ impl Config {
                     _ => ("board.tia_gain_ohm", self.board.tia_gain_ohm),
                 };
                 let what = if amp > hi {
-                    "overflow (products of two values would leave f64's range)"
+                    "overflow (products of two values would leave the range of double-precision numbers, about 1e308)"
                 } else {
                     "underflow (subnormal arithmetic, many times slower, rounds the signal away)"
                 };
@@ -128,7 +135,7 @@ impl Config {
         Ok(())
     }
 
-    fn validate_converters(&self, warnings: &mut Vec<String>) -> Result<(), ConfigError> {
+    fn validate_converters(&self, p: &mut Rules, warnings: &mut Vec<String>) {
         let b = &self.board;
         let lsb = |bits: u32, full_scale: f64| full_scale / (1u64 << (bits - 1)) as f64;
         for k in 0..2 {
@@ -136,14 +143,14 @@ impl Config {
             let drive_key = ["drive.f1", "drive.f2"][k];
             if let Some(bits) = b.dac_bits {
                 let step = lsb(bits, b.dac_full_scale);
-                check(
+                p.check(
                     a[0] >= 0.5 * step,
                     drive_key,
                     a[0],
-                    &format!(
+                    format!(
                         "is below half an LSB of the DAC ({step:e} = board.dac_full_scale / 2^(board.dac_bits - 1)): every drive sample would be 0; raise it or board.dac_bits, or lower board.dac_full_scale"
                     ),
-                )?;
+                );
                 if a[0] > b.dac_full_scale - 0.5 * step {
                     warnings.push(format!(
                         "{drive_key} = {} exceeds the DAC's range (board.dac_full_scale = {}): the drive's peaks will clip; raise board.dac_full_scale",
@@ -155,17 +162,16 @@ impl Config {
             if let Some(bits) = b.adc_bits {
                 let step = lsb(bits, b.adc_full_scale_v);
                 // The amplitude is an estimate at resonance: refuse only a clearly dead ADC.
-                if tia_out < 0.125 * step && self.noise.is_none() {
-                    return Err(ConfigError::key(
-                        "board.adc_bits",
-                        bits,
-                        format!(
-                            "the TIA output of mode {} (about {tia_out:e} V) is far below half an LSB of the ADC ({:e} V): every sample would read 0; raise board.tia_gain_ohm or board.adc_bits, or lower board.adc_full_scale_v",
-                            k + 1,
-                            0.5 * step
-                        ),
-                    ));
-                }
+                p.check(
+                    !(tia_out < 0.125 * step && self.noise.is_none()),
+                    "board.adc_bits",
+                    bits,
+                    format!(
+                        "the TIA output of mode {} (about {tia_out:e} V) is far below half an LSB of the ADC ({:e} V): every sample would read 0; raise board.tia_gain_ohm or board.adc_bits, or lower board.adc_full_scale_v",
+                        k + 1,
+                        0.5 * step
+                    ),
+                );
                 if tia_out < 0.5 * step {
                     warnings.push(format!(
                         "the TIA output of mode {} (about {tia_out:e} V) is below half an LSB of the ADC ({:e} V): the signal survives only as dither of the noise",
@@ -190,13 +196,12 @@ impl Config {
                 }
             }
         }
-        Ok(())
     }
 
     /// The DAC holds each drive sample for a period: the measured phase departs from the
     /// continuous-drive theory by what the exact held-drive steady state says. Stated when it
     /// matters, refused when the hold's images dominate.
-    fn validate_hold(&self, warnings: &mut Vec<String>) -> Result<(), ConfigError> {
+    fn validate_hold(&self, p: &mut Rules, warnings: &mut Vec<String>) {
         let dev = DrivenDevice {
             plant: self.resonator_params(),
             drive: [self.drive.f1, self.f2()],
@@ -226,20 +231,19 @@ impl Config {
             }
         }
         let per_period = self.fs_hz() / self.device.f0_hz;
-        check(
+        p.check(
             worst <= MAX_HOLD_ERROR_MDEG,
             "board.fs_hz",
             self.fs_hz(),
-            &format!(
+            format!(
                 "at {per_period:.2} samples per carrier period the DAC's zero-order hold moves the measured phase by up to {worst:.3e} mdeg from the continuous-drive theory (its images beside the carrier dominate); raise fs_hz (16 samples per period keeps it near 0.01 mdeg)"
             ),
-        )?;
+        );
         if worst > WARN_HOLD_ERROR_MDEG {
             warnings.push(format!(
                 "board.fs_hz = {} ({per_period:.2} samples per carrier period): the DAC's zero-order hold moves the measured phase by up to {worst:.3e} mdeg from the continuous-drive theory at these rates (the exact held-drive steady state); raise fs_hz to shrink it",
                 self.fs_hz()
             ));
         }
-        Ok(())
     }
 }

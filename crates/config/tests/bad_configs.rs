@@ -1,6 +1,8 @@
 //! Malformed configs, each one edit away from a valid preset: parsing or validation refuses
 //! it with a message that names the key, shows the bad value, states the rule, and (for a
 //! TOML error) gives the line and column; the soft rules validate with a warning instead.
+//! One edit is one problem (no follow-on errors); a file with several problems gets them all
+//! in one message; no message speaks Rust (`usize`, `f64`, ...).
 
 use gyroemu_config::presets::preset_text;
 use gyroemu_config::{parse_config, ConfigError};
@@ -12,9 +14,9 @@ const T: &str = "m2tfg-ratetable";
 /// How the edited config must fail.
 #[derive(Debug)]
 enum Expect {
-    /// TOML/serde refuses it at this 1-based line.
+    /// Parsing refuses it at this 1-based line.
     ParseAt(usize),
-    /// TOML/serde refuses it where no single line is to blame (e.g. a missing table).
+    /// Parsing refuses it where no line is to blame (a missing section): no location.
     Parse,
     /// It parses, `validate()` refuses it.
     Invalid,
@@ -27,7 +29,16 @@ struct Case {
     what: &'static str,
     text: String,
     expect: Expect,
+    /// The first needle is the (first) problem's key, exactly (unless it has none).
     needles: Vec<&'static str>,
+    /// How many problems the message lists (one edit: one problem).
+    problems: usize,
+}
+
+impl Case {
+    fn problems(self, problems: usize) -> Self {
+        Self { problems, ..self }
+    }
 }
 
 fn base(name: &str) -> String {
@@ -102,6 +113,17 @@ fn remove(text: &str, section: &str, key: &str) -> String {
     lines.join("\n") + "\n"
 }
 
+/// The 1-based line of the header `[section]`.
+fn header_line(text: &str, section: &str) -> usize {
+    let lines: Vec<&str> = text.lines().collect();
+    section_range(&lines, section).expect("section").0 + 1
+}
+
+/// `text` without `key` of `[section]`, refused at the section's header.
+fn missing(text: &str, section: &str, key: &str) -> (String, usize) {
+    (remove(text, section, key), header_line(text, section))
+}
+
 /// Removes the whole `[section]`.
 fn remove_section(text: &str, section: &str) -> String {
     let lines: Vec<&str> = text.lines().collect();
@@ -124,6 +146,7 @@ fn parse_case(what: &'static str, (text, line): (String, usize), needles: &[&'st
         text,
         expect: Expect::ParseAt(line),
         needles: needles.to_vec(),
+        problems: 1,
     }
 }
 
@@ -133,6 +156,7 @@ fn case(what: &'static str, text: String, expect: Expect, needles: &[&'static st
         text,
         expect,
         needles: needles.to_vec(),
+        problems: 1,
     }
 }
 
@@ -169,40 +193,57 @@ fn cases() -> Vec<Case> {
             rename(&c, "device", "f0_hz", "f0_hzz"),
             &[
                 "device.f0_hzz",
-                "unknown field",
+                "unknown key",
+                "did you mean `f0_hz`?",
                 "expected one of",
-                "`f0_hz`",
+                "`quadrature_coupling_rad2_s2`",
             ],
         ),
         parse_case(
             "unknown drive key",
             set(&c, "drive", "f3", "1.0"),
-            &["drive.f3", "unknown field", "expected `f1` or `f2`"],
+            &["drive.f3", "unknown key", "expected `f1` or `f2`"],
         ),
         parse_case(
             "misspelt board key",
             rename(&c, "board", "decimation", "decimaton"),
-            &["board.decimaton", "unknown field", "`decimation`"],
+            &[
+                "board.decimaton",
+                "unknown key",
+                "did you mean `decimation`?",
+            ],
         ),
         parse_case(
             "unknown experiment key",
             set(&c, "experiment", "average", "2.0"),
-            &["experiment.average", "unknown field", "`average_s`"],
+            &[
+                "experiment.average",
+                "unknown key",
+                "did you mean `average_s`?",
+            ],
         ),
         parse_case(
             "misspelt noise key",
             set(&noise, "noise", "temprature_k", "300.0"),
-            &["noise.temprature_k", "unknown field", "`temperature_k`"],
+            &[
+                "noise.temprature_k",
+                "unknown key",
+                "did you mean `temperature_k`?",
+            ],
         ),
         parse_case(
             "misspelt selfcal key",
             set(&selfcal, "selfcal", "tau_max", "10.0"),
-            &["selfcal.tau_max", "unknown field", "`tau_max_s`"],
+            &[
+                "selfcal.tau_max",
+                "unknown key",
+                "did you mean `tau_max_s`?",
+            ],
         ),
         parse_case(
             "unknown dump key",
             set(&dumped, "dump", "window_s", "1.0"),
-            &["dump.window_s", "unknown field", "`duration_s`"],
+            &["dump.window_s", "unknown key", "`duration_s`"],
         ),
         parse_case(
             "unknown section",
@@ -211,73 +252,102 @@ fn cases() -> Vec<Case> {
                 let (t, line) = set(&c, "devices", "f0_hz", "1.0");
                 (t, line - 1)
             },
-            &["devices", "unknown field", "`device`"],
+            &[
+                "devices",
+                "unknown key",
+                "did you mean `device`?",
+                "`experiment`",
+            ],
         ),
         // Wrong types.
         parse_case(
             "string for a number",
             set(&c, "device", "q", "\"high\""),
-            &["device.q", "\"high\"", "expected f64"],
+            &["device.q", "= \"high\"", "expected a number"],
         ),
         parse_case(
             "float for an integer",
             set(&c, "board", "decimation", "100.5"),
-            &["board.decimation", "100.5", "usize"],
+            &[
+                "board.decimation",
+                "= 100.5",
+                "expected a non-negative integer",
+            ],
         ),
         parse_case(
             "negative for usize",
             set(&c, "board", "lpf_order", "-4"),
-            &["board.lpf_order", "-4", "usize"],
+            &["board.lpf_order", "= -4", "expected a non-negative integer"],
         ),
         parse_case(
             "negative seed",
             set(&noise, "noise", "seed", "-1"),
-            &["noise.seed", "-1", "u64"],
+            &["noise.seed", "= -1", "expected a non-negative integer"],
         ),
         parse_case(
             "integer for a bool",
             set(&c, "board", "tia_inverting", "1"),
-            &["board.tia_inverting", "1", "bool"],
+            &["board.tia_inverting", "= 1", "expected true or false"],
         ),
         parse_case(
             "number for a list",
             set(&c, "experiment", "rates_dps", "25.0"),
-            &["experiment.rates_dps", "25", "sequence"],
+            &[
+                "experiment.rates_dps",
+                "= 25.0",
+                "expected a list of numbers",
+            ],
         ),
         parse_case(
             "string in the rate list",
             set(&c, "experiment", "rates_dps", "[25.0, \"x\"]"),
-            &["experiment.rates_dps", "\"x\"", "f64"],
+            &["experiment.rates_dps[1]", "= \"x\"", "expected a number"],
         ),
         parse_case(
             "unknown kind",
             set(&c, "experiment", "kind", "\"spinning\""),
-            &["experiment.kind", "spinning", "`coriolis`", "`rotating`"],
+            &[
+                "experiment.kind",
+                "= \"spinning\"",
+                "expected \"coriolis\" or \"rotating\"",
+            ],
         ),
         parse_case(
             "unknown rate table",
             set(&c, "experiment", "rate_table", "\"triangle\""),
             &[
                 "experiment.rate_table",
-                "triangle",
-                "`constant`",
-                "`sinusoid`",
+                "= \"triangle\"",
+                "expected \"constant\" or \"sinusoid\"",
             ],
         ),
         parse_case(
             "unknown window",
             set(&c, "experiment", "window", "\"flat\""),
-            &["experiment.window", "flat", "`boxcar`", "`hann`"],
+            &[
+                "experiment.window",
+                "= \"flat\"",
+                "expected \"boxcar\" or \"hann\"",
+            ],
         ),
         parse_case(
             "negative dac_bits",
             set(&c, "board", "dac_bits", "-1"),
-            &["board.dac_bits", "-1", "u32"],
+            &[
+                "board.dac_bits",
+                "= -1",
+                "expected an integer from 0 to 4294967295",
+            ],
         ),
         parse_case(
             "float adc_bits",
             set(&c, "board", "adc_bits", "16.0"),
-            &["board.adc_bits", "16", "u32"],
+            &[
+                "board.adc_bits",
+                "= 16.0",
+                "expected an integer from 0 to 4294967295",
+                "write 16 without a decimal point",
+            ],
         ),
         parse_case(
             "TOML syntax: no value",
@@ -285,48 +355,89 @@ fn cases() -> Vec<Case> {
             &["device.q"],
         ),
         // Missing required keys and tables.
-        case(
+        parse_case(
             "missing f0_hz",
-            remove(&c, "device", "f0_hz"),
-            Parse,
-            &["device.f0_hz", "missing field `f0_hz`"],
+            missing(&c, "device", "f0_hz"),
+            &["device.f0_hz", "is missing", "[device] requires it"],
         ),
-        case(
+        parse_case(
             "missing angular_gain",
-            remove(&c, "device", "angular_gain"),
-            Parse,
-            &["device.angular_gain", "missing field `angular_gain`"],
+            missing(&c, "device", "angular_gain"),
+            &["device.angular_gain", "is missing", "[device] requires it"],
         ),
-        case(
+        parse_case(
             "missing f1",
-            remove(&c, "drive", "f1"),
-            Parse,
-            &["drive.f1", "missing field `f1`"],
+            missing(&c, "drive", "f1"),
+            &["drive.f1", "is missing", "[drive] requires it"],
         ),
-        case(
+        parse_case(
             "missing rates",
-            remove(&c, "experiment", "rates_dps"),
-            Parse,
-            &["experiment.rates_dps", "missing field `rates_dps`"],
+            missing(&c, "experiment", "rates_dps"),
+            &[
+                "experiment.rates_dps",
+                "is missing",
+                "[experiment] requires it",
+            ],
         ),
+        parse_case(
+            "missing kind",
+            missing(&c, "experiment", "kind"),
+            &["experiment.kind", "is missing", "[experiment] requires it"],
+        ),
+        parse_case(
+            "missing average_s",
+            missing(&c, "experiment", "average_s"),
+            &[
+                "experiment.average_s",
+                "is missing",
+                "[experiment] requires it",
+            ],
+        ),
+        // A missing section is named as itself (not as a key of the section above it), with
+        // the keys it must hold.
         case(
             "missing [drive]",
             remove_section(&c, "drive"),
             Parse,
-            &["drive", "missing field `drive`"],
+            &["drive", "the section [drive] (with f1)"],
         ),
         case(
-            "missing average_s",
-            remove(&c, "experiment", "average_s"),
+            "missing [device] (the first section)",
+            remove_section(&c, "device"),
             Parse,
-            &["experiment.average_s", "missing field `average_s`"],
+            &[
+                "device",
+                "the section [device] (with f0_hz, q, angular_gain)",
+            ],
+        ),
+        case(
+            "missing [experiment]",
+            remove_section(&c, "experiment"),
+            Parse,
+            &[
+                "experiment",
+                "the section [experiment] (with kind, rates_dps, average_s)",
+            ],
+        ),
+        case(
+            "missing [drive] in a file that starts with [device]",
+            remove_section(&strip_comments(&c), "drive"),
+            Parse,
+            &["drive", "the section [drive]"],
         ),
         case(
             "only a comment",
             "# nothing here\n".into(),
             Parse,
-            &["missing field `device`"],
-        ),
+            &[
+                "device",
+                "[device]",
+                "[drive]",
+                "[experiment]",
+                "3 problems",
+            ],
+        )
+        .problems(3),
         case("empty file", String::new(), Invalid, &["empty"]),
         case("blank file", " \n\t\n".into(), Invalid, &["empty"]),
         // nan, inf and -inf (TOML accepts them).
@@ -851,14 +962,57 @@ fn cases() -> Vec<Case> {
                 "1e299",
             ),
             &["experiment.settle_s", "1e300", "2^53"],
-        ),
+        )
+        // The dump's own window is also far too long, whatever the run.
+        .problems(2),
     ]
+}
+
+/// `text` without comment lines and blank lines (it then starts with its first header).
+fn strip_comments(text: &str) -> String {
+    text.lines()
+        .filter(|l| !l.trim_start().starts_with('#') && !l.trim().is_empty())
+        .map(|l| l.split(" #").next().unwrap_or(l).trim_end())
+        .collect::<Vec<_>>()
+        .join("\n")
+        + "\n"
 }
 
 fn check_needles(what: &str, msg: &str, needles: &[&str]) -> Result<(), String> {
     match needles.iter().find(|n| !msg.contains(*n)) {
         Some(n) => Err(format!("{what}: `{n}` missing from: {msg}")),
         None => Ok(()),
+    }
+}
+
+/// The refusal of `text`: by parsing, or else by validation.
+fn refusal(text: &str) -> Option<ConfigError> {
+    match parse_config(text) {
+        Err(e) => Some(e),
+        Ok(cfg) => cfg.validate().err(),
+    }
+}
+
+/// The error names the case's key (its first needle) first, and lists as many problems as
+/// the case expects, each with a key.
+fn check_key_and_count(case: &Case, e: &ConfigError) -> Result<(), String> {
+    let what = case.what;
+    let n = e.problems().len();
+    if n != case.problems {
+        return Err(format!(
+            "{what}: {n} problems, expected {}: {e}",
+            case.problems
+        ));
+    }
+    match &e.key {
+        Some(k) if k != case.needles[0] => Err(format!(
+            "{what}: key `{k}`, expected `{}`: {e}",
+            case.needles[0]
+        )),
+        Some(_) if e.problems().iter().any(|p| p.key.is_none()) => {
+            Err(format!("{what}: a problem without a key: {e}"))
+        }
+        _ => Ok(()),
     }
 }
 
@@ -869,6 +1023,7 @@ fn check_case(case: &Case) -> Result<(), String> {
         text,
         expect,
         needles,
+        ..
     } = case;
     match expect {
         Expect::ParseAt(_) | Expect::Parse => {
@@ -876,30 +1031,26 @@ fn check_case(case: &Case) -> Result<(), String> {
                 .err()
                 .ok_or_else(|| format!("{what}: parsed"))?;
             let msg = e.to_string();
-            let loc = e.location.as_deref().unwrap_or("");
-            if !(loc.starts_with("line ") && loc.contains(", column ")) {
-                return Err(format!("{what}: no line and column: {msg}"));
-            }
-            if let Expect::ParseAt(line) = expect {
-                if !loc.starts_with(&format!("line {line}, ")) {
-                    return Err(format!("{what}: expected line {line}: {msg}"));
-                }
-            }
             eprintln!("{what}: {msg}");
+            match (expect, e.location.as_deref()) {
+                (Expect::ParseAt(line), Some(loc)) => {
+                    if !(loc.starts_with(&format!("line {line}, column "))) {
+                        return Err(format!("{what}: expected line {line}: {msg}"));
+                    }
+                }
+                (Expect::Parse, None) => {}
+                _ => return Err(format!("{what}: wrong location: {msg}")),
+            }
             if e.key.is_none() {
                 return Err(format!("{what}: no key in {msg}"));
             }
+            check_key_and_count(case, &e)?;
             check_needles(what, &msg, needles)
         }
         Expect::Invalid => {
-            let e = match parse_config(text) {
-                Err(e) => e,
-                Ok(cfg) => cfg
-                    .validate()
-                    .err()
-                    .ok_or_else(|| format!("{what}: validated"))?,
-            };
+            let e = refusal(text).ok_or_else(|| format!("{what}: validated"))?;
             eprintln!("{what}: {e}");
+            check_key_and_count(case, &e)?;
             check_needles(what, &e.to_string(), needles)
         }
         Expect::Warning => {
@@ -968,4 +1119,214 @@ fn the_unedited_presets_and_the_edit_helpers_are_sound() {
     }
     let dumped = parse_config(&with(base(C), DUMP)).unwrap();
     assert!(dumped.validate().is_ok());
+}
+
+/// The Rust words serde would use, none of which a user should have to read.
+const RUST_WORDS: [&str; 20] = [
+    "usize", "isize", "u8", "u16", "u32", "u64", "u128", "i8", "i16", "i32", "i64", "i128", "f32",
+    "f64", "sequence", "boolean", "floating", "variant", "struct", "field",
+];
+
+/// The Rust words in `msg` (whole words: `f0_hz` is not `f0`).
+fn rust_words(msg: &str) -> Vec<&'static str> {
+    let words: Vec<&str> = msg
+        .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .collect();
+    RUST_WORDS
+        .into_iter()
+        .filter(|w| words.contains(w))
+        .collect()
+}
+
+#[test]
+fn no_message_names_a_rust_type() {
+    assert_eq!(rust_words("expected usize, not f0_hz or u64x"), ["usize"]);
+    let mut checked = 0;
+    for case in cases() {
+        let msgs = match refusal(&case.text) {
+            Some(e) => vec![e.to_string()],
+            None => parse_config(&case.text).unwrap().validate().unwrap(),
+        };
+        for m in msgs {
+            assert!(rust_words(&m).is_empty(), "{}: {m}", case.what);
+            checked += 1;
+        }
+    }
+    assert!(checked >= 100, "{checked}");
+    // Every key of every section, set to values of every wrong kind.
+    let full = with(
+        with(base(T), DUMP),
+        "\n[noise]\nseed = 1\n\n[selfcal]\ntau_max_s = 10.0\n",
+    );
+    let values = [
+        "\"text\"",
+        "\"1.0\"",
+        "-1",
+        "2.5",
+        "1e400",
+        "99999999999999999999",
+        "4294967296",
+        "true",
+        "[1.0, \"x\"]",
+        "[\"tia\", 3]",
+        "{ a = 1 }",
+        "1979-05-27",
+    ];
+    let doc: toml::Table = full.parse().unwrap();
+    let mut refused = 0;
+    for (section, table) in &doc {
+        for key in table.as_table().unwrap().keys() {
+            for v in values {
+                let (text, line) = set(&full, section, key, v);
+                let Err(e) = parse_config(&text) else {
+                    continue;
+                };
+                let msg = e.to_string();
+                assert!(rust_words(&msg).is_empty(), "{section}.{key} = {v}: {msg}");
+                assert!(
+                    e.key
+                        .as_deref()
+                        .is_some_and(|k| k.starts_with(&format!("{section}.{key}"))),
+                    "{section}.{key} = {v}: {msg}"
+                );
+                assert!(
+                    msg.contains(&format!("line {line}, column ")),
+                    "{section}.{key} = {v}: {msg}"
+                );
+                refused += 1;
+            }
+        }
+    }
+    assert!(refused >= 150, "{refused}");
+}
+
+/// The keys of an error's problems, in order.
+fn keys(e: &ConfigError) -> Vec<String> {
+    e.problems()
+        .into_iter()
+        .map(|p| p.key.unwrap_or_default())
+        .collect()
+}
+
+#[test]
+fn a_file_with_several_bad_keys_gets_every_one_in_one_message() {
+    // Parsing: a wrong type, a misspelt key, a missing key and a negative count, in four
+    // sections; each is its own line with the key, the value and the rule, in file order.
+    let c = base(C);
+    let (t, l_q) = set(&c, "device", "q", "\"high\"");
+    let (t, l_f3) = set(&t, "drive", "f3", "1.0");
+    let (t, l_order) = set(&t, "board", "lpf_order", "-4");
+    let l_exp = header_line(&t, "experiment");
+    let t = remove(&t, "experiment", "average_s");
+    let e = parse_config(&t).unwrap_err();
+    assert_eq!(
+        keys(&e),
+        [
+            "device.q",
+            "drive.f3",
+            "board.lpf_order",
+            "experiment.average_s"
+        ]
+    );
+    let lines: Vec<usize> = e
+        .problems()
+        .iter()
+        .map(|p| {
+            let loc = p.location.as_deref().unwrap();
+            loc["line ".len()..loc.find(',').unwrap()].parse().unwrap()
+        })
+        .collect();
+    assert_eq!(lines, [l_q, l_f3, l_order, l_exp]);
+    let msg = e.to_string();
+    let body: Vec<&str> = msg.lines().collect();
+    assert_eq!(body[0], "config error: 4 problems:", "{msg}");
+    for (line, needles) in body[1..].iter().zip([
+        &["device.q", "= \"high\"", "expected a number"][..],
+        &["drive.f3", "unknown key", "expected `f1` or `f2`"],
+        &["board.lpf_order", "= -4", "a non-negative integer"],
+        &["experiment.average_s", "is missing"],
+    ]) {
+        check_needles("several parse problems", line, needles).unwrap();
+    }
+
+    // Validation: three independent bad values, each reported with key, value and rule.
+    let t = set(&c, "device", "q", "-5.0").0;
+    let t = set(&t, "board", "tia_gain_ohm", "0.0").0;
+    let t = set(&t, "experiment", "average_s", "0.0").0;
+    let t = set(&t, "board", "dac_bits", "40").0;
+    let e = parse_config(&t).unwrap().validate().unwrap_err();
+    assert_eq!(
+        keys(&e),
+        [
+            "device.q",
+            "board.tia_gain_ohm",
+            "board.dac_bits",
+            "experiment.average_s"
+        ]
+    );
+    let msg = e.to_string();
+    for needles in [
+        &["key `device.q` = -5: ", "> 0"][..],
+        &["key `board.tia_gain_ohm` = 0: ", "> 0"],
+        &["key `board.dac_bits` = 40: ", "2 to 32"],
+        &["key `experiment.average_s` = 0: ", "> 0"],
+    ] {
+        check_needles("several invalid values", &msg, needles).unwrap();
+    }
+    assert_eq!(msg.lines().count(), 5, "{msg}");
+}
+
+#[test]
+fn a_bad_value_brings_no_follow_on_errors_through_derived_keys() {
+    // f0 = 0 with the sample rate, cutoff and decimation left to their defaults (derived from
+    // f0): only f0 is reported, not the rate, cutoff or decimation computed from it; a bad
+    // F1 is not repeated as the F2 derived from it.
+    let mut t = strip_comments(&base(C));
+    for key in ["fs_hz", "lpf_cutoff_hz", "decimation", "tia_pole_hz"] {
+        t = remove(&t, "board", key);
+    }
+    let t = remove(&t, "drive", "f2");
+    let cfg = parse_config(&t).unwrap();
+    assert!(cfg.validate().is_ok());
+    let t0 = set(&t, "device", "f0_hz", "0.0").0;
+    let e = parse_config(&t0).unwrap().validate().unwrap_err();
+    assert_eq!(keys(&e), ["device.f0_hz"], "{e}");
+    let t1 = set(&t, "drive", "f1", "-1.0").0;
+    let e = parse_config(&t1).unwrap().validate().unwrap_err();
+    assert_eq!(keys(&e), ["drive.f1"], "{e}");
+    // An F2 the user set is judged on its own.
+    let t2 = set(&t1, "drive", "f2", "-2.0").0;
+    let e = parse_config(&t2).unwrap().validate().unwrap_err();
+    assert_eq!(keys(&e), ["drive.f1", "drive.f2"], "{e}");
+}
+
+#[test]
+fn validation_problems_are_located_in_the_text_that_set_them() {
+    let c = base(C);
+    let (t, l_avg) = set(&c, "experiment", "average_s", "0.0");
+    let (t, l_q) = set(&t, "device", "q", "-5.0");
+    let (t, l_rate) = set(&t, "experiment", "rates_dps", "[25.0, nan]");
+    let e = parse_config(&t).unwrap().validate().unwrap_err();
+    assert!(e.problems().iter().all(|p| p.location.is_none()));
+    let located = e.with_locations(&t);
+    // In the order of the text, each at its value (the NaN is the list's second item).
+    let rate_col = 1 + t.lines().nth(l_rate - 1).unwrap().find("nan").unwrap();
+    let want = [
+        ("device.q", format!("line {l_q}, column 5")),
+        (
+            "experiment.rates_dps[1]",
+            format!("line {l_rate}, column {rate_col}"),
+        ),
+        ("experiment.average_s", format!("line {l_avg}, column 13")),
+    ];
+    let got: Vec<(String, String)> = located
+        .problems()
+        .into_iter()
+        .map(|p| (p.key.unwrap(), p.location.unwrap()))
+        .collect();
+    let want: Vec<(String, String)> = want
+        .iter()
+        .map(|(k, l)| (k.to_string(), l.clone()))
+        .collect();
+    assert_eq!(got, want);
 }

@@ -53,7 +53,9 @@ pub(crate) fn sections(
                 STAGE,
                 param,
                 value,
-                format!("{why} at fs_hz = {fs_hz} (too close to 0 or to fs/2 for f64)"),
+                format!(
+                    "{why} at fs_hz = {fs_hz} (too close to 0 or to fs/2 for double precision)"
+                ),
             )
         })?;
     }
@@ -85,7 +87,7 @@ fn realisable(c: &Coefs, margin: f64) -> Result<(), String> {
     let a_at_minus_1 = 1.0 - c.a1 + c.a2;
     if !(1.0 - c.a2.abs() > margin && a_at_1 > margin && a_at_minus_1 > margin) {
         return Err(format!(
-            "a pole is not safely inside the unit circle in f64 (|pole| = {}, stability sums 1 +- a1 + a2 = {a_at_1:e}, {a_at_minus_1:e} must exceed the rounding {margin:e})",
+            "a pole is not safely inside the unit circle in double precision (|pole| = {}, stability sums 1 +- a1 + a2 = {a_at_1:e}, {a_at_minus_1:e} must exceed the rounding {margin:e})",
             pole_radius(c.a1, c.a2)
         ));
     }

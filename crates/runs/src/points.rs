@@ -264,7 +264,10 @@ pub fn scan_points(out: &Path) -> Result<PointScan, String> {
     for p in paths {
         let parsed = std::fs::read_to_string(&p)
             .map_err(|e| e.to_string())
-            .and_then(|t| serde_json::from_str::<PointFile>(&t).map_err(|e| e.to_string()))
+            .and_then(|t| {
+                serde_json::from_str::<PointFile>(&t)
+                    .map_err(|e| gyroemu_config::plain_words(&e.to_string()))
+            })
             .and_then(|f| {
                 if f.format == POINT_FORMAT {
                     Ok(f)

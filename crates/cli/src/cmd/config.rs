@@ -1,6 +1,6 @@
 //! `gyroemu config [--preset NAME] [--list]`.
 
-use crate::input::{print_out, BadInput};
+use crate::input::{print_out, refused, BadInput};
 use anyhow::Result;
 use gyroemu_config::parse_config_explained;
 use gyroemu_config::presets::{preset_text, PRESETS};
@@ -13,9 +13,7 @@ pub fn resolved_command(path: &Path) -> Result<()> {
         .map_err(|e| BadInput(format!("cannot read config `{}`: {e}", path.display())))?;
     let (cfg, derived) =
         parse_config_explained(&text).map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
-    let warnings = cfg
-        .validate()
-        .map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    let warnings = cfg.validate().map_err(|e| refused(path, &text, e))?;
     let mut out = format!(
         "# {} with every key filled in (gyroemu config --resolved).\n",
         path.display()

@@ -1,6 +1,6 @@
 //! `gyroemu selfcal CONFIG --out DIR`.
 
-use crate::input::{list_written, load_config, BadInput};
+use crate::input::{list_written, read_config, refused, BadInput};
 use crate::progress::Terminal;
 use anyhow::Result;
 use gyroemu_analysis::selfcal::validate_selfcal;
@@ -13,11 +13,11 @@ use std::path::Path;
 /// The scale factor from the rotating excitation alone, checked against the virtual rate
 /// table on the same board, plus the analyses the config asks for.
 pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
-    let cfg = load_config(config)?;
-    // load_config printed the config's own warnings; these are the derived sweeps' extra ones.
-    let warnings =
-        validate_selfcal(&cfg).map_err(|e| BadInput(format!("{}: {e}", config.display())))?;
-    for w in &warnings {
+    let (cfg, text) = read_config(config)?;
+    // The config's own rules and selfcal's (its derived sweeps) in one refusal.
+    let extra = validate_selfcal(&cfg).map_err(|e| refused(config, &text, e))?;
+    let own = cfg.validate().map_err(|e| refused(config, &text, e))?;
+    for w in own.iter().chain(&extra) {
         eprintln!("warning: {}: {w}", config.display());
     }
     let work = selfcal_work(&cfg);

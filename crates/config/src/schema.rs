@@ -1,0 +1,229 @@
+//! The keys each section of a config takes, what kind of value each holds and which are
+//! required: the TOML is checked against this before it is deserialised, so a file's unknown,
+//! missing and wrong-typed keys are all reported at once, in the user's words. The tests hold
+//! it to the serde structs of `config.rs` (same keys, same required ones, same values
+//! accepted).
+
+/// What a key's value must be.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Kind {
+    /// A number: a float, or an integer within the 64-bit range.
+    Number,
+    /// An integer from 0 to `max`.
+    Count { max: u64 },
+    /// `true` or `false`.
+    Bool,
+    /// A list of numbers.
+    Numbers,
+    /// A list of strings.
+    Names,
+    /// A string (an item of `Names`).
+    Text,
+    /// One of these strings.
+    Choice(&'static [&'static str]),
+}
+
+/// One key of a section.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Field {
+    pub name: &'static str,
+    pub kind: Kind,
+    pub required: bool,
+}
+
+/// One `[section]` of the config.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Section {
+    pub name: &'static str,
+    pub required: bool,
+    pub fields: &'static [Field],
+}
+
+const fn req(name: &'static str, kind: Kind) -> Field {
+    Field {
+        name,
+        kind,
+        required: true,
+    }
+}
+
+const fn opt(name: &'static str, kind: Kind) -> Field {
+    Field {
+        name,
+        kind,
+        required: false,
+    }
+}
+
+use Kind::*;
+
+/// Any non-negative integer a `usize` or `u64` key holds.
+const COUNT: Kind = Count {
+    max: usize::MAX as u64,
+};
+/// A `u32` key (converter bits).
+const BITS: Kind = Count {
+    max: u32::MAX as u64,
+};
+const SEED: Kind = Count { max: u64::MAX };
+
+/// Every section, in the order the user guide documents them.
+pub(crate) const SECTIONS: &[Section] = &[
+    Section {
+        name: "device",
+        required: true,
+        fields: &[
+            req("f0_hz", Number),
+            req("q", Number),
+            req("angular_gain", Number),
+            opt("mode2_f0_offset_hz", Number),
+            opt("q_mode2", Number),
+            opt("quadrature_coupling_rad2_s2", Number),
+            opt("transduction_a_s_per_m", Number),
+        ],
+    },
+    Section {
+        name: "drive",
+        required: true,
+        fields: &[req("f1", Number), opt("f2", Number)],
+    },
+    Section {
+        name: "board",
+        required: false,
+        fields: &[
+            opt("fs_hz", Number),
+            opt("tia_gain_ohm", Number),
+            opt("tia_pole_hz", Number),
+            opt("tia_inverting", Bool),
+            opt("tia_rail_v", Number),
+            opt("lpf_order", COUNT),
+            opt("lpf_cutoff_hz", Number),
+            opt("decimation", COUNT),
+            opt("dac_bits", BITS),
+            opt("dac_full_scale", Number),
+            opt("phase_shifter_error_deg", Number),
+            opt("adc_bits", BITS),
+            opt("adc_full_scale_v", Number),
+        ],
+    },
+    Section {
+        name: "experiment",
+        required: true,
+        fields: &[
+            req("kind", Choice(&["coriolis", "rotating"])),
+            req("rates_dps", Numbers),
+            opt("settle_s", Number),
+            req("average_s", Number),
+            opt("window", Choice(&["boxcar", "hann"])),
+            opt("rate_table", Choice(&["constant", "sinusoid"])),
+            opt("table_freq_hz", Number),
+        ],
+    },
+    Section {
+        name: "dump",
+        required: false,
+        fields: &[
+            opt("rate_dps", Number),
+            opt("start_s", Number),
+            opt("duration_s", Number),
+            opt("nodes", Names),
+        ],
+    },
+    Section {
+        name: "noise",
+        required: false,
+        fields: &[
+            opt("seed", SEED),
+            opt("temperature_k", Number),
+            opt("effective_mass_kg", Number),
+            opt("tia_current_noise_a_per_rthz", Number),
+            opt("tia_voltage_noise_v_per_rthz", Number),
+        ],
+    },
+    Section {
+        name: "selfcal",
+        required: false,
+        fields: &[
+            opt("allan_record_s", Number),
+            opt("tau_max_s", Number),
+            opt("drift_delta_t_k", Numbers),
+            opt("f0_tc_ppm_per_k", Number),
+            opt("q_tc_ppm_per_k", Number),
+        ],
+    },
+];
+
+/// `` `a` ``, `` `a` or `b` ``, `` one of `a`, `b`, `c` `` (what follows "expected").
+pub(crate) fn one_of(names: &[&str], quote: &str) -> String {
+    let q: Vec<String> = names.iter().map(|n| format!("{quote}{n}{quote}")).collect();
+    match q.as_slice() {
+        [a] => a.clone(),
+        [a, b] => format!("{a} or {b}"),
+        _ => format!("one of {}", q.join(", ")),
+    }
+}
+
+/// The known name closest to a misspelt one (two edits at most, or one a prefix of the
+/// other), to suggest.
+pub(crate) fn closest<'a>(name: &str, known: &[&'a str]) -> Option<&'a str> {
+    known
+        .iter()
+        .map(|k| {
+            let d = if k.starts_with(name) || name.starts_with(k) {
+                1
+            } else {
+                edit_distance(name, k)
+            };
+            (d, *k)
+        })
+        .filter(|&(d, _)| d <= 2)
+        .min_by_key(|&(d, _)| d)
+        .map(|(_, k)| k)
+}
+
+/// Levenshtein distance (insertions, deletions, substitutions), by characters.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diag = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let next = (diag + usize::from(ca != cb))
+                .min(row[j] + 1)
+                .min(row[j + 1] + 1);
+            diag = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn edit_distance_is_levenshtein() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("f0_hzz", "f0_hz"), 1);
+        assert_eq!(edit_distance("temprature_k", "temperature_k"), 1);
+        assert_eq!(
+            closest("decimaton", &["decimation", "lpf_order"]),
+            Some("decimation")
+        );
+        assert_eq!(
+            closest("average", &["average_s", "kind"]),
+            Some("average_s")
+        );
+        assert_eq!(closest("xyz", &["f1", "f2"]), None);
+    }
+
+    #[test]
+    fn lists_read_as_english() {
+        assert_eq!(one_of(&["f1"], "`"), "`f1`");
+        assert_eq!(one_of(&["f1", "f2"], "`"), "`f1` or `f2`");
+        assert_eq!(one_of(&["a", "b", "c"], "\""), "one of \"a\", \"b\", \"c\"");
+    }
+}
