@@ -36,6 +36,14 @@ pub enum SweepError {
 /// The file stem of a sweep's signal dump in its output folder (see [`Probe::write`]).
 pub const DUMP_STEM: &str = "dump";
 
+/// The index (in `emulated_rates_dps`) of the point the config's `[dump]` records, if any.
+pub fn dump_point(cfg: &Config) -> Option<usize> {
+    let d = cfg.dump_resolved()?;
+    let rate = d.rate_dps.unwrap_or(f64::NAN);
+    let rates = cfg.emulated_rates_dps();
+    Some(rates.iter().position(|&r| r == rate).unwrap_or(0))
+}
+
 /// Runs the whole sweep and reads it out. `dump_dir` receives the probe's files when the
 /// config asks for a dump.
 pub fn run_sweep(
@@ -142,8 +150,7 @@ pub fn run_sweep_with(
     let total: u64 = groups.iter().map(|g| samples_of(g)).sum();
     let done = AtomicU64::new(0);
     let dump = cfg.dump_resolved().map(|d| {
-        let rate = d.rate_dps.unwrap_or(f64::NAN);
-        let idx = rates.iter().position(|&r| r == rate).unwrap_or(0);
+        let idx = dump_point(cfg).unwrap_or(0);
         let nodes = d.nodes.clone().unwrap_or_default();
         let window = (d.start_s.unwrap_or(0.0), d.duration_s.unwrap_or(0.0));
         (idx, nodes, window)

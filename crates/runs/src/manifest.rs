@@ -27,7 +27,7 @@ pub struct ShardId {
 pub struct Manifest {
     /// [`MANIFEST_FORMAT`].
     pub format: String,
-    /// `running`, `interrupted` or `complete`.
+    /// `running`, `interrupted`, `failed` or `complete`.
     pub status: String,
     /// SHA-256 of the canonical config TOML.
     pub config_sha256: String,
@@ -73,6 +73,17 @@ impl Manifest {
             gyroemu_version: env!("CARGO_PKG_VERSION").to_string(),
             config_toml: config_toml.to_string(),
         }
+    }
+
+    /// Points `done` (of this manifest's) are saved.
+    pub fn mark_done(&mut self, done: &[usize]) {
+        self.points_missing.retain(|i| !done.contains(i));
+        for &i in done {
+            if self.points.contains(&i) && !self.points_done.contains(&i) {
+                self.points_done.push(i);
+            }
+        }
+        self.points_done.sort_unstable();
     }
 
     /// Writes the manifest atomically.
