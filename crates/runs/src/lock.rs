@@ -12,6 +12,7 @@
 
 use crate::abort;
 use crate::error::RunError;
+use crate::manifest::files_like;
 use gyroemu_experiment::Reporter;
 use serde::{Deserialize, Serialize};
 use std::io::{ErrorKind, Write};
@@ -134,17 +135,7 @@ fn conflicting(out: &Path, scope: LockScope) -> Result<Vec<PathBuf>, RunError> {
     if let LockScope::Shard { .. } = scope {
         return Ok(vec![out.join(LOCK_FILE)]);
     }
-    let mut v: Vec<PathBuf> = std::fs::read_dir(out)
-        .map_err(RunError::io(format!("cannot read `{}`", out.display())))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .is_some_and(|n| n.starts_with("gyroemu-shard-") && n.ends_with(".lock"))
-        })
-        .collect();
-    v.sort();
-    Ok(v)
+    files_like(out, "gyroemu-shard-", ".lock")
 }
 
 fn refusal(out: &Path, lock: &Path, holder: &LockInfo) -> RunError {

@@ -108,13 +108,18 @@ pub fn read_manifest(path: &Path) -> Result<Manifest, String> {
 
 /// The shard manifests `shard-I-of-N.json` in `dir`, sorted by name.
 pub fn shard_manifest_paths(dir: &Path) -> Result<Vec<PathBuf>, RunError> {
+    files_like(dir, "shard-", ".json")
+}
+
+/// The files in `dir` whose names start with `prefix` and end with `suffix`, sorted.
+pub(crate) fn files_like(dir: &Path, prefix: &str, suffix: &str) -> Result<Vec<PathBuf>, RunError> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(RunError::io(format!("cannot read `{}`", dir.display())))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| {
             p.file_name()
                 .map(|n| n.to_string_lossy().into_owned())
-                .is_some_and(|n| n.starts_with("shard-") && n.ends_with(".json"))
+                .is_some_and(|n| n.starts_with(prefix) && n.ends_with(suffix))
         })
         .collect();
     v.sort();
