@@ -232,8 +232,9 @@ impl<S: Sample> Board<S> {
     }
 
     /// A flag that, once raised, makes a run stop at its next progress report (every 65 536
-    /// input samples or so) and return at once: its averages are then meaningless, so the
-    /// caller must test the flag after the run and discard them (Ctrl-C of a sweep).
+    /// input samples or so) and return at once: only the lanes whose window had ended are
+    /// then marked [`RunOutput::complete`]; the others' averages are meaningless (Ctrl-C of
+    /// a sweep).
     pub fn set_cancel(&mut self, flag: Arc<AtomicBool>) {
         self.cancel = Some(flag);
     }

@@ -124,6 +124,8 @@ impl<S: Sample> Board<S> {
             })
             .collect();
         let mut counts = Counters::<S>::default();
+        // The decimated sample a cancel stopped the run at (its block not averaged).
+        let mut stopped_at = None;
         for k in 0..n_out {
             let n0 = k * m;
             // The recording path only for blocks that touch the dump window.
@@ -158,6 +160,7 @@ impl<S: Sample> Board<S> {
                     .as_ref()
                     .is_some_and(|c| c.load(Ordering::Relaxed))
                 {
+                    stopped_at = Some(k);
                     break;
                 }
             }
@@ -226,6 +229,13 @@ impl<S: Sample> Board<S> {
             }
         }
         progress(n_out * m);
+        // A lane is complete when its window (and its counts) ended before the stop: every
+        // later sample has weight zero, and adding 0 leaves a compensated sum's value as it
+        // is, so the lane holds the bits an uninterrupted run returns.
+        let complete = lane_end
+            .iter()
+            .map(|&e| stopped_at.is_none_or(|k| e <= k))
+            .collect();
         Ok(RunOutput {
             lanes: (0..lanes)
                 .map(|i| LaneResult {
@@ -235,6 +245,7 @@ impl<S: Sample> Board<S> {
                 .collect(),
             early_reads: early,
             series,
+            complete,
         })
     }
 

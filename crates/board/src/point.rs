@@ -70,4 +70,8 @@ pub struct RunOutput {
     /// Per lane: the series rows (Coriolis: I1, Q1, I2, Q2 of the low-passed stage-1 outputs;
     /// rotating: C and S of both modes as in [`LaneResult`], 8 values).
     pub series: Vec<Vec<[f64; 8]>>,
+    /// Per lane: its window ended before the run stopped (always, unless a cancel flag
+    /// stopped it), so its entry of `lanes` is the point's final result; the other lanes'
+    /// entries are meaningless.
+    pub complete: Vec<bool>,
 }

@@ -242,7 +242,16 @@ impl Probe {
         self.decimated.record(k, &frame[..n]);
     }
 
-    /// Writes `<stem>_fullrate.{csv,wav}` and `<stem>_decimated.{csv,wav}` into `dir`.
+    /// The names of every file [`Probe::write`] may write for `stem` (to clear a folder of
+    /// an earlier dump).
+    pub fn file_names(stem: &str) -> Vec<String> {
+        ["fullrate", "decimated"]
+            .iter()
+            .flat_map(|r| SignalRecorder::file_names(&format!("{stem}_{r}")))
+            .collect()
+    }
+
+    /// Writes `<stem>_fullrate.*` and `<stem>_decimated.*` (CSV, WAV, SigMF) into `dir`.
     pub fn write(&self, dir: &Path, stem: &str) -> Result<(), IoError> {
         if !self.full.names().is_empty() {
             self.full.write(dir, &format!("{stem}_fullrate"))?;

@@ -47,6 +47,20 @@ pub fn print_out(text: &str) -> Result<()> {
     }
 }
 
+/// This process's command line, for the output folder's lock (arguments with spaces quoted).
+pub fn command_line() -> String {
+    std::env::args()
+        .map(|a| {
+            if a.contains(char::is_whitespace) || a.is_empty() {
+                format!("'{a}'")
+            } else {
+                a
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// Lists the files a command wrote, one per line on stderr, relative to `out` where inside it.
 pub fn list_written(out: &Path, files: &[std::path::PathBuf]) {
     eprintln!("wrote {} files in `{}`:", files.len(), out.display());

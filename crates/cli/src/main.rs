@@ -110,7 +110,7 @@ pub const EXIT_BAD_INPUT: u8 = 2;
 fn exit_code(e: &anyhow::Error) -> u8 {
     use gyroemu_runs::RunError;
     match e.downcast_ref::<RunError>() {
-        Some(RunError::BadInput(_)) => return EXIT_BAD_INPUT,
+        Some(RunError::BadInput(_) | RunError::Locked(_)) => return EXIT_BAD_INPUT,
         Some(RunError::Interrupted(_)) => return signals::EXIT_INTERRUPTED,
         _ => {}
     }

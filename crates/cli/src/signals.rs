@@ -1,5 +1,7 @@
-//! Ctrl-C (SIGINT) and SIGTERM from a scheduler: the first raises the flag a run stops on
-//! after saving its finished points; a second exits at once (files being written are
+//! Ctrl-C (SIGINT) and SIGTERM from a scheduler. For `run`, the first raises the flag a run
+//! stops on after saving its finished points; a second exits at once. Other commands, and
+//! any second signal, exit at once after marking the manifest of a run in progress
+//! `interrupted` and removing this process's folder locks (files being written are
 //! temporaries, never left under their final names).
 
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -10,24 +12,30 @@ pub const EXIT_INTERRUPTED: u8 = 130;
 
 static CANCEL: OnceLock<Arc<AtomicBool>> = OnceLock::new();
 
-/// The flag raised by Ctrl-C or SIGTERM; the handler is installed on first call.
-pub fn cancel_flag() -> Arc<AtomicBool> {
+/// Installs the handler (first call only): `graceful`, the first signal raises the returned
+/// flag (a run stops on it); otherwise every signal exits at once.
+pub fn install(graceful: bool) -> Arc<AtomicBool> {
     CANCEL
         .get_or_init(|| {
             let flag = Arc::new(AtomicBool::new(false));
             let f = flag.clone();
             let installed = ctrlc::set_handler(move || {
-                if f.swap(true, Ordering::SeqCst) {
-                    eprintln!("\ninterrupted again: exiting now");
-                    std::process::exit(EXIT_INTERRUPTED.into());
+                if graceful && !f.swap(true, Ordering::SeqCst) {
+                    eprintln!(
+                        "\ninterrupt: saving the finished points and stopping \
+                         (Ctrl-C again to quit at once)"
+                    );
+                    return;
                 }
-                eprintln!(
-                    "\ninterrupt: saving the finished points and stopping \
-                     (Ctrl-C again to quit at once)"
-                );
+                let marked = gyroemu_runs::abort_now();
+                for m in &marked {
+                    eprintln!("\ninterrupted: `{}` marked interrupted", m.display());
+                }
+                eprintln!("\ninterrupted: exiting now");
+                std::process::exit(EXIT_INTERRUPTED.into());
             });
             if let Err(e) = installed {
-                eprintln!("warning: Ctrl-C will not save progress: {e}");
+                eprintln!("warning: Ctrl-C will not save progress nor release the lock: {e}");
             }
             flag
         })

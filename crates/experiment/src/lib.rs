@@ -13,6 +13,7 @@ pub mod work;
 pub use progress::{Progress, Quiet, Reporter, Task};
 pub use readout::{post_process, theory_deg, Compensation, PointResult, SweepResult};
 pub use sweep::{
-    finish_sweep, run_sweep, run_sweep_with, OnGroup, SweepError, SweepOptions, SweepRun,
+    dump_point, finish_sweep, run_sweep, run_sweep_with, OnGroup, SweepError, SweepOptions,
+    SweepRun, DUMP_STEM,
 };
 pub use work::{sweep_work, Work, MAX_POINT_SAMPLES};

@@ -33,6 +33,17 @@ pub enum SweepError {
     Missing(Vec<usize>),
 }
 
+/// The file stem of a sweep's signal dump in its output folder (see [`Probe::write`]).
+pub const DUMP_STEM: &str = "dump";
+
+/// The index (in `emulated_rates_dps`) of the point the config's `[dump]` records, if any.
+pub fn dump_point(cfg: &Config) -> Option<usize> {
+    let d = cfg.dump_resolved()?;
+    let rate = d.rate_dps.unwrap_or(f64::NAN);
+    let rates = cfg.emulated_rates_dps();
+    Some(rates.iter().position(|&r| r == rate).unwrap_or(0))
+}
+
 /// Runs the whole sweep and reads it out. `dump_dir` receives the probe's files when the
 /// config asks for a dump.
 pub fn run_sweep(
@@ -45,8 +56,9 @@ pub fn run_sweep(
 }
 
 /// Called from the worker threads with each finished lane group's points, `(index in
-/// emulated_rates_dps, lane result)`, after the group's dump (if any) is written. An error
-/// stops the sweep (groups not started are skipped) and is returned.
+/// emulated_rates_dps, lane result)`, after the group's dump (if any) is written, and with
+/// the finished points of a group a cancel stopped. An error stops the sweep (groups not
+/// started are skipped) and is returned.
 pub type OnGroup<'a> = &'a (dyn Fn(&[(usize, LaneResult)]) -> Result<(), String> + Sync);
 
 /// What [`run_sweep_with`] runs and what it does with the points it finishes.
@@ -57,7 +69,8 @@ pub struct SweepOptions<'a> {
     /// The point indices this run is responsible for (a shard); `None`: all.
     pub only: Option<Vec<usize>>,
     /// Raised (Ctrl-C): groups not started are skipped, running ones stop within about
-    /// 65 536 samples, and the points of every group that did not finish are left out.
+    /// 65 536 samples; of a stopped group, the points whose own window had ended are kept
+    /// (and passed to `on_group`), the others are left out.
     pub cancel: Option<Arc<AtomicBool>>,
     /// Receives each finished group (e.g. to write its point files).
     pub on_group: Option<OnGroup<'a>>,
@@ -137,8 +150,7 @@ pub fn run_sweep_with(
     let total: u64 = groups.iter().map(|g| samples_of(g)).sum();
     let done = AtomicU64::new(0);
     let dump = cfg.dump_resolved().map(|d| {
-        let rate = d.rate_dps.unwrap_or(f64::NAN);
-        let idx = rates.iter().position(|&r| r == rate).unwrap_or(0);
+        let idx = dump_point(cfg).unwrap_or(0);
         let nodes = d.nodes.clone().unwrap_or_default();
         let window = (d.start_s.unwrap_or(0.0), d.duration_s.unwrap_or(0.0));
         (idx, nodes, window)
@@ -161,7 +173,8 @@ pub fn run_sweep_with(
         board.set_cancel(stop.clone());
         boards.push(board);
     }
-    type Outcome = Option<Result<(Vec<(usize, LaneResult)>, u64), SweepError>>;
+    // Per group: skipped (None), or its points with their work and whether all finished.
+    type Outcome = Option<Result<(Vec<(usize, LaneResult)>, u64, bool), SweepError>>;
     let outcomes: Vec<Outcome> = boards
         .into_par_iter()
         .zip(groups.par_iter())
@@ -177,14 +190,15 @@ pub fn run_sweep_with(
                 .as_ref()
                 .and_then(|(idx, nodes, (start_s, duration_s))| {
                     g.iter().position(|i| i == idx).map(|lane| {
-                        Probe::new(
+                        let p = Probe::new(
                             nodes,
                             cfg.fs_hz(),
                             cfg.decimation(),
                             *start_s,
                             *duration_s,
                             lane,
-                        )
+                        );
+                        (lane, p)
                     })
                 });
             let last = AtomicU64::new(0);
@@ -195,25 +209,42 @@ pub fn run_sweep_with(
                 }
             };
             let run_opts = RunOptions {
-                probe: probe.as_mut(),
+                probe: probe.as_mut().map(|(_, p)| p),
                 ..Default::default()
             };
             let res = board.run(n_settle, &points, run_opts, &report);
-            // A raised flag may have cut the run short: its averages are not the point's.
-            if stop.load(Ordering::Relaxed) {
-                return None;
-            }
             let finished = (|| {
-                let lanes = res?.lanes;
-                if let (Some(p), Some(dir)) = (probe, dump_dir) {
-                    p.write(dir, "dump")
-                        .map_err(|e| SweepError::Output(e.to_string()))?;
+                let out = res?;
+                // A raised flag may have cut the run short: only the lanes whose own window
+                // ended before it hold their points' results. The dumped lane waits for a
+                // whole run, which writes its dump.
+                let whole = out.complete.iter().all(|&c| c);
+                let pts: Vec<(usize, LaneResult)> = g
+                    .iter()
+                    .copied()
+                    .zip(out.lanes)
+                    .zip(&out.complete)
+                    .enumerate()
+                    .filter(|(lane, (_, &c))| {
+                        whole || (c && probe.as_ref().is_none_or(|(l, _)| l != lane))
+                    })
+                    .map(|(_, (p, _))| p)
+                    .collect();
+                if whole {
+                    if let (Some((_, p)), Some(dir)) = (probe, dump_dir) {
+                        p.write(dir, DUMP_STEM)
+                            .map_err(|e| SweepError::Output(e.to_string()))?;
+                    }
                 }
-                let pts: Vec<(usize, LaneResult)> = g.iter().copied().zip(lanes).collect();
-                if let Some(f) = opts.on_group {
+                if let (Some(f), false) = (opts.on_group, pts.is_empty()) {
                     f(&pts).map_err(SweepError::Output)?;
                 }
-                Ok((pts, samples_of(g) * g.len() as u64))
+                let work = if whole {
+                    samples_of(g) * g.len() as u64
+                } else {
+                    0
+                };
+                Ok((pts, work, whole))
             })();
             if finished.is_err() {
                 stop.store(true, Ordering::Relaxed);
@@ -234,7 +265,8 @@ pub fn run_sweep_with(
             Some(Err(e)) => {
                 first_err.get_or_insert(e);
             }
-            Some(Ok((pts, work))) => {
+            Some(Ok((pts, work, whole))) => {
+                run.cancelled |= !whole;
                 run.point_samples += work;
                 for (i, lane) in pts {
                     run.computed.push(i);
@@ -334,6 +366,63 @@ mod resume_tests {
         s.sort_unstable();
         assert_eq!(s, (0..n).collect::<Vec<_>>());
         assert_eq!(finish_sweep(&cfg, &rest.lanes).unwrap(), whole);
+    }
+
+    #[test]
+    fn a_cancel_keeps_the_points_whose_window_ended_with_their_bits() {
+        // One lane group of rotating points, windows of 0.6 to 1.03 s (whole half periods).
+        let mut cfg = small();
+        cfg.experiment.kind = gyroemu_config::ExperimentKind::Rotating;
+        cfg.experiment.rates_dps = vec![200.0, 250.0, 300.0, 350.0];
+        cfg.experiment.average_s = 1.1;
+        let whole = run_sweep_with(&cfg, &|_, _| {}, None, SweepOptions::default()).unwrap();
+        let m = cfg.decimation() as u64;
+        let ends: Vec<u64> = cfg
+            .emulated_rates_dps()
+            .iter()
+            .map(|&r| (cfg.n_settle_out() + cfg.plan_point(r).window.samples()) * m)
+            .collect();
+        // Stop once the shortest window has ended (a report comes every 65 536 samples).
+        let at = ends.iter().min().unwrap() + 1000;
+        assert!(at + 65_536 < *ends.iter().max().unwrap());
+        let cancel = Arc::new(AtomicBool::new(false));
+        let stopped_at = AtomicU64::new(0);
+        let progress = |done: u64, _: u64| {
+            if done >= at && !cancel.swap(true, Ordering::SeqCst) {
+                stopped_at.store(done, Ordering::SeqCst);
+            }
+        };
+        let seen = Mutex::new(Vec::new());
+        let on_group = |pts: &[(usize, LaneResult)]| {
+            seen.lock().unwrap().extend_from_slice(pts);
+            Ok(())
+        };
+        let cut = run_sweep_with(
+            &cfg,
+            &progress,
+            None,
+            SweepOptions {
+                cancel: Some(cancel.clone()),
+                on_group: Some(&on_group),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(cut.cancelled);
+        // The stop's block is not averaged: a window ending by its start is complete.
+        let stop = stopped_at.load(Ordering::SeqCst) - m;
+        let expect: Vec<usize> = (0..ends.len()).filter(|&i| ends[i] <= stop).collect();
+        assert!(
+            !expect.is_empty() && expect.len() < ends.len(),
+            "{expect:?}"
+        );
+        assert_eq!(cut.computed, expect);
+        let seen = seen.into_inner().unwrap();
+        assert_eq!(seen.iter().map(|p| p.0).collect::<Vec<_>>(), expect);
+        for (i, lane) in seen {
+            assert_eq!(lane, whole.lanes[&i], "point {i}");
+            assert_eq!(cut.lanes[&i], whole.lanes[&i]);
+        }
     }
 
     #[test]

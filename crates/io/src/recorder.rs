@@ -105,6 +105,11 @@ impl SignalRecorder {
         self.data.iter().skip(k).step_by(ch).copied().collect()
     }
 
+    /// The names of every file [`SignalRecorder::write`] writes for `stem`.
+    pub fn file_names(stem: &str) -> [String; 4] {
+        ["csv", "wav", "sigmf-data", "sigmf-meta"].map(|e| format!("{stem}.{e}"))
+    }
+
     /// Writes, each atomically:
     /// - `<dir>/<stem>.csv` (columns `sample`, `time_s`, then one per name; exact float text);
     /// - `<dir>/<stem>.wav` (one 32-bit float channel per name at round(fs_hz) Hz). WAV values

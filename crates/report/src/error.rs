@@ -24,6 +24,14 @@ pub enum ReportError {
     /// non-finite read-out): the outputs are written with those values null, and this says why.
     #[error("{0}")]
     Unreliable(String),
+    /// Deleting a stale file failed.
+    #[error("cannot delete `{path}`: {source}")]
+    Remove {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
     /// Creating a folder failed.
     #[error("cannot create `{path}`: {source}")]
     Dir {

@@ -10,5 +10,5 @@ pub mod sweep_report;
 
 pub use error::{check_problems, ReportError};
 pub use reproduce::{plan_reproduce, reproduce, ReproducePlan};
-pub use selfcal_report::write_selfcal;
+pub use selfcal_report::{write_selfcal, SelfcalFiles, SELFCAL_ANALYSIS_FILES};
 pub use sweep_report::{health_json, run_title, write_run, RUN_FILES};

@@ -13,8 +13,50 @@ use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
-/// Writes the self-calibration's files into `out`; returns their paths.
+/// The files of the analyses, each written only when its analysis runs.
+pub const SELFCAL_ANALYSIS_FILES: [&str; 6] = [
+    "allan.csv",
+    "allan.png",
+    "error_vs_tau.csv",
+    "error_vs_tau.png",
+    "drift.csv",
+    "drift.png",
+];
+
+/// What [`write_selfcal`] did in the output folder.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SelfcalFiles {
+    /// The files written.
+    pub written: Vec<PathBuf>,
+    /// Analysis files of an earlier run that this one did not write, deleted so that none
+    /// sits beside a `selfcal.json` saying its analysis did not run.
+    pub removed: Vec<PathBuf>,
+}
+
+/// Writes the self-calibration's files into `out`, then deletes the analysis files of an
+/// earlier run that this one did not write.
 pub fn write_selfcal(
+    out: &Path,
+    cfg: &Config,
+    report: &SelfcalReport,
+) -> Result<SelfcalFiles, ReportError> {
+    let written = write_selfcal_files(out, cfg, report)?;
+    let mut removed = Vec::new();
+    for name in SELFCAL_ANALYSIS_FILES {
+        let p = out.join(name);
+        if written.contains(&p) || !p.exists() {
+            continue;
+        }
+        std::fs::remove_file(&p).map_err(|source| ReportError::Remove {
+            path: p.clone(),
+            source,
+        })?;
+        removed.push(p);
+    }
+    Ok(SelfcalFiles { written, removed })
+}
+
+fn write_selfcal_files(
     out: &Path,
     cfg: &Config,
     report: &SelfcalReport,

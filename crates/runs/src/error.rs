@@ -10,6 +10,10 @@ pub enum RunError {
     /// with shards missing): fix the input; nothing was computed.
     #[error("{0}")]
     BadInput(String),
+    /// Another live process holds the output folder's lock (named in the message): wait or
+    /// choose another folder; nothing was written.
+    #[error("{0}")]
+    Locked(String),
     /// Stopped by Ctrl-C or SIGTERM after saving the finished points: rerun to resume.
     #[error("{0}")]
     Interrupted(String),
@@ -20,6 +24,14 @@ pub enum RunError {
     /// ([`ReportError::Unreliable`]: written as null, the run exits non-zero).
     #[error(transparent)]
     Report(#[from] ReportError),
+    /// A failure (`cause`) after which the manifest could not be updated either: it still
+    /// says `running`.
+    #[error("{cause}; the manifest `{}` could not be updated either ({why}): it still says `running`", manifest.display())]
+    Unrecorded {
+        cause: Box<RunError>,
+        manifest: std::path::PathBuf,
+        why: String,
+    },
     /// A file of the output folder could not be read, written or removed.
     #[error("{context}: {source}")]
     Io {

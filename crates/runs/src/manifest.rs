@@ -27,7 +27,7 @@ pub struct ShardId {
 pub struct Manifest {
     /// [`MANIFEST_FORMAT`].
     pub format: String,
-    /// `running`, `interrupted` or `complete`.
+    /// `running`, `interrupted`, `failed` or `complete`.
     pub status: String,
     /// SHA-256 of the canonical config TOML.
     pub config_sha256: String,
@@ -75,6 +75,17 @@ impl Manifest {
         }
     }
 
+    /// Points `done` (of this manifest's) are saved.
+    pub fn mark_done(&mut self, done: &[usize]) {
+        self.points_missing.retain(|i| !done.contains(i));
+        for &i in done {
+            if self.points.contains(&i) && !self.points_done.contains(&i) {
+                self.points_done.push(i);
+            }
+        }
+        self.points_done.sort_unstable();
+    }
+
     /// Writes the manifest atomically.
     pub fn write(&self, path: &Path) -> Result<(), RunError> {
         gyroemu_io::write_json(path, self)
@@ -98,13 +109,18 @@ pub fn read_manifest(path: &Path) -> Result<Manifest, String> {
 
 /// The shard manifests `shard-I-of-N.json` in `dir`, sorted by name.
 pub fn shard_manifest_paths(dir: &Path) -> Result<Vec<PathBuf>, RunError> {
+    files_like(dir, "shard-", ".json")
+}
+
+/// The files in `dir` whose names start with `prefix` and end with `suffix`, sorted.
+pub(crate) fn files_like(dir: &Path, prefix: &str, suffix: &str) -> Result<Vec<PathBuf>, RunError> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(RunError::io(format!("cannot read `{}`", dir.display())))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| {
             p.file_name()
                 .map(|n| n.to_string_lossy().into_owned())
-                .is_some_and(|n| n.starts_with("shard-") && n.ends_with(".json"))
+                .is_some_and(|n| n.starts_with(prefix) && n.ends_with(suffix))
         })
         .collect();
     v.sort();

@@ -3,6 +3,7 @@
 //! cover every operating point exactly once, and every point's file must be there; then the
 //! results are built from the point files exactly as a one-machine run builds them.
 
+use crate::config_diff::{config_diff, describe_diff};
 use crate::error::RunError;
 use crate::manifest::{read_manifest, shard_manifest_paths, Manifest, RUN_MANIFEST};
 use crate::points::{config_hash, scan_points, PointFile, POINTS_DIR};
@@ -66,9 +67,16 @@ pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunErr
             )));
         }
         if m.config_sha256 != hash {
+            let differs = parse_config(&m.config_toml)
+                .ok()
+                .and_then(|c| config_diff(&first.config_toml, &c).ok())
+                .filter(|d| !d.is_empty())
+                .map_or(String::new(), |d| {
+                    format!("; they differ in {}", describe_diff(&d, 12))
+                });
             return Err(bad(format!(
-                "`{name}` ran another config than `{first_name}` (config sha256 {} vs {}): every \
-                 shard must run the same config",
+                "`{name}` ran another config than `{first_name}` (config sha256 {} vs \
+                 {}){differs}: every shard must run the same config",
                 &m.config_sha256[..m.config_sha256.len().min(12)],
                 &hash[..hash.len().min(12)]
             )));
@@ -173,11 +181,29 @@ pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunErr
         )));
     }
     let r = finish_sweep(&cfg, &lanes)?;
-    let mut files = write_run(dir, &cfg, &r, &run_title(&cfg))?;
     let all: Vec<usize> = (0..n).collect();
     let mut m = Manifest::new("complete", &hash, &first.config_toml, None, n, &all, &lanes);
-    m.next = format!("merged from {count} shards");
     let path = dir.join(RUN_MANIFEST);
+    let mut files = match write_run(dir, &cfg, &r, &run_title(&cfg)) {
+        Ok(f) => f,
+        Err(e) => {
+            // The run manifest says the merge failed and why (the shards' stay as they are).
+            m.status = "failed".into();
+            m.next = format!(
+                "fix the cause ({e}) and rerun gyroemu merge {}",
+                dir.display()
+            );
+            return Err(match m.write(&path) {
+                Ok(()) => e.into(),
+                Err(w) => RunError::Unrecorded {
+                    cause: Box::new(e.into()),
+                    manifest: path,
+                    why: w.to_string(),
+                },
+            });
+        }
+    };
+    m.next = format!("merged from {count} shards");
     m.write(&path)?;
     files.push(path);
     reporter.note(&format!("merged {count} shards ({n} points)"));

@@ -25,9 +25,23 @@ pub fn canonical_toml(cfg: &Config) -> String {
     toml::to_string(cfg).expect("a config always serialises to TOML")
 }
 
-/// SHA-256 of the canonical config text, lowercase hex: the identity of a sweep.
+/// The part of a config that decides a sweep's results: all but `[dump]` (what is recorded
+/// on the way) and `[selfcal]` (what `selfcal` adds), so a config differing only there
+/// reuses the saved points.
+pub fn result_config(cfg: &Config) -> Config {
+    Config {
+        dump: None,
+        selfcal: None,
+        ..cfg.clone()
+    }
+}
+
+/// SHA-256 of the canonical text of the config's [`result_config`], lowercase hex: the
+/// identity of a sweep.
 pub fn config_hash(cfg: &Config) -> String {
-    hex(&Sha256::digest(canonical_toml(cfg).as_bytes()))
+    hex(&Sha256::digest(
+        canonical_toml(&result_config(cfg)).as_bytes(),
+    ))
 }
 
 fn hex(bytes: &[u8]) -> String {
@@ -359,5 +373,16 @@ mod tests {
         other.device.q += 1.0;
         assert_ne!(config_hash(&other), config_hash(&base));
         assert_eq!(config_hash(&base).len(), 64);
+    }
+
+    #[test]
+    fn hash_ignores_the_dump_and_the_selfcal_analyses() {
+        let base = gyroemu_config::presets::preset("m2tfg-coriolis").unwrap();
+        let text = canonical_toml(&base);
+        let more = format!("{text}\n[dump]\nnodes = [\"tia\"]\n[selfcal]\nallan_record_s = 10.0\n");
+        let dumped = gyroemu_config::parse_config(&more).unwrap();
+        assert!(dumped.dump.is_some() && dumped.selfcal.is_some());
+        assert_ne!(canonical_toml(&dumped), text);
+        assert_eq!(config_hash(&dumped), config_hash(&base));
     }
 }

@@ -3,6 +3,8 @@
 //! manifest says what is done; an interrupt keeps what finished; a whole run then writes the
 //! results.
 
+use crate::abort::LiveManifest;
+use crate::dumps::reconcile_dump;
 use crate::error::RunError;
 use crate::manifest::{Manifest, ShardId, RUN_MANIFEST};
 use crate::points::{canonical_toml, config_hash, scan_points, write_point, POINTS_DIR};
@@ -11,7 +13,9 @@ use crate::shard::Shard;
 use gyroemu_board::LaneResult;
 use gyroemu_config::Config;
 use gyroemu_experiment::work::measured_throughput;
-use gyroemu_experiment::{finish_sweep, run_sweep_with, sweep_work, Reporter, SweepOptions, Work};
+use gyroemu_experiment::{
+    dump_point, finish_sweep, run_sweep_with, sweep_work, Reporter, SweepOptions, Work,
+};
 use gyroemu_report::{check_problems, run_title, write_run};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -68,7 +72,8 @@ pub fn prepare_out(out: &Path) -> Result<(), RunError> {
 }
 
 /// Runs the points of `req` not yet saved in `req.out`, saving each as it finishes; then (a
-/// whole sweep) writes the results.
+/// whole sweep) writes the results. The manifest ends `complete`, `interrupted` or `failed`
+/// (with the cause in `next`), also when writing the results fails.
 pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunError> {
     let (cfg, out) = (req.config, req.out);
     let hash = config_hash(cfg);
@@ -88,7 +93,22 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     };
     share.check_cap(req.force).map_err(RunError::BadInput)?;
     reporter.note(&share.describe(Some(measured_throughput(cfg))));
-    let prev = previous_points(out, &hash, n, req.force, reporter)?;
+    let manifest_path = match &req.shard {
+        Some(s) => out.join(s.manifest_name()),
+        None => out.join(RUN_MANIFEST),
+    };
+    let mut prev = previous_points(out, cfg, n, req.force, reporter)?;
+    let owns_dump = req.shard.is_none() || dump_point(cfg).is_some_and(|i| mine.contains(&i));
+    reconcile_dump(
+        cfg,
+        &config_toml,
+        out,
+        &manifest_path,
+        &mine,
+        owns_dump,
+        &mut prev,
+        reporter,
+    )?;
     let reused = mine.iter().filter(|i| prev.contains_key(i)).count();
     let what = match &req.shard {
         Some(s) => format!(
@@ -119,19 +139,34 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         index: s.index,
         count: s.count,
     });
-    let manifest_path = match &req.shard {
-        Some(s) => out.join(s.manifest_name()),
-        None => out.join(RUN_MANIFEST),
-    };
     let manifest = |status: &str, done: &BTreeMap<usize, LaneResult>| {
         Manifest::new(status, &hash, &config_toml, shard_id, n, &mine, done)
     };
     manifest("running", &prev).write(&manifest_path)?;
+    // What an abrupt exit (a second Ctrl-C) leaves: the points saved until then.
+    let mut aborted = manifest("interrupted", &prev);
+    aborted.next = "stopped at once by a second Ctrl-C or SIGTERM: rerun the same command to \
+                    resume"
+        .into();
+    let live = LiveManifest::new(&manifest_path, aborted);
+    let fail = |e: RunError, done: &BTreeMap<usize, LaneResult>| {
+        let mut m = manifest("failed", done);
+        m.next = format!("fix the cause ({e}) and rerun the same command");
+        match live.write_final(&manifest_path, &m) {
+            Ok(()) => e,
+            Err(w) => RunError::Unrecorded {
+                cause: Box::new(e),
+                manifest: manifest_path.clone(),
+                why: w.to_string(),
+            },
+        }
+    };
 
     let saved = AtomicUsize::new(0);
     let on_group = |pts: &[(usize, LaneResult)]| -> Result<(), String> {
         for (i, lane) in pts {
             write_point(out, &hash, *i, rates[*i], lane)?;
+            live.saved(&[*i]);
         }
         let k = saved.fetch_add(pts.len(), Ordering::SeqCst) + pts.len();
         if let Some(f) = req.on_saved {
@@ -154,10 +189,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
                 .ok()
                 .and_then(|s| s.lanes(&hash, n).ok())
                 .unwrap_or_default();
-            let mut m = manifest("failed", &done);
-            m.next = format!("fix the cause ({e}) and rerun the same command");
-            m.write(&manifest_path)?;
-            return Err(e.into());
+            return Err(fail(e.into(), &done));
         }
     };
     task.finish(Some(swept.point_samples));
@@ -165,15 +197,22 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     if swept.cancelled || missing > 0 {
         let mut m = manifest("interrupted", &swept.lanes);
         m.next = "rerun the same command to resume".into();
-        m.write(&manifest_path)?;
-        return Err(RunError::Interrupted(format!(
+        let e = RunError::Interrupted(format!(
             "interrupted: {} of {} points saved in `{}`, {missing} missing (listed in `{}`); \
              rerun the same command to resume",
             mine.len() - missing,
             mine.len(),
             points_dir.display(),
             manifest_path.display()
-        )));
+        ));
+        return match live.write_final(&manifest_path, &m) {
+            Ok(()) => Err(e),
+            Err(w) => Err(RunError::Unrecorded {
+                cause: Box::new(e),
+                manifest: manifest_path.clone(),
+                why: w.to_string(),
+            }),
+        };
     }
     let mut m = manifest("complete", &swept.lanes);
     if let Some(s) = &req.shard {
@@ -182,12 +221,16 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
             s.count,
             out.display()
         );
-        m.write(&manifest_path)?;
+        live.write_final(&manifest_path, &m)
+            .map_err(|e| fail(e, &swept.lanes))?;
         return Ok(RunOutcome::ShardComplete { next: m.next });
     }
-    let r = finish_sweep(cfg, &swept.lanes)?;
-    let mut files = write_run(out, cfg, &r, &run_title(cfg))?;
-    m.write(&manifest_path)?;
+    let written = finish_sweep(cfg, &swept.lanes)
+        .map_err(RunError::from)
+        .and_then(|r| Ok((write_run(out, cfg, &r, &run_title(cfg))?, r)));
+    let (mut files, r) = written.map_err(|e| fail(e, &swept.lanes))?;
+    live.write_final(&manifest_path, &m)
+        .map_err(|e| fail(e, &swept.lanes))?;
     files.push(manifest_path);
     for w in &r.warnings {
         reporter.warn(w);

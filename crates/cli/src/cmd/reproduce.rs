@@ -1,10 +1,11 @@
 //! `gyroemu reproduce --out DIR [--quick]`.
 
-use crate::input::{list_written, BadInput};
+use crate::input::{command_line, list_written, BadInput};
 use crate::progress::Terminal;
+use crate::signals;
 use anyhow::Result;
 use gyroemu_report::{plan_reproduce, reproduce, ReportError};
-use gyroemu_runs::prepare_out;
+use gyroemu_runs::{lock_out, prepare_out, LockScope};
 use std::path::Path;
 
 /// Reproduces the paper's figures from the embedded presets into `out`.
@@ -19,7 +20,9 @@ pub fn reproduce_command(out: &Path, quick: bool) -> Result<()> {
     }
     let rate = gyroemu_experiment::work::measured_throughput(plan.first_config());
     eprintln!("{}", plan.work().describe(Some(rate)));
+    signals::install(false);
     prepare_out(out)?;
+    let _lock = lock_out(out, &command_line(), LockScope::Folder, &Terminal)?;
     let files = reproduce(&plan, out, &Terminal)?;
     list_written(out, &files);
     Ok(())

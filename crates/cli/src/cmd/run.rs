@@ -1,10 +1,10 @@
 //! `gyroemu run CONFIG --out DIR [--shard I/N] [--force]`.
 
-use crate::input::{list_written, load_config};
+use crate::input::{command_line, list_written, load_config};
 use crate::progress::Terminal;
-use crate::signals::cancel_flag;
+use crate::signals;
 use anyhow::Result;
-use gyroemu_runs::{prepare_out, resolve_shard, run, RunOutcome, RunRequest};
+use gyroemu_runs::{lock_out, prepare_out, resolve_shard, run, LockScope, RunOutcome, RunRequest};
 use std::path::Path;
 
 /// The arguments of `gyroemu run`.
@@ -25,13 +25,21 @@ pub struct RunArgs<'a> {
 pub fn run_command(a: &RunArgs) -> Result<()> {
     let cfg = load_config(a.config)?;
     let shard = resolve_shard(a.shard, a.shard_count, &|k| std::env::var(k).ok())?;
+    let cancel = signals::install(true);
     prepare_out(a.out)?;
+    let scope = shard
+        .as_ref()
+        .map_or(LockScope::Folder, |s| LockScope::Shard {
+            index: s.index,
+            count: s.count,
+        });
+    let _lock = lock_out(a.out, &command_line(), scope, &Terminal)?;
     let req = RunRequest {
         config: &cfg,
         out: a.out,
         shard,
         force: a.force,
-        cancel: cancel_flag(),
+        cancel,
         on_saved: None,
     };
     match run(&req, &Terminal)? {

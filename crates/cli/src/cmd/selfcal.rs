@@ -1,13 +1,14 @@
 //! `gyroemu selfcal CONFIG --out DIR`.
 
-use crate::input::{list_written, read_config, refused, BadInput};
+use crate::input::{command_line, list_written, read_config, refused, BadInput};
 use crate::progress::Terminal;
+use crate::signals;
 use anyhow::Result;
 use gyroemu_analysis::selfcal::validate_selfcal;
 use gyroemu_analysis::{run_selfcal, selfcal_work};
 use gyroemu_experiment::work::measured_throughput;
 use gyroemu_report::{check_problems, write_selfcal};
-use gyroemu_runs::prepare_out;
+use gyroemu_runs::{lock_out, prepare_out, LockScope};
 use std::path::Path;
 
 /// The scale factor from the rotating excitation alone, checked against the virtual rate
@@ -23,9 +24,23 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
     let work = selfcal_work(&cfg);
     work.check_cap(force).map_err(BadInput)?;
     eprintln!("{}", work.describe(Some(measured_throughput(&cfg))));
+    signals::install(false);
     prepare_out(out)?;
+    let _lock = lock_out(out, &command_line(), LockScope::Folder, &Terminal)?;
     let report = run_selfcal(&cfg, &Terminal)?;
     let files = write_selfcal(out, &cfg, &report)?;
+    if !files.removed.is_empty() {
+        let names: Vec<String> = files
+            .removed
+            .iter()
+            .map(|p| p.strip_prefix(out).unwrap_or(p).display().to_string())
+            .collect();
+        eprintln!(
+            "deleted {} files of an earlier selfcal whose analyses this config does not run: {}",
+            names.len(),
+            names.join(", ")
+        );
+    }
     for w in report
         .core
         .rotating
@@ -47,7 +62,7 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
         m.relative_error_ci95,
         cfg.experiment.average_s
     );
-    list_written(out, &files);
+    list_written(out, &files.written);
     let problems: Vec<String> = [&report.core.rotating, &report.core.coriolis]
         .iter()
         .flat_map(|r| r.problems.iter().cloned())
