@@ -9,8 +9,8 @@ mod common;
 #[path = "../fixtures/load.rs"]
 mod load;
 
-use common::{run, DEG};
-use gyroemu::config::parse_config;
+use common::{config_with_board, run, DEG};
+use gyroemu::config::Config;
 use gyroemu::resonator::{continuous_steady_state, ResonatorParams};
 use gyroemu::theory::{coriolis_theta_rad, rotating_psi_rad};
 use gyroemu::Complex64;
@@ -226,29 +226,11 @@ fn board_config(
     kind: &str,
     rates: &[f64],
     average_s: f64,
-) -> gyroemu::config::Config {
-    let text = format!(
-        r#"
-[device]
-f0_hz = {f0}
-q = {q}
-angular_gain = {lambda}
-[drive]
-f1 = 1.0
-f2 = {f2_over_f1}
-[board]
-tia_pole_hz = {pole}
-fs_hz = {fs_hz}
-decimation = {decimation}
-[experiment]
-kind = "{kind}"
-rates_dps = {rates:?}
-average_s = {average_s}
-"#,
-        pole = 4.0 * f0,
-        decimation = (fs_hz / FS_OUT_HZ).round(),
+) -> Config {
+    let board = format!(
+        "tia_pole_hz = {}\nfs_hz = {fs_hz}\ndecimation = {}",
+        4.0 * f0,
+        (fs_hz / FS_OUT_HZ).round()
     );
-    let cfg = parse_config(&text).expect("fixture config parses");
-    cfg.validate().expect("fixture config validates");
-    cfg
+    config_with_board(kind, f0, q, lambda, f2_over_f1, rates, average_s, &board)
 }
