@@ -39,6 +39,24 @@ pub fn config(
     } else {
         (16.0 * f0, 4.0 * f0, 200.0, 100)
     };
+    let board =
+        format!("fs_hz = {fs}\ntia_pole_hz = {pole}\nlpf_cutoff_hz = {cutoff}\ndecimation = {dec}");
+    config_with_board(kind, f0, q, lambda, f2_over_f1, rates, average_s, &board)
+}
+
+/// A config with the given device and sweep and `board` as the body of its `[board]` section
+/// (keys left out take their derived defaults).
+#[allow(clippy::too_many_arguments)]
+pub fn config_with_board(
+    kind: &str,
+    f0: f64,
+    q: f64,
+    lambda: f64,
+    f2_over_f1: f64,
+    rates: &[f64],
+    average_s: f64,
+    board: &str,
+) -> Config {
     let text = format!(
         r#"
 [device]
@@ -49,10 +67,7 @@ angular_gain = {lambda}
 f1 = 1.0
 f2 = {f2_over_f1}
 [board]
-fs_hz = {fs}
-tia_pole_hz = {pole}
-lpf_cutoff_hz = {cutoff}
-decimation = {dec}
+{board}
 [experiment]
 kind = "{kind}"
 rates_dps = {rates:?}
