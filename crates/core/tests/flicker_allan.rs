@@ -10,7 +10,7 @@ use gyroemu_core::flicker::{flicker_adev, Flicker, FlickerDesign, FlickerParams}
 use gyroemu_core::{f64x4, Stage};
 
 /// fs = 1 Hz, 1/f from 1e-5 Hz to Nyquist: the Allan deviation is flat (to 1 %) from
-/// m = 8 to m = 4096 samples (1/tau from 0.125 fs down to 25 f_lo).
+/// m = 8 to m = 2048 samples (1/tau from 0.125 fs down to 49 f_lo).
 fn params() -> FlickerParams {
     FlickerParams {
         fs_hz: 1.0,
