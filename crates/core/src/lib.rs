@@ -6,6 +6,7 @@
 pub mod check;
 pub mod detmath;
 pub mod error;
+pub mod flicker;
 pub mod noise;
 pub mod sample;
 pub mod stage;

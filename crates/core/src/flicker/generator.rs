@@ -1,0 +1,98 @@
+//! The flicker generator: the designed filter in modal form, run sample by sample on a unit
+//! Gaussian sequence the caller draws (so it follows whatever Gaussian generator the board
+//! uses), lane-parallel through [`Sample`].
+
+use super::stationary::cholesky_factor;
+use super::{FlickerDesign, FlickerParams};
+use crate::{Complex64, ParamResult, Response, Sample, Stage};
+
+/// A flicker (1/f) source: `tick(w)` takes one unit-variance white Gaussian per lane and
+/// returns the next flicker sample, whose one-sided density is [`FlickerDesign::psd`] (`S1 /
+/// f` in band). Every lane runs the scalar recursion on its own input, so lane `l` of an
+/// `f64x4` source gives the bits of an `f64` source fed lane `l`'s Gaussians.
+#[derive(Clone, Debug)]
+pub struct Flicker<S: Sample> {
+    design: FlickerDesign,
+    a: Vec<S>,
+    rho: Vec<S>,
+    direct: S,
+    /// Modal states `m_k[n] = a_k m_k[n-1] + w[n]`.
+    state: Vec<S>,
+    /// The state `reset` restores (the start state).
+    start: Vec<S>,
+}
+
+impl<S: Sample> Flicker<S> {
+    /// A source started at rest (every state 0): a linear filter of its input, as the
+    /// response checks need. Its output is stationary only after about `1 / (2 pi f_lo)`
+    /// seconds; for noise use [`Flicker::stationary`].
+    pub fn at_rest(p: &FlickerParams) -> ParamResult<Self> {
+        let design = FlickerDesign::new(p)?;
+        let n = design.poles();
+        Ok(Self {
+            a: design.pole_radii().iter().map(|&v| S::splat(v)).collect(),
+            rho: design.residues().iter().map(|&v| S::splat(v)).collect(),
+            direct: S::splat(design.direct()),
+            state: vec![S::default(); n],
+            start: vec![S::default(); n],
+            design,
+        })
+    }
+
+    /// A source whose start state is drawn from the stationary law of the filter driven by
+    /// unit white noise, so the output is stationary from its first sample. Draws exactly
+    /// [`FlickerDesign::poles`] unit Gaussians from `gauss`, in order, before anything else.
+    /// `reset` returns to this start.
+    pub fn stationary(p: &FlickerParams, mut gauss: impl FnMut() -> S) -> ParamResult<Self> {
+        let mut f = Self::at_rest(p)?;
+        let n = f.design.poles();
+        let l = cholesky_factor(&f.design);
+        let xi: Vec<S> = (0..n).map(|_| gauss()).collect();
+        for i in 0..n {
+            let mut v = S::default();
+            for (k, &x) in xi.iter().enumerate().take(i + 1) {
+                v += S::splat(l[i * n + k]) * x;
+            }
+            f.start[i] = v;
+        }
+        f.state.clone_from(&f.start);
+        Ok(f)
+    }
+
+    /// The design (exact spectrum, variance, poles).
+    pub fn design(&self) -> &FlickerDesign {
+        &self.design
+    }
+
+    /// The exact one-sided density of the output at `f_hz`, unit^2/Hz.
+    pub fn psd(&self, f_hz: f64) -> f64 {
+        self.design.psd(f_hz)
+    }
+}
+
+impl<S: Sample> Stage for Flicker<S> {
+    /// One unit-variance white Gaussian per lane.
+    type Input = S;
+    type Output = S;
+
+    #[inline(always)]
+    fn tick(&mut self, w: S) -> S {
+        let mut y = w * self.direct;
+        for ((m, &a), &r) in self.state.iter_mut().zip(&self.a).zip(&self.rho) {
+            *m = m.mul_add(a, w);
+            y = m.mul_add(r, y);
+        }
+        y
+    }
+
+    fn reset(&mut self) {
+        self.state.clone_from(&self.start);
+    }
+}
+
+impl<S: Sample> Response for Flicker<S> {
+    /// The complex gain from the Gaussian input to the output (the design's).
+    fn response(&self, f_hz: f64) -> Complex64 {
+        self.design.response(f_hz)
+    }
+}
