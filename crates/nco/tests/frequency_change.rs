@@ -115,7 +115,7 @@ fn a_bad_frequency_is_refused_and_changes_nothing() {
 fn reset_restores_the_built_frequency() {
     let fresh = Nco::new(f_of(P_OLD), FS_HZ, 1.3).unwrap();
     let mut nco = fresh.clone();
-    let mut rot = RotatingNco::<f64>::new(&[fresh.clone()]);
+    let mut rot = RotatingNco::<f64>::new(std::slice::from_ref(&fresh));
     for _ in 0..100 {
         nco.tick(());
         rot.tick(());
