@@ -87,6 +87,7 @@
 
 pub mod design;
 mod params;
+mod pi;
 mod pll;
 
 pub use design::LoopDesign;

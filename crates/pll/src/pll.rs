@@ -1,9 +1,10 @@
 //! The PLL stage: phase detector, PI loop filter, frequency limits and lock detection.
 
 use crate::design::{noise_bandwidth_hz, LoopDesign};
+use crate::pi::Pi;
 use crate::PllParams;
 use core::f64::consts::TAU;
-use gyroemu_core::detmath::{sin_cos, sin_cos_turns};
+use gyroemu_core::detmath::sin_cos;
 use gyroemu_core::{Complex64, ParamResult, Response, Stage};
 
 /// A carrier PLL, ticked once per demodulated (decimated) output sample: input the complex
@@ -28,7 +29,8 @@ pub struct Pll {
     min_hz: f64,
     max_hz: f64,
     // State.
-    integ_rad_s: f64,
+    /// The PI filter, in rad/s of carrier per rad of phase error.
+    pi: Pi,
     out_hz: f64,
     error_rad: f64,
     run: u32,
@@ -43,13 +45,14 @@ impl Pll {
         let p = *params;
         let phi = p.phase_offset_rad % TAU;
         let (s, c) = sin_cos(phi);
+        let design = LoopDesign::new(p.natural_hz, p.damping, p.tau_s, p.update_rate_hz);
         Ok(Self {
             params: p,
-            design: LoopDesign::new(p.natural_hz, p.damping, p.tau_s, p.update_rate_hz),
+            design,
             derot: Complex64::new(c, -s),
             min_hz: p.min_hz.unwrap_or(f64::NEG_INFINITY),
             max_hz: p.max_hz.unwrap_or(f64::INFINITY),
-            integ_rad_s: 0.0,
+            pi: Pi::new(design.kp_per_s, design.ki_t_per_s),
             out_hz: p.carrier_hz,
             error_rad: 0.0,
             run: 0,
@@ -87,7 +90,7 @@ impl Pll {
 
     /// The integrator's share of the correction, Hz.
     pub fn integrator_hz(&self) -> f64 {
-        self.integ_rad_s / TAU
+        self.pi.integrator() / TAU
     }
 
     /// Whether the last output sat on `min_hz` or `max_hz`.
@@ -126,19 +129,11 @@ impl Stage for Pll {
         // The detector: std atan2, once per update, so it is linear over the whole circle (a
         // sine detector, Im z / |z|, would flatten past 90 degrees and slow the pull-in).
         let e = r.im.atan2(r.re);
-        let integ = self.integ_rad_s + self.design.ki_t_per_s * e;
-        let f = self.params.carrier_hz + (self.design.kp_per_s * e + integ) * (1.0 / TAU);
-        let (out, pushing_out) = if f > self.max_hz {
-            (self.max_hz, e > 0.0)
-        } else if f < self.min_hz {
-            (self.min_hz, e < 0.0)
-        } else {
-            (f, false)
-        };
-        if !pushing_out {
-            self.integ_rad_s = integ;
-        }
-        self.limited = out != f;
+        let carrier = self.params.carrier_hz;
+        let (out, limited) = self
+            .pi
+            .tick(e, self.min_hz, self.max_hz, |u| carrier + u * (1.0 / TAU));
+        self.limited = limited;
         self.error_rad = e;
         self.run = if e.abs() < self.params.lock_threshold_rad && !self.limited {
             self.run.saturating_add(1)
@@ -151,7 +146,7 @@ impl Stage for Pll {
 
     /// Back to the nominal carrier, integrator empty, not locked.
     fn reset(&mut self) {
-        self.integ_rad_s = 0.0;
+        self.pi.reset();
         self.out_hz = self.params.carrier_hz;
         self.error_rad = 0.0;
         self.run = 0;
@@ -172,19 +167,6 @@ impl Response for Pll {
     /// `f_hz` (relative to the update rate): `(Kp + Ki T / (1 - e^{-j 2 pi f T})) / 2 pi`.
     /// Infinite at DC (and at multiples of the update rate), where the integrator's is.
     fn response(&self, f_hz: f64) -> Complex64 {
-        // The response has the period of the update rate; reduce to |x| <= 1/2 turn first,
-        // so a multiple of the update rate is exactly 0 (the integrator's pole).
-        let x = f_hz / self.params.update_rate_hz;
-        let x = x - x.round();
-        // 1 - e^{-jw} = 2 sin^2(w/2) + j sin w, accurate near DC.
-        let (sh, ch) = sin_cos_turns(0.5 * x);
-        let one_minus = Complex64::new(2.0 * sh * sh, 2.0 * sh * ch);
-        let d = &self.design;
-        let integ = if x == 0.0 {
-            Complex64::new(f64::INFINITY, 0.0)
-        } else {
-            Complex64::new(d.ki_t_per_s, 0.0) / one_minus
-        };
-        (Complex64::new(d.kp_per_s, 0.0) + integ) * (1.0 / TAU)
+        self.pi.response(f_hz / self.params.update_rate_hz) * (1.0 / TAU)
     }
 }
