@@ -83,13 +83,32 @@
 //! [`Pll::is_locked`]: `|e|` below `lock_threshold_rad` on each of the last `lock_updates`
 //! ticks, with a signal and off the frequency limits. An input at or below `min_amplitude`
 //! (or not finite) carries no phase: the PLL holds its frequency and drops lock.
+//!
+//! # Drive amplitude (AGC)
+//!
+//! [`Agc`] closes a second loop around the same envelope: a PI on `ln(setpoint / |z|)`
+//! setting the drive gain. In logs the amplitude follows the gain through the same lag
+//! `1 / (1 + s tau)` (gain 1 instead of the phase's `tau`), so its gains are the PLL's times
+//! `tau` (`Kp = 2 zeta wn tau - 1`, `Ki = wn^2 tau`) and the amplitude's response to a step of
+//! the setpoint is the carrier's to a step of the resonance.
+//!
+//! # Determinism
+//!
+//! The gains and the offset rotation are computed once, when a stage is built (std `exp`,
+//! `expm1`, `sin`, `cos`; `detmath` for the rotation). Per update the PLL calls std `atan2`
+//! once, the AGC std `ln` and `exp` once each: the only libm calls on the signal path besides
+//! the rate-table unwrap (docs/architecture.md section 6).
 #![warn(missing_docs)]
 
+mod agc;
+mod agc_params;
 pub mod design;
 mod params;
 mod pi;
 mod pll;
 
+pub use agc::Agc;
+pub use agc_params::{AgcParams, AGC_STAGE};
 pub use design::LoopDesign;
 pub use params::{PllParams, MAX_LOWPASS_LAG_RAD, MAX_NATURAL_PER_UPDATE};
 pub use pll::Pll;

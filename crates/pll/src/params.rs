@@ -147,9 +147,9 @@ impl PllParams {
 }
 
 /// Checks the parameters of a loop around the envelope (the PLL's and the AGC's): rate,
-/// natural frequency, damping and time constant finite and > 0, the low-pass delay finite and
-/// >= 0, and the three design rules (natural frequency against the update rate and the
-/// low-pass, `2 zeta wn tau >= 1`). Errors name `stage`.
+/// natural frequency, damping and time constant finite and positive, the low-pass delay
+/// finite and not negative, and the three design rules (natural frequency against the update
+/// rate and the low-pass, `2 zeta wn tau >= 1`). Errors name `stage`.
 pub(crate) fn validate_loop(
     stage: &'static str,
     update_rate_hz: f64,

@@ -2,11 +2,14 @@
 //! NCO, the TIA, the stage-1 mixer and a low-pass on I and Q, and the PLL steering the NCO once
 //! per decimation block, as the board will.
 
+// Each test file uses its own part of this module.
+#![allow(dead_code)]
+
 use gyroemu_core::{Complex64, Response, Stage};
 use gyroemu_lpf::{LowPass, LowPassDesign};
 use gyroemu_mixer::Stage1Mixer;
 use gyroemu_nco::{Nco, RotatingNco};
-use gyroemu_pll::{Pll, PllParams};
+use gyroemu_pll::{Agc, Pll, PllParams};
 use gyroemu_resonator::{Resonator, ResonatorParams};
 use gyroemu_tia::{Tia, TiaParams};
 
@@ -83,11 +86,17 @@ impl Setup {
     /// steady state at f0 (the DAC hold included) times the TIA's response (its inversion and
     /// pole); the low-pass has a real unit gain at DC.
     pub fn phase_offset_rad(&self) -> f64 {
+        self.z_at_resonance().arg()
+    }
+
+    /// The demodulated output at steady state on the resonance, unit gain: the plant's
+    /// sampled steady-state velocity times the TIA's response (the low-pass's DC gain is 1).
+    pub fn z_at_resonance(&self) -> Complex64 {
         let v = self.plant(self.f0_hz).held_steady_state(
             self.f0_hz,
             [Complex64::new(FORCE, 0.0), Complex64::new(0.0, 0.0)],
         )[2];
-        (v * self.tia().response(self.f0_hz)).arg()
+        v * self.tia().response(self.f0_hz)
     }
 
     /// The PLL for this chain with its nominal carrier at `carrier_hz`.
@@ -118,6 +127,10 @@ pub struct Loop {
     pub closed: bool,
     /// Feeds the PLL `conj z` instead of `z`: the detector's sign flipped (a wrong loop).
     pub mirrored: bool,
+    /// The drive-amplitude loop, when there is one: it sets `gain` once per block.
+    pub agc: Option<Agc>,
+    /// The factor on the drive amplitude.
+    pub gain: f64,
 }
 
 impl Loop {
@@ -134,6 +147,8 @@ impl Loop {
             m: setup.m,
             closed: true,
             mirrored: false,
+            agc: None,
+            gain: 1.0,
         }
     }
 
@@ -161,7 +176,7 @@ impl Loop {
         let mut z = Complex64::new(0.0, 0.0);
         for _ in 0..self.m {
             let (c, s) = self.nco.tick(());
-            let out = self.plant.tick([FORCE * c, 0.0]);
+            let out = self.plant.tick([FORCE * self.gain * c, 0.0]);
             let y = self.tia.tick(out.current[0]);
             let iq = self.mixer.tick((y, Complex64::new(c, s)));
             z = Complex64::new(self.lpf[0].tick(iq.i), self.lpf[1].tick(iq.q));
@@ -169,6 +184,9 @@ impl Loop {
         let f = self.pll.tick(if self.mirrored { z.conj() } else { z });
         if self.closed {
             self.nco.set_frequency_hz(0, f).unwrap();
+        }
+        if let Some(agc) = &mut self.agc {
+            self.gain = agc.tick(z);
         }
         (f, z)
     }
