@@ -5,6 +5,7 @@
 
 mod common;
 
+use common::models::{continuous_step, sampled_loop, worst_difference, AGC};
 use common::{Loop, Setup};
 use core::f64::consts::TAU;
 use gyroemu_core::check::{self, FnResponse, Gen};
@@ -111,47 +112,6 @@ fn the_sampled_amplitude_loop_has_its_poles_at_exp_s_t() {
     assert!(((a.kp_per_s - 0.25 * d.kp_per_s) / a.kp_per_s).abs() < 1e-15);
 }
 
-/// The continuous amplitude loop's (log) response to a unit step of the (log) setpoint,
-/// `zeta < 1`: the PLL's to a resonance step (docs of `Agc`).
-fn continuous_step(t: f64, natural_hz: f64, zeta: f64, tau: f64) -> f64 {
-    let wn = TAU * natural_hz;
-    let sigma = zeta * wn;
-    let wd = wn * (1.0 - zeta * zeta).sqrt();
-    1.0 - (-sigma * t).exp() * ((wd * t).cos() + (1.0 / tau - sigma) / wd * (wd * t).sin())
-}
-
-/// The sampled linear loop's response (log amplitude) to a unit step of the log setpoint, per
-/// input sample through the low-pass (the real stage, on the log amplitude: for small signals
-/// the low-passed amplitude's log is the low-passed log) when `lowpass`, else per update.
-fn sampled_step(s: &Setup, kp: f64, ki_t: f64, n: usize, lowpass: bool) -> Vec<f64> {
-    let (sub, h) = if lowpass {
-        (s.m, 1.0 / s.fs_hz)
-    } else {
-        (1, 1.0 / s.update_rate_hz())
-    };
-    let alpha = (-h / s.tau_s()).exp();
-    let mut lpf = s.lowpass();
-    let (mut x, mut integ, mut lg) = (0.0f64, 0.0f64, 0.0f64);
-    (0..n)
-        .map(|_| {
-            let mut seen = x;
-            for _ in 0..sub {
-                if lowpass {
-                    seen = lpf.tick(x);
-                }
-                x = alpha * x + (1.0 - alpha) * lg;
-            }
-            if !lowpass {
-                seen = x;
-            }
-            let e = 1.0 - seen;
-            integ += ki_t * e;
-            lg = kp * e + integ;
-            seen
-        })
-        .collect()
-}
-
 fn agc_params(s: &Setup, setpoint: f64) -> AgcParams {
     let mut p = AgcParams::new(
         s.update_rate_hz(),
@@ -198,18 +158,18 @@ fn setpoint_step_response_matches_the_linear_models() {
         let y: Vec<f64> = (0..n)
             .map(|_| (lp.block().1.norm().ln() - before) / step)
             .collect();
-        let sampled = sampled_step(&s, d.kp_per_s, d.ki_t_per_s, n, false);
-        let with_lowpass = sampled_step(&s, d.kp_per_s, d.ki_t_per_s, n, true);
+        let model = |lowpass| -> Vec<f64> {
+            sampled_loop(&s, &AGC, d.kp_per_s, d.ki_t_per_s, n, lowpass)
+                .into_iter()
+                .map(|(x, _)| x)
+                .collect()
+        };
+        let (sampled, with_lowpass) = (model(false), model(true));
         let t_up = 1.0 / s.update_rate_hz();
         let analytic: Vec<f64> = (0..n)
             .map(|k| continuous_step(k as f64 * t_up, fnat, zeta, s.tau_s()))
             .collect();
-        let worst = |m: &[f64]| {
-            y.iter()
-                .zip(m)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max)
-        };
+        let worst = |m: &[f64]| worst_difference(&y, m);
         let (w_a, w_s, w_l) = (worst(&analytic), worst(&sampled), worst(&with_lowpass));
         println!(
             "AGC fn {fnat} Hz, zeta {zeta}: worst |ln|z| - model| / step: analytic {w_a:.4}, \

@@ -5,6 +5,8 @@
 // Each test file uses its own part of this module.
 #![allow(dead_code)]
 
+pub mod models;
+
 use gyroemu_core::{Complex64, Response, Stage};
 use gyroemu_lpf::{LowPass, LowPassDesign};
 use gyroemu_mixer::Stage1Mixer;
