@@ -16,6 +16,7 @@ pub struct Nco {
     phase: u64,
     step: u64,
     phase0: u64,
+    step0: u64,
     fs_hz: f64,
     table: &'static Table,
 }
@@ -27,24 +28,16 @@ impl Nco {
     /// request.
     pub fn new(f_hz: f64, fs_hz: f64, phase_rad: f64) -> ParamResult<Self> {
         let fs_hz = error::positive(STAGE, "fs_hz", fs_hz)?;
-        let f_hz = error::finite(STAGE, "f_hz", f_hz)?;
-        if f_hz.abs() >= 0.5 * fs_hz {
-            return Err(ParamError::new(
-                STAGE,
-                "f_hz",
-                f_hz,
-                format!("|f_hz| must be below Nyquist (fs/2 = {} Hz)", 0.5 * fs_hz),
-            ));
-        }
+        let step = step_of(f_hz, fs_hz)?;
         let phase_rad = error::finite(STAGE, "phase_rad", phase_rad)?;
         let turns = phase_rad.rem_euclid(core::f64::consts::TAU) / core::f64::consts::TAU;
         // turns is in [0, 1]; 1 maps to word 2^64 = 0 by the truncating cast.
         let phase0 = (turns * TWO_POW_64).round() as u128 as u64;
-        let step = ratio_to_word(f_hz, fs_hz) as u64;
         Ok(Self {
             phase: phase0,
             step,
             phase0,
+            step0: step,
             fs_hz,
             table: table(),
         })
@@ -75,6 +68,17 @@ impl Nco {
         turns_of_word(self.phase) * core::f64::consts::TAU
     }
 
+    /// Changes the frequency to `f_hz` (finite, `|f_hz| < fs_hz/2`) from the next tick on,
+    /// with the phase continuous: only the step word is replaced (by the exact nearest word,
+    /// as in [`Nco::new`]), the phase accumulator is kept. So the next output is the phasor
+    /// the old frequency would have given, and every later one advances by the new step.
+    /// A bad frequency is refused and changes nothing. [`Stage::reset`] restores the
+    /// frequency the oscillator was built with.
+    pub fn set_frequency_hz(&mut self, f_hz: f64) -> ParamResult<()> {
+        self.step = step_of(f_hz, self.fs_hz)?;
+        Ok(())
+    }
+
     /// Advances exactly `n_samples` steps at once (wrapping integer arithmetic).
     pub fn jump(&mut self, n_samples: u64) {
         self.phase = self.phase.wrapping_add(self.step.wrapping_mul(n_samples));
@@ -99,8 +103,24 @@ impl Stage for Nco {
         p
     }
 
-    /// Back to the start phase.
+    /// Back to the start phase and the frequency the oscillator was built with.
     fn reset(&mut self) {
         self.phase = self.phase0;
+        self.step = self.step0;
     }
+}
+
+/// The step word of `f_hz` at `fs_hz` (`fs_hz` already checked), refusing a non-finite
+/// frequency or one at or above Nyquist.
+pub(crate) fn step_of(f_hz: f64, fs_hz: f64) -> ParamResult<u64> {
+    let f_hz = error::finite(STAGE, "f_hz", f_hz)?;
+    if f_hz.abs() >= 0.5 * fs_hz {
+        return Err(ParamError::new(
+            STAGE,
+            "f_hz",
+            f_hz,
+            format!("|f_hz| must be below Nyquist (fs/2 = {} Hz)", 0.5 * fs_hz),
+        ));
+    }
+    Ok(ratio_to_word(f_hz, fs_hz) as u64)
 }

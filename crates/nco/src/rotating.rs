@@ -3,9 +3,10 @@
 //! phase accumulator of [`Nco`]. Between re-sets the rounding of the rotation grows by at most
 //! a few ulp per sample, so the output stays within ~1e-14 of the NCO's and never drifts.
 
+use crate::nco::step_of;
 use crate::trig::phasor_of_word;
 use crate::Nco;
-use gyroemu_core::{Sample, Stage};
+use gyroemu_core::{ParamError, ParamResult, Sample, Stage};
 
 /// Samples between exact re-sets of the rotated phasor.
 pub const RESYNC: u32 = 64;
@@ -17,9 +18,12 @@ pub struct RotatingNco<S: Sample> {
     im: S,
     rot_re: S,
     rot_im: S,
+    /// Per lane: the exact phase word of the sample `count` ticks ahead (the next re-set).
     phase: [u64; 4],
     step: [u64; 4],
     phase0: [u64; 4],
+    step0: [u64; 4],
+    fs_hz: [f64; 4],
     count: u32,
 }
 
@@ -30,6 +34,7 @@ impl<S: Sample> RotatingNco<S> {
         let pick = |i: usize| &ncos[i.min(ncos.len() - 1)];
         let phase: [u64; 4] = core::array::from_fn(|i| pick(i).phase_word());
         let step: [u64; 4] = core::array::from_fn(|i| pick(i).step_word());
+        let fs_hz: [f64; 4] = core::array::from_fn(|i| pick(i).fs_hz());
         let rot = |i: usize| phasor_of_word(step[i]);
         let mut s = Self {
             re: S::splat(0.0),
@@ -39,10 +44,52 @@ impl<S: Sample> RotatingNco<S> {
             phase,
             step,
             phase0: phase,
+            step0: step,
+            fs_hz,
             count: 0,
         };
         s.resync();
         s
+    }
+
+    /// Changes lane `lane`'s frequency to `f_hz` (finite, `|f_hz| < fs/2` of that lane's
+    /// [`Nco`]) from the next tick on, with the phase continuous; the other lanes are not
+    /// touched (not a bit). The lane's phase word of the next sample is recovered exactly
+    /// from the accumulator, its phasor is re-set exactly from it (as at a re-set) and its
+    /// step and rotation are replaced, so from here on the lane is within ~1e-14 of an
+    /// [`Nco`] given the same [`Nco::set_frequency_hz`] at the same sample. A bad lane or
+    /// frequency is refused and changes nothing. [`Stage::reset`] restores the frequencies the
+    /// oscillator was built with.
+    pub fn set_frequency_hz(&mut self, lane: usize, f_hz: f64) -> ParamResult<()> {
+        if lane >= S::LANES {
+            return Err(ParamError::new(
+                "rotating_nco",
+                "lane",
+                lane,
+                format!("must be below the number of lanes ({})", S::LANES),
+            ));
+        }
+        let step = step_of(f_hz, self.fs_hz[lane])?;
+        let next = self.next_phase_word(lane);
+        self.step[lane] = step;
+        self.phase[lane] = next.wrapping_add(step.wrapping_mul(u64::from(self.count)));
+        let (p, r) = (phasor_of_word(next), phasor_of_word(step));
+        let set = |v: S, new: f64| S::from_fn(|l| if l == lane { new } else { v.lane(l) });
+        self.re = set(self.re, p.re);
+        self.im = set(self.im, p.im);
+        self.rot_re = set(self.rot_re, r.re);
+        self.rot_im = set(self.rot_im, r.im);
+        Ok(())
+    }
+
+    /// Lane `lane`'s realised (step-quantised) frequency, signed, in Hz (`lane < 4`).
+    pub fn f_hz(&self, lane: usize) -> f64 {
+        (self.step[lane] as i64) as f64 * (self.fs_hz[lane] / 18_446_744_073_709_551_616.0)
+    }
+
+    /// Lane `lane`'s exact phase word (2^-64 turn) of the sample the next tick outputs.
+    pub fn next_phase_word(&self, lane: usize) -> u64 {
+        self.phase[lane].wrapping_sub(self.step[lane].wrapping_mul(u64::from(self.count)))
     }
 
     /// Sets the phasor exactly from the accumulator and advances the accumulator by one
@@ -82,6 +129,13 @@ impl<S: Sample> Stage for RotatingNco<S> {
 
     fn reset(&mut self) {
         self.phase = self.phase0;
+        if self.step != self.step0 {
+            self.step = self.step0;
+            let rot: [gyroemu_core::Complex64; 4] =
+                core::array::from_fn(|i| phasor_of_word(self.step[i]));
+            self.rot_re = S::from_fn(|i| rot[i].re);
+            self.rot_im = S::from_fn(|i| rot[i].im);
+        }
         self.resync();
     }
 }
