@@ -35,6 +35,7 @@ fn brownian_motion_obeys_equipartition() {
     let text = preset("m2tfg-coriolis").unwrap();
     let mut cfg: Config = text;
     cfg.device.f0_hz = 1000.0;
+    cfg.drive.carrier_hz = None; // back to f0 (the preset resolved it to its own)
     cfg.device.q = 10.0;
     cfg.drive.f1 = 1e-30;
     cfg.drive.f2 = Some(1e-30);

@@ -123,6 +123,8 @@ pub fn drifted(cfg: &Config, delta_t_k: f64) -> Config {
     c.device.mode2_f0_offset_hz *= f_scale;
     c.device.q *= q_scale;
     c.device.q_mode2 = c.device.q_mode2.map(|q| q * q_scale);
+    // The carrier follows the resonance (a perfectly tracked drive).
+    c.drive.carrier_hz = c.drive.carrier_hz.map(|f| f * f_scale);
     c
 }
 

@@ -57,6 +57,11 @@ pub struct DriveConfig {
     /// default F1 (filled in by `parse_config`, read it with [`Config::f2`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub f2: Option<f64>,
+    /// Frequency of the drive's carrier (and of the stage-1 demodulation), Hz; default the
+    /// mode-1 resonance `device.f0_hz` (read it with [`Config::carrier_hz`]). Set it apart
+    /// from f0 for a detuned open-loop drive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub carrier_hz: Option<f64>,
 }
 
 /// The readout board.

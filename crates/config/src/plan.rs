@@ -79,6 +79,7 @@ impl Config {
             plant: self.resonator_params(),
             drive: [self.drive.f1, self.f2()],
             phase_shifter_error_deg: self.board.phase_shifter_error_deg,
+            carrier_hz: self.carrier_hz(),
         }
     }
 
@@ -104,7 +105,6 @@ impl Config {
             .rate_table_harmonics_needed(
                 self.max_rate_rad_s(),
                 freq_hz,
-                self.device.f0_hz,
                 TABLE_HARMONIC_REL,
                 MAX_TABLE_HARMONIC,
             )
@@ -129,7 +129,7 @@ impl Config {
         let b = &self.board;
         BoardParams {
             plant: self.resonator_params(),
-            carrier_hz: self.device.f0_hz,
+            carrier_hz: self.carrier_hz(),
             drive: [self.drive.f1, self.f2()],
             phase_shifter_error_deg: b.phase_shifter_error_deg,
             dac: b.dac_bits.map(|bits| Converter {

@@ -45,6 +45,11 @@ impl Config {
             .unwrap_or(DEFAULT_SAMPLES_PER_PERIOD * self.f0_max_hz())
     }
 
+    /// Carrier frequency of the drive, Hz (set, or the mode-1 resonance).
+    pub fn carrier_hz(&self) -> f64 {
+        self.drive.carrier_hz.unwrap_or(self.device.f0_hz)
+    }
+
     /// Mode-2 drive amplitude F2 (set, or F1).
     pub fn f2(&self) -> f64 {
         self.drive.f2.unwrap_or(self.drive.f1)
@@ -75,16 +80,35 @@ impl Config {
         })
     }
 
-    /// Decimation after the low-pass (set, or the largest that keeps 20 output samples per
-    /// cutoff period, at least 1).
+    /// Decimation after the low-pass (set, or derived): at most the `M_max` that keeps 20
+    /// output samples per cutoff period, and among `M_max/2 ..= M_max` the one that puts the
+    /// stage-1 mixer's 2 f_c product, aliased by the decimation, farthest from DC (the largest
+    /// such M on a tie). An output rate dividing 2 f_c would fold what the low-pass leaves of
+    /// that product onto the averaged DC (at 16 samples per period, every M multiple of 8).
     pub fn decimation(&self) -> usize {
         self.board.decimation.unwrap_or_else(|| {
             let m = (self.fs_hz() / (OUTPUT_SAMPLES_PER_CUTOFF * self.lpf_cutoff_hz())).floor();
-            if m.is_finite() && m >= 1.0 {
-                m as usize
-            } else {
-                1
+            if !(m.is_finite() && m >= 1.0) {
+                return 1;
             }
+            let m_max = m.min(1e9) as usize;
+            let two_fc_per_sample = 2.0 * self.carrier_hz() / self.fs_hz();
+            // Distance of the aliased 2 f_c from DC, in output periods (0 .. 1/2).
+            let dist = |m: usize| {
+                let a = (two_fc_per_sample * m as f64).rem_euclid(1.0);
+                a.min(1.0 - a)
+            };
+            (m_max.div_ceil(2)..=m_max)
+                .rev()
+                .fold((m_max, -1.0), |best, m| {
+                    let d = dist(m);
+                    if d > best.1 + 1e-12 {
+                        (m, d)
+                    } else {
+                        best
+                    }
+                })
+                .0
         })
     }
 
@@ -139,6 +163,14 @@ impl Config {
                 rule: "equal to drive.f1".into(),
             });
         }
+        if self.drive.carrier_hz.is_none() {
+            self.drive.carrier_hz = Some(f0);
+            out.push(Derived {
+                key: "drive.carrier_hz",
+                value: fmt(f0),
+                rule: "the mode-1 resonance device.f0_hz".into(),
+            });
+        }
         if self.board.fs_hz.is_none() {
             let fs = self.fs_hz();
             self.board.fs_hz = Some(fs);
@@ -172,7 +204,7 @@ impl Config {
                 key: "board.decimation",
                 value: m.to_string(),
                 rule: format!(
-                    "floor(fs_hz / ({OUTPUT_SAMPLES_PER_CUTOFF} x lpf_cutoff_hz)): {OUTPUT_SAMPLES_PER_CUTOFF} output samples per cutoff period or more"
+                    "at most floor(fs_hz / ({OUTPUT_SAMPLES_PER_CUTOFF} x lpf_cutoff_hz)) ({OUTPUT_SAMPLES_PER_CUTOFF} output samples per cutoff period or more), chosen to alias the 2 x carrier mixer product as far from DC as possible"
                 ),
             });
         }

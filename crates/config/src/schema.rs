@@ -85,7 +85,11 @@ pub(crate) const SECTIONS: &[Section] = &[
     Section {
         name: "drive",
         required: true,
-        fields: &[req("f1", Number), opt("f2", Number)],
+        fields: &[
+            req("f1", Number),
+            opt("f2", Number),
+            opt("carrier_hz", Number),
+        ],
     },
     Section {
         name: "board",

@@ -50,6 +50,12 @@ impl Config {
         if same(raw(&|c| c.drive.f2 = None).f2(), self.f2()) {
             p.derived_from("drive.f2", "drive.f1");
         }
+        if same(
+            raw(&|c| c.drive.carrier_hz = None).carrier_hz(),
+            self.carrier_hz(),
+        ) {
+            p.derived_from("drive.carrier_hz", "device.f0_hz");
+        }
         if same(raw(&|c| c.board.fs_hz = None).fs_hz(), self.fs_hz()) {
             p.derived_from("board.fs_hz", "device.f0_hz");
             p.derived_from("board.fs_hz", "device.mode2_f0_offset_hz");
@@ -64,6 +70,7 @@ impl Config {
         if raw(&|c| c.board.decimation = None).decimation() == self.decimation() {
             p.derived_from("board.decimation", "board.fs_hz");
             p.derived_from("board.decimation", "board.lpf_cutoff_hz");
+            p.derived_from("board.decimation", "drive.carrier_hz");
         }
     }
 
@@ -102,6 +109,14 @@ impl Config {
                 "board.fs_hz",
                 fs_hz,
                 format!("must be above 2*f0 = {} Hz", 2.0 * f_max),
+            );
+        }
+        if p.positive("drive.carrier_hz", self.carrier_hz()) && p.clean(&["board.fs_hz"]) {
+            p.check(
+                self.carrier_hz() < 0.5 * fs_hz,
+                "drive.carrier_hz",
+                self.carrier_hz(),
+                format!("must be below Nyquist (fs_hz/2 = {} Hz)", 0.5 * fs_hz),
             );
         }
         p.positive("board.tia_gain_ohm", b.tia_gain_ohm);

@@ -7,7 +7,6 @@ use crate::config::Config;
 use crate::error::ConfigError;
 use crate::rules::Rules;
 use gyroemu_board::Shape;
-use gyroemu_theory::DrivenDevice;
 
 /// Every node's amplitude must lie in this band (in its own unit): products of two stay finite
 /// and normal, and no signal is rounded away in subnormals.
@@ -71,12 +70,9 @@ impl Config {
             return;
         };
         let n = gyroemu_mixer::MAX_TABLE_HARMONIC;
-        let env = self.driven_device().rate_table_envelopes(
-            self.max_rate_rad_s(),
-            freq_hz,
-            self.device.f0_hz,
-            n + 1,
-        );
+        let env = self
+            .driven_device()
+            .rate_table_envelopes(self.max_rate_rad_s(), freq_hz, n + 1);
         let peak = env.iter().flatten().map(|v| v.norm()).fold(0.0, f64::max);
         let left = env
             .iter()
@@ -202,11 +198,7 @@ impl Config {
     /// continuous-drive theory by what the exact held-drive steady state says. Stated when it
     /// matters, refused when the hold's images dominate.
     fn validate_hold(&self, p: &mut Rules, warnings: &mut Vec<String>) {
-        let dev = DrivenDevice {
-            plant: self.resonator_params(),
-            drive: [self.drive.f1, self.f2()],
-            phase_shifter_error_deg: self.board.phase_shifter_error_deg,
-        };
+        let dev = self.driven_device();
         let deg = core::f64::consts::PI / 180.0;
         let mut worst: f64 = 0.0;
         for &r in &self.experiment.rates_dps {

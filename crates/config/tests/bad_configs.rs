@@ -202,7 +202,11 @@ fn cases() -> Vec<Case> {
         parse_case(
             "unknown drive key",
             set(&c, "drive", "f3", "1.0"),
-            &["drive.f3", "unknown key", "expected `f1` or `f2`"],
+            &[
+                "drive.f3",
+                "unknown key",
+                "expected one of `f1`, `f2`, `carrier_hz`",
+            ],
         ),
         parse_case(
             "misspelt board key",
@@ -1242,7 +1246,11 @@ fn a_file_with_several_bad_keys_gets_every_one_in_one_message() {
     assert_eq!(body[0], "config error: 4 problems:", "{msg}");
     for (line, needles) in body[1..].iter().zip([
         &["device.q", "= \"high\"", "expected a number"][..],
-        &["drive.f3", "unknown key", "expected `f1` or `f2`"],
+        &[
+            "drive.f3",
+            "unknown key",
+            "expected one of `f1`, `f2`, `carrier_hz`",
+        ],
         &["board.lpf_order", "= -4", "a non-negative integer"],
         &["experiment.average_s", "is missing"],
     ]) {

@@ -20,6 +20,8 @@ pub struct DrivenDevice {
     pub drive: [f64; 2],
     /// Error of the board's 90-degree phase shifter, degrees.
     pub phase_shifter_error_deg: f64,
+    /// Frequency of the drive's carrier, Hz (the resonance of mode 1 unless detuned).
+    pub carrier_hz: f64,
 }
 
 /// Phase lag of `x` behind the reference `x0`, in (-pi, pi]: `arg(x0 / x)` (the branch of
@@ -34,11 +36,12 @@ fn lag_rad(x: Complex64, x0: Complex64) -> f64 {
 }
 
 impl DrivenDevice {
-    /// Matched modes, equal Q, no quadrature coupling and an exact phase shifter: the closed
-    /// forms apply.
+    /// Matched modes, equal Q, no quadrature coupling, an exact phase shifter and a carrier at
+    /// the resonance: the closed forms apply.
     pub fn is_ideal(&self) -> bool {
         let p = &self.plant;
-        p.mode2.f0_hz == p.mode1.f0_hz
+        self.carrier_hz == p.mode1.f0_hz
+            && p.mode2.f0_hz == p.mode1.f0_hz
             && p.mode2.q == p.mode1.q
             && p.quadrature_coupling_rad2_s2 == 0.0
             && self.phase_shifter_error_deg == 0.0
@@ -58,7 +61,7 @@ impl DrivenDevice {
         }
         let shift = (90.0 + self.phase_shifter_error_deg) * DEG;
         let force = [Complex64::new(f1, 0.0), Complex64::from_polar(f2, -shift)];
-        let v = |w: f64| continuous_steady_state(p, w, self.f0(), force);
+        let v = |w: f64| continuous_steady_state(p, w, self.carrier_hz, force);
         let (x0, x) = (v(0.0), v(omega));
         [lag_rad(x[2], x0[2]), lag_rad(x[3], x0[3])]
     }
@@ -81,7 +84,7 @@ impl DrivenDevice {
         let v = |sign: f64| {
             let turn = Complex64::from_polar(1.0, -sign * eps);
             let force = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
-            continuous_steady_state(p, 0.0, self.f0() + sign * fm, force)
+            continuous_steady_state(p, 0.0, self.carrier_hz + sign * fm, force)
         };
         let (vp, vm) = (v(1.0), v(-1.0));
         let m = [
@@ -103,7 +106,7 @@ impl DrivenDevice {
         let force = self.coriolis_force();
         let v = |w: f64| {
             Resonator::<f64>::new(&self.plant, w)
-                .map(|r| r.held_steady_state(self.f0(), force))
+                .map(|r| r.held_steady_state(self.carrier_hz, force))
                 .unwrap_or([Complex64::new(f64::NAN, f64::NAN); 4])
         };
         let (x0, x) = (v(0.0), v(omega));
@@ -127,7 +130,7 @@ impl DrivenDevice {
         let v = |sign: f64| {
             let turn = Complex64::from_polar(1.0, -sign * eps);
             let force = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
-            plant.held_steady_state(self.f0() + sign * fm, force)
+            plant.held_steady_state(self.carrier_hz + sign * fm, force)
         };
         let (vp, vm) = (v(1.0), v(-1.0));
         let m = [
@@ -149,21 +152,20 @@ impl DrivenDevice {
     }
 
     /// The velocity envelopes of both modes on the rate table `amplitude sin(2 pi table_hz t)`
-    /// (rad/s), driven at `carrier_hz`: harmonics `-harmonics ..= harmonics` of `V_k(t)` in
+    /// (rad/s), driven at the carrier: harmonics `-harmonics ..= harmonics` of `V_k(t)` in
     /// `v_k = Re{V_k(t) e^{j w_c t}}`, from the plant's exact periodic steady state (harmonic
     /// balance, THEORY.md section 3).
     pub fn rate_table_envelopes(
         &self,
         amplitude_rad_s: f64,
         table_hz: f64,
-        carrier_hz: f64,
         harmonics: usize,
     ) -> [Vec<Complex64>; 2] {
         let x = rate_table_steady_state(
             &self.plant,
             amplitude_rad_s,
             table_hz,
-            carrier_hz,
+            self.carrier_hz,
             self.coriolis_force(),
             harmonics,
         );
@@ -176,12 +178,11 @@ impl DrivenDevice {
         &self,
         amplitude_rad_s: f64,
         table_hz: f64,
-        carrier_hz: f64,
         rel: f64,
         max: usize,
     ) -> Option<usize> {
         let n = max + 8;
-        let env = self.rate_table_envelopes(amplitude_rad_s, table_hz, carrier_hz, n);
+        let env = self.rate_table_envelopes(amplitude_rad_s, table_hz, n);
         let peak = env.iter().flatten().map(|v| v.norm()).fold(0.0, f64::max);
         let beyond = |k: usize| {
             env.iter()
@@ -193,21 +194,20 @@ impl DrivenDevice {
     }
 
     /// The exact phase response of each mode to the rate table `amplitude sin(2 pi table_hz
-    /// t)` (rad/s) with the drive at f0: the fundamental of the phase lag of the velocity's
+    /// t)` (rad/s) with the drive at the carrier: the fundamental of the phase lag of the velocity's
     /// periodic steady state (harmonic balance, at any swing), as `(amplitude rad, lag rad)`
     /// per mode, a lag `a sin(w_t t - l)` read as `(a, l)`. NaN when the envelope passes
     /// through 0 (no continuous phase).
     pub fn rate_table_response(&self, amplitude_rad_s: f64, table_hz: f64) -> ([f64; 2], [f64; 2]) {
         // Enough harmonics that the rest is below f64's resolution of the envelope: 24 for
         // swings up to tens of degrees, 48 beyond.
-        let f0 = self.f0();
-        let mut env = self.rate_table_envelopes(amplitude_rad_s, table_hz, f0, 24);
+        let mut env = self.rate_table_envelopes(amplitude_rad_s, table_hz, 24);
         let peak = env.iter().flatten().map(|v| v.norm()).fold(0.0, f64::max);
         if env
             .iter()
             .any(|h| h[2].norm().max(h[46].norm()) > 1e-17 * peak)
         {
-            env = self.rate_table_envelopes(amplitude_rad_s, table_hz, f0, 48);
+            env = self.rate_table_envelopes(amplitude_rad_s, table_hz, 48);
         }
         let x = env.map(|h| phase_fundamental(&h));
         let amp = x.map(|x| x.norm());

@@ -20,6 +20,7 @@ fn fork(q: f64) -> DrivenDevice {
         },
         drive: [1.0, 1.0],
         phase_shifter_error_deg: 0.0,
+        carrier_hz: 15e3,
     }
 }
 
