@@ -116,7 +116,7 @@ pub fn welch(x: &[f64], fs_hz: f64, segment_len: Option<usize>) -> Result<Psd, S
         .enumerate()
         .map(|(k, a)| {
             // Bin L/2 exists only for even L and is its own mirror image.
-            let both_signs = k > 0 && !(l % 2 == 0 && k == l / 2);
+            let both_signs = k > 0 && !(l.is_multiple_of(2) && k == l / 2);
             a * scale * if both_signs { 2.0 } else { 1.0 }
         })
         .collect();
