@@ -91,6 +91,21 @@ impl SignalRecorder {
         dst[m..].fill(f64::NAN);
     }
 
+    /// Sample rate, Hz.
+    pub fn fs_hz(&self) -> f64 {
+        self.fs_hz
+    }
+
+    /// First sample index of the window.
+    pub fn start(&self) -> u64 {
+        self.start
+    }
+
+    /// Time of sample index 0, s.
+    pub fn t0_s(&self) -> f64 {
+        self.t0_s
+    }
+
     /// Channel names in column order.
     pub fn names(&self) -> &[String] {
         &self.names

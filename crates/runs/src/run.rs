@@ -145,6 +145,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         only: req.shard.as_ref().map(|_| mine.clone()),
         cancel: Some(req.cancel.clone()),
         on_group: Some(&on_group),
+        dump: None,
     };
     let swept = match run_sweep_with(cfg, &|d, t| task.update(d, t), Some(out), opts) {
         Ok(s) => s,
@@ -160,7 +161,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
             return Err(e.into());
         }
     };
-    task.finish(Some(swept.point_samples));
+    task.finish_writing(Some(swept.point_samples), swept.written());
     let missing = mine.iter().filter(|i| !swept.lanes.contains_key(i)).count();
     if swept.cancelled || missing > 0 {
         let mut m = manifest("interrupted", &swept.lanes);
@@ -189,6 +190,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     let mut files = write_run(out, cfg, &r, &run_title(cfg))?;
     m.write(&manifest_path)?;
     files.push(manifest_path);
+    files.extend(swept.dump_files.iter().cloned());
     for w in &r.warnings {
         reporter.warn(w);
     }
