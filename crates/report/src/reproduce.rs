@@ -1,12 +1,16 @@
 //! `gyroemu reproduce`: the paper's Figs. 4, 5, 6, 8 and 9 from the emulated board, on the
 //! embedded presets, with the exact theory beside every point.
 
+use crate::dump_figures::write_dump_figures;
+use crate::dump_set::read_dump_set;
 use crate::error::{check_problems, create_dir, ReportError};
 use crate::sweep_report::{sweep_figure, theory_series, write_run};
 use gyroemu_analysis::bandwidth::{bandwidth, BANDWIDTH_AMPLITUDE_DPS, BANDWIDTH_FREQS_HZ};
 use gyroemu_config::presets::preset;
-use gyroemu_config::Config;
-use gyroemu_experiment::{run_sweep, Reporter, SweepResult};
+use gyroemu_config::{Config, DumpConfig};
+use gyroemu_experiment::{
+    finish_sweep, run_sweep_with, DumpPlan, Reporter, SweepOptions, SweepResult,
+};
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
 use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
 use gyroemu_theory::rate_table_gain;
@@ -15,6 +19,32 @@ use std::path::{Path, PathBuf};
 
 /// Averaging of Fig. 9 with `--quick`, s (the paper: 500 s).
 const QUICK_AVERAGE_S: f64 = 15.0;
+
+/// Most full-rate frames of the dump each experiment writes (about 1.6 MB in all formats).
+pub const DUMP_FULL_FRAMES: f64 = 4096.0;
+/// Most decimated frames of that dump (about 0.9 MB).
+pub const DUMP_DECIMATED_FRAMES: f64 = 2048.0;
+
+/// The dump `reproduce` records of an experiment: every node at the largest rate from the end
+/// of settling (the `[dump]` defaults), the full-rate window cut to [`DUMP_FULL_FRAMES`], the
+/// decimated one [`DUMP_DECIMATED_FRAMES`] long, both within the point's run.
+pub fn reproduce_dump(cfg: &Config) -> DumpPlan {
+    let mut with_dump = cfg.clone();
+    with_dump.dump = Some(DumpConfig {
+        rate_dps: None,
+        start_s: None,
+        duration_s: None,
+        nodes: None,
+    });
+    let d = DumpPlan::from_config(&with_dump).expect("the config has a dump section now");
+    let p = cfg.plan_point(d.rate_dps);
+    let end_s = (cfg.n_settle_out() + p.window.samples()) as f64 / cfg.fs_out_hz();
+    DumpPlan {
+        duration_s: d.duration_s.min(DUMP_FULL_FRAMES / cfg.fs_hz()),
+        decimated_duration_s: (DUMP_DECIMATED_FRAMES / cfg.fs_out_hz()).min(end_s - d.start_s),
+        ..d
+    }
+}
 
 struct Job {
     preset: &'static str,
@@ -101,9 +131,20 @@ pub fn reproduce(
     let mut results = Vec::new();
     for job in jobs {
         let progress = reporter.task(job.preset);
-        let r = run_sweep(&job.cfg, &|d, t| progress.update(d, t), None)?;
-        progress.finish(Some(r.point_samples));
-        files.extend(write_run(&out.join(job.preset), &job.cfg, &r, job.title)?);
+        let dir = out.join(job.preset);
+        create_dir(&dir)?;
+        // The dump only records: the results are those of a run without it.
+        let opts = SweepOptions {
+            dump: Some(reproduce_dump(&job.cfg)),
+            ..Default::default()
+        };
+        let run = run_sweep_with(&job.cfg, &|d, t| progress.update(d, t), Some(&dir), opts)?;
+        let r = finish_sweep(&job.cfg, &run.lanes)?;
+        progress.finish_writing(Some(r.point_samples), run.written());
+        files.extend(write_run(&dir, &job.cfg, &r, job.title)?);
+        files.extend(run.dump_files.iter().cloned());
+        let set = read_dump_set(&dir.join("dump"))?;
+        files.extend(write_dump_figures(&set, &dir)?);
         for w in &r.warnings {
             reporter.warn(&format!("{}: {w}", job.preset));
         }
