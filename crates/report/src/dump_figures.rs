@@ -81,8 +81,8 @@ fn heading(set: &DumpSet) -> String {
     format!("{}{rate}", short.join("/"))
 }
 
-/// The time-domain panels and the figure's title.
-fn signal_panels(set: &DumpSet) -> (String, Vec<Figure>) {
+/// The panels of `signals.png` and its title.
+pub fn signal_panels(set: &DumpSet) -> (String, Vec<Figure>) {
     let mut panels = Vec::new();
     let mut zero = Vec::new();
     for (d, decimated) in set
@@ -284,8 +284,8 @@ fn spectrum_panel(
     Some(f)
 }
 
-/// The spectrum panels and the figure's title.
-fn spectrum_panels(set: &DumpSet) -> (String, Vec<Figure>) {
+/// The panels of `spectrum.png` and its title.
+pub fn spectrum_panels(set: &DumpSet) -> (String, Vec<Figure>) {
     let mut panels = Vec::new();
     let full_groups = set.full.as_ref().map(groups).unwrap_or_default();
     if let Some(d) = &set.full {

@@ -157,6 +157,18 @@ pub const NODES: [Node; 8] = [
     },
 ];
 
+/// The unit of a channel: the recording's, or for a board node whose name carries none (the
+/// drive, the mixer and low-pass I/Q) the node's.
+pub fn channel_unit<'a>(name: &str, recorded: &'a str) -> &'a str {
+    if !recorded.is_empty() {
+        return recorded;
+    }
+    NODES
+        .iter()
+        .find(|n| n.channels.contains(&name))
+        .map_or(recorded, |n| n.unit)
+}
+
 /// One panel's worth of channels of a recording: `(title, unit, [(name, samples)])`. The
 /// board's nodes first; any other channel gets a panel of its own.
 pub fn groups(d: &Dump) -> Vec<(String, String, Vec<(&str, &[f64])>)> {
@@ -179,7 +191,7 @@ pub fn groups(d: &Dump) -> Vec<(String, String, Vec<(&str, &[f64])>)> {
     for (k, c) in d.channels.iter().enumerate().filter(|(k, _)| !used[*k]) {
         out.push((
             c.name.clone(),
-            c.unit.clone(),
+            channel_unit(&c.name, &c.unit).to_string(),
             vec![(c.name.as_str(), d.data[k].as_slice())],
         ));
     }

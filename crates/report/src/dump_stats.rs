@@ -1,8 +1,8 @@
 //! What `gyroemu inspect` prints about a dump: per channel the RMS, the peak and the
 //! strongest tones (frequency and level).
 
-use crate::dump_figures::db_unit;
-use crate::dump_set::DumpSet;
+use crate::dump_figures::{db_unit, SPECTRUM_RANGE_DB};
+use crate::dump_set::{channel_unit, DumpSet};
 use gyroemu_spectrum::{find_tones, welch, Tone};
 
 /// Tones listed per channel.
@@ -21,7 +21,8 @@ pub struct ChannelStats {
     pub rms: f64,
     /// Largest |sample|.
     pub peak: f64,
-    /// The strongest tones, strongest first (empty when the spectrum cannot be computed).
+    /// The strongest tones, strongest first, within [`SPECTRUM_RANGE_DB`] of the first (empty
+    /// when the spectrum cannot be computed).
     pub tones: Vec<Tone>,
     /// Why there are no tones, when the spectrum was refused (e.g. non-finite samples).
     pub spectrum_error: Option<String>,
@@ -36,13 +37,17 @@ pub fn channel_stats(d: &gyroemu_io::Dump) -> Vec<ChannelStats> {
             let n = x.len().max(1) as f64;
             let rms = (x.iter().map(|v| v * v).sum::<f64>() / n).sqrt();
             let peak = x.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
-            let (tones, spectrum_error) = match welch(x, d.sample_rate_hz, None) {
+            let (mut tones, spectrum_error) = match welch(x, d.sample_rate_hz, None) {
                 Ok(p) => (find_tones(&p, TONES_LISTED, TONE_MIN_SNR_DB), None),
                 Err(e) => (Vec::new(), Some(e.to_string())),
             };
+            // Below that range lies f64 arithmetic's own floor, not the signal.
+            if let Some(top) = tones.first().map(Tone::level_db) {
+                tones.retain(|t| t.level_db() >= top - SPECTRUM_RANGE_DB);
+            }
             ChannelStats {
                 name: c.name.clone(),
-                unit: c.unit.clone(),
+                unit: channel_unit(&c.name, &c.unit).to_string(),
                 rms,
                 peak,
                 tones,
@@ -57,11 +62,14 @@ pub fn inspect_text(set: &DumpSet) -> String {
     let mut out = String::new();
     for d in set.recordings() {
         let n = d.frames();
+        // A rate read from a CSV's time column carries its rounding: show it to 12 digits.
+        let fs = format!("{:.12e}", d.sample_rate_hz)
+            .parse::<f64>()
+            .unwrap_or(d.sample_rate_hz);
         out.push_str(&format!(
-            "{}: {} channel(s), {n} samples at {} Hz, t = {:.6} .. {:.6} s\n",
+            "{}: {} channel(s), {n} samples at {fs} Hz, t = {:.6} .. {:.6} s\n",
             d.path.display(),
             d.channels.len(),
-            d.sample_rate_hz,
             d.time_s(0),
             d.time_s(n.saturating_sub(1)),
         ));
@@ -72,7 +80,7 @@ pub fn inspect_text(set: &DumpSet) -> String {
         for s in channel_stats(d) {
             let tones = match (&s.spectrum_error, s.tones.is_empty()) {
                 (Some(e), _) => format!("no spectrum: {e}"),
-                (None, true) => "none 20 dB above the floor".into(),
+                (None, true) => format!("none {TONE_MIN_SNR_DB} dB above the median bin"),
                 (None, false) => s
                     .tones
                     .iter()
