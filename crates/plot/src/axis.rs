@@ -82,23 +82,32 @@ impl AxisScale {
         }
     }
 
-    /// Logarithmic axis over the positive finite values of `vals`: whole decades around them
-    /// (at least one), padded by 2 % of the span; `[1, 10]` when there is none.
+    /// Logarithmic axis over the positive finite values of `vals`: their span in decades with
+    /// 5 % margins when that holds two whole decades or more (each gets a tick), else the
+    /// whole decades around them (at least one) with 2 % margins; `[1, 10]` when there is no
+    /// positive value.
     pub fn log_from_values(vals: impl IntoIterator<Item = f64>) -> Self {
-        let (lo, hi) = match finite_bounds(vals.into_iter().filter(|v| *v > 0.0).map(f64::log10)) {
-            None => (0.0, 1.0),
+        let logs = vals.into_iter().filter(|v| *v > 0.0).map(f64::log10);
+        let (lo, hi) = match finite_bounds(logs) {
+            None => (-0.02, 1.02),
             Some((lo, hi)) => {
-                let (lo, mut hi) = (lo.floor(), hi.ceil());
-                if hi <= lo {
-                    hi = lo + 1.0;
+                let pad = MARGIN_FRACTION * (hi - lo);
+                let (tlo, thi) = (lo - pad, hi + pad);
+                if thi.floor() - tlo.ceil() >= 1.0 {
+                    (tlo, thi)
+                } else {
+                    let (lo, mut hi) = (lo.floor(), hi.ceil());
+                    if hi <= lo {
+                        hi = lo + 1.0;
+                    }
+                    let pad = 0.02 * (hi - lo);
+                    (lo - pad, hi + pad)
                 }
-                (lo, hi)
             }
         };
-        let pad = 0.02 * (hi - lo);
         AxisScale {
-            lo: lo - pad,
-            hi: hi + pad,
+            lo,
+            hi,
             exp10: 0,
             decimals: 0,
             log: true,
@@ -268,11 +277,10 @@ mod tests {
     fn log_axes_span_whole_decades_and_tick_on_them() {
         let a = AxisScale::log_from_values([3e-9, 0.0, -1.0, f64::NAN, 2e-2]);
         assert!(a.log && a.exp10 == 0);
-        // Decades -9 .. -1, padded by 2 % of 8 decades.
-        assert!(
-            (a.lo + 9.16).abs() < 1e-12 && (a.hi + 0.84).abs() < 1e-12,
-            "{a:?}"
-        );
+        // The data's decades with 5 % margins: they hold the ticks -8 .. -2.
+        let (l, h) = (3e-9f64.log10(), 2e-2f64.log10());
+        let pad = 0.05 * (h - l);
+        assert!((a.lo - (l - pad)).abs() < 1e-12 && (a.hi - (h + pad)).abs() < 1e-12);
         assert!((a.map(1e-5) + 5.0).abs() < 1e-12);
         assert!(a.map(0.0).is_nan() && a.map(-3.0).is_nan());
         assert_eq!(a.label(-5.0), "10⁻⁵");
@@ -289,9 +297,12 @@ mod tests {
                 assert!(a.lo <= *t && *t <= a.hi);
             }
         }
-        assert_eq!(
-            a.ticks(10),
-            [-9.0, -8.0, -7.0, -6.0, -5.0, -4.0, -3.0, -2.0, -1.0]
+        assert_eq!(a.ticks(10), [-8.0, -7.0, -6.0, -5.0, -4.0, -3.0, -2.0]);
+        // Less than two decades of data: whole decades around them.
+        let c = AxisScale::log_from_values([0.08, 0.7]);
+        assert!(
+            (c.lo + 2.04).abs() < 1e-12 && (c.hi - 0.04).abs() < 1e-12,
+            "{c:?}"
         );
         // One value: one whole decade around it; nothing positive: 10^0 .. 10^1.
         let b = AxisScale::log_from_values([5.0]);

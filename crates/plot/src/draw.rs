@@ -384,7 +384,7 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
 }
 
 /// Dashed grey vertical lines at the figure's markers inside the frame `(x0, x1, y0, y1)`,
-/// each labelled near the top; labels step down so neighbours do not overwrite each other,
+/// each labelled near the bottom; labels step up so neighbours do not overwrite each other,
 /// and sit left of their line in the right third of the plot.
 fn draw_markers(
     area: &Area,
@@ -395,7 +395,7 @@ fn draw_markers(
 ) -> DrawResult {
     let px = |v: f64| (v * s).round().max(1.0) as i32;
     let colour = RGBColor(70, 70, 70);
-    let font = text(13.0 * s).color(&colour);
+    let font = text(14.0 * s).color(&colour);
     let (_, th) = area.estimate_text_size("Hg", &font)?;
     let mut placed: Vec<(i32, i32)> = Vec::new();
     for m in &fig.markers {
@@ -432,7 +432,8 @@ fn draw_markers(
             row += 1;
         }
         placed.push((row, tx));
-        let ty = y0 + px(4.0) + row * (th as i32 + px(2.0));
+        // Rows stack up from the bottom of the plot, away from peaks and the legend.
+        let ty = y1 - px(4.0) - th as i32 - row * (th as i32 + px(2.0));
         area.draw(&Rectangle::new(
             [
                 (tx - px(1.0), ty),

@@ -169,8 +169,11 @@ pub fn render_panels_png(
             root.clone()
         } else {
             let s = text_scale(width_px, height_px) * ss;
+            // A long title shrinks to fit the width (down to half its size).
+            let (tw, _) = root.estimate_text_size(title, &bold(24.0 * s))?;
+            let fit = (0.96 * f64::from(width_px) * ss / tw.max(1) as f64).clamp(0.5, 1.0);
             root.margin((10.0 * s).round() as i32, 0, 0, 0)
-                .titled(title, bold(24.0 * s))?
+                .titled(title, bold(24.0 * s * fit))?
         };
         for (cell, fig) in body.split_evenly((rows, cols)).iter().zip(panels) {
             draw_figure(cell, fig, ss)?;

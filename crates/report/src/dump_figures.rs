@@ -4,7 +4,7 @@
 //! rotating excitation's sidebands, the 2 f0 mixer product and the low-pass residual marked
 //! and their levels read by the tone finder.
 
-use crate::dump_set::{groups, DumpSet};
+use crate::dump_set::{groups, DumpSet, Group};
 use crate::error::ReportError;
 use gyroemu_io::Dump;
 use gyroemu_plot::{render_panels_png, Figure, Series, SeriesStyle};
@@ -48,19 +48,17 @@ fn density_unit(unit: &str) -> String {
 
 /// Writes `signals.png` and `spectrum.png` of `set` into `dir`; returns their paths.
 pub fn write_dump_figures(set: &DumpSet, dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
-    let (sig_title, sig) = signal_panels(set);
-    let (spec_title, spec) = spectrum_panels(set);
-    let mut files = Vec::new();
-    for (file, title, panels) in [
-        ("signals.png", sig_title, sig),
-        ("spectrum.png", spec_title, spec),
-    ] {
+    let render = |file: &str, (title, panels): (String, Vec<Figure>)| {
         let path = dir.join(file);
         let rows = panels.len().div_ceil(2).max(1) as u32;
-        render_panels_png(&title, &panels, 2, WIDTH_PX, 80 + ROW_PX * rows, &path)?;
-        files.push(path);
-    }
-    Ok(files)
+        render_panels_png(&title, &panels, 2, WIDTH_PX, 80 + ROW_PX * rows, &path).map(|_| path)
+    };
+    // The two figures are independent: draw them on two threads.
+    let (a, b) = rayon::join(
+        || render("signals.png", signal_panels(set)),
+        || render("spectrum.png", spectrum_panels(set)),
+    );
+    Ok(vec![a?, b?])
 }
 
 /// "m2tfg-rotating/dump at 175 deg/s": the dump's folder and name, and the operating point
@@ -310,8 +308,6 @@ pub fn spectrum_panels(set: &DumpSet) -> (String, Vec<Figure>) {
     );
     (title, panels)
 }
-
-type Group<'a> = (String, String, Vec<(&'a str, &'a [f64])>);
 
 /// The low-pass output's channels of a decimated recording.
 fn lowpass_group(d: &Dump) -> Option<Group<'_>> {

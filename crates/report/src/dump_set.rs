@@ -169,9 +169,12 @@ pub fn channel_unit<'a>(name: &str, recorded: &'a str) -> &'a str {
         .map_or(recorded, |n| n.unit)
 }
 
+/// A panel's title, its unit and its channels `(name, samples)`.
+pub type Group<'a> = (String, String, Vec<(&'a str, &'a [f64])>);
+
 /// One panel's worth of channels of a recording: `(title, unit, [(name, samples)])`. The
 /// board's nodes first; any other channel gets a panel of its own.
-pub fn groups(d: &Dump) -> Vec<(String, String, Vec<(&str, &[f64])>)> {
+pub fn groups(d: &Dump) -> Vec<Group<'_>> {
     let mut out = Vec::new();
     let mut used = vec![false; d.channels.len()];
     for node in &NODES {

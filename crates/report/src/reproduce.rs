@@ -14,6 +14,7 @@ use gyroemu_experiment::{
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
 use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
 use gyroemu_theory::rate_table_gain;
+use rayon::prelude::*;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -129,6 +130,8 @@ pub fn reproduce(
     let (jobs, quick) = (&plan.jobs, plan.quick);
     let mut files = Vec::new();
     let mut results = Vec::new();
+    // Where each experiment's dump figures go in the list, and its folder.
+    let mut dump_dirs = Vec::new();
     for job in jobs {
         let progress = reporter.task(job.preset);
         let dir = out.join(job.preset);
@@ -143,13 +146,22 @@ pub fn reproduce(
         progress.finish_writing(Some(r.point_samples), run.written());
         files.extend(write_run(&dir, &job.cfg, &r, job.title)?);
         files.extend(run.dump_files.iter().cloned());
-        let set = read_dump_set(&dir.join("dump"))?;
-        files.extend(write_dump_figures(&set, &dir)?);
+        dump_dirs.push((files.len(), dir));
         for w in &r.warnings {
             reporter.warn(&format!("{}: {w}", job.preset));
         }
         check_problems(job.preset, &r.problems)?;
         results.push(r);
+    }
+    // The dumps' figures, read back from the files, drawn in parallel once every sweep is
+    // done (so they do not compete with the emulation for the cores).
+    let figures: Vec<Result<Vec<PathBuf>, ReportError>> = dump_dirs
+        .par_iter()
+        .map(|(_, dir)| write_dump_figures(&read_dump_set(&dir.join("dump"))?, dir))
+        .collect();
+    for ((at, _), figs) in dump_dirs.iter().zip(figures).rev() {
+        let figs = figs?;
+        files.splice(at..at, figs);
     }
     let get = |name: &str| {
         let i = jobs.iter().position(|j| j.preset == name).unwrap_or(0);
@@ -258,8 +270,9 @@ fn bandwidth_outputs(base: &Config, out: &Path) -> Result<(Figure, PathBuf), Rep
     )?;
     let theory = |f: f64| rate_table_gain(d.f0_hz, d.q, d.angular_gain, 1.0, 1.0, f);
     let fmax = BANDWIDTH_FREQS_HZ[BANDWIDTH_FREQS_HZ.len() - 1];
+    // Log-spaced: the figure's axes are logarithmic (a low-pass is a line in decades).
     let fs: Vec<f64> = (0..=200)
-        .map(|i| 0.01 + (fmax - 0.01) * i as f64 / 200.0)
+        .map(|i| 0.01 * (fmax / 0.01).powf(i as f64 / 200.0))
         .collect();
     let corner = d.f0_hz / (2.0 * d.q);
     let figure = Figure::new(
@@ -270,6 +283,8 @@ fn bandwidth_outputs(base: &Config, out: &Path) -> Result<(Figure, PathBuf), Rep
         "Rate-table frequency (Hz)",
         "Phase amplitude per unit rate (deg per deg/s)",
     )
+    .log_x()
+    .log_y()
     .with(Series {
         name: format!("mode 1 emulated ({BANDWIDTH_AMPLITUDE_DPS} deg/s amplitude)"),
         style: SeriesStyle::Points,
