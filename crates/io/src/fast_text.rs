@@ -20,101 +20,35 @@ pub(crate) fn push_f64(x: f64, out: &mut Vec<u8>) {
     }
     let mut buf = ryu::Buffer::new();
     let text = buf.format_finite(x).as_bytes();
-    // ryu writes [-]digits[.digits][e[-]exp]: collect the significant digits and the decimal
-    // exponent `e` of the first one (value = d.ddd x 10^e).
-    let (neg, text) = match text.split_first() {
-        Some((b'-', rest)) => (true, rest),
-        _ => (false, text),
-    };
-    let (mantissa, exp_part) = match text.iter().position(|&b| b == b'e') {
+    // ryu switches to d.ddde-x below 1e-5 and at 1e16 and above, where format_f64 switches to
+    // `{:e}`, whose layout is the same; in between it writes integers with a ".0" that `{}`
+    // leaves out. Only the digits of an exact tie can differ.
+    if ryu_rounded_a_tie_down(x, digits_after_point(text)) {
+        let mut s = String::new();
+        crate::format_f64(x, &mut s);
+        out.extend_from_slice(s.as_bytes());
+        return;
+    }
+    out.extend_from_slice(text.strip_suffix(b".0").unwrap_or(text));
+}
+
+/// How many digits of ryu's `text` lie after the decimal point of the value (negative when
+/// the last significant digit is left of it: "1200.0" gives -2, "1.5e3" gives -2).
+fn digits_after_point(text: &[u8]) -> i32 {
+    let (mant, exp) = match text.iter().position(|&b| b == b'e') {
         Some(i) => (&text[..i], parse_exp(&text[i + 1..])),
         None => (text, 0),
     };
-    let mut digits = [0u8; 24];
-    let mut nd = 0;
-    let mut int_len = 0i32;
-    let mut seen_point = false;
-    let mut leading = true;
-    let mut lead_zeros_after_point = 0i32;
-    for &b in mantissa {
-        if b == b'.' {
-            seen_point = true;
-            continue;
+    let frac = match mant.iter().position(|&b| b == b'.') {
+        Some(i) if &mant[i..] == b".0" => {
+            // An integer: its trailing zeros are not significant.
+            let int = &mant[..i];
+            -(int.iter().rev().take_while(|&&b| b == b'0').count() as i32)
         }
-        if leading && b == b'0' {
-            if seen_point {
-                lead_zeros_after_point += 1;
-            }
-            continue;
-        }
-        leading = false;
-        digits[nd] = b;
-        nd += 1;
-        if !seen_point {
-            int_len += 1;
-        }
-    }
-    while nd > 1 && digits[nd - 1] == b'0' {
-        nd -= 1;
-    }
-    let mut e = if int_len > 0 {
-        int_len - 1
-    } else {
-        -lead_zeros_after_point - 1
-    } + exp_part;
-    if ryu_rounded_a_tie_down(x, nd as i32 - 1 - e) {
-        // Rust rounds an exact tie up where ryu rounds it to even: add one in the last place.
-        let mut i = nd;
-        loop {
-            if i == 0 {
-                // 9.99 -> 10.0: one more digit in front, the rest are zeros.
-                digits[0] = b'1';
-                nd = 1;
-                e += 1;
-                break;
-            }
-            i -= 1;
-            if digits[i] == b'9' {
-                digits[i] = b'0';
-            } else {
-                digits[i] += 1;
-                break;
-            }
-        }
-        while nd > 1 && digits[nd - 1] == b'0' {
-            nd -= 1;
-        }
-    }
-    if neg {
-        out.push(b'-');
-    }
-    let d = &digits[..nd];
-    let a = x.abs();
-    if (1e-5..1e16).contains(&a) {
-        if e >= 0 {
-            let int_digits = e as usize + 1;
-            if nd <= int_digits {
-                out.extend_from_slice(d);
-                out.resize(out.len() + int_digits - nd, b'0');
-            } else {
-                out.extend_from_slice(&d[..int_digits]);
-                out.push(b'.');
-                out.extend_from_slice(&d[int_digits..]);
-            }
-        } else {
-            out.extend_from_slice(b"0.");
-            out.resize(out.len() + (-e - 1) as usize, b'0');
-            out.extend_from_slice(d);
-        }
-    } else {
-        out.push(d[0]);
-        if nd > 1 {
-            out.push(b'.');
-            out.extend_from_slice(&d[1..]);
-        }
-        out.push(b'e');
-        push_i64(i64::from(e), out);
-    }
+        Some(i) => (mant.len() - i - 1) as i32,
+        None => 0,
+    };
+    frac - exp
 }
 
 /// Whether |x| lies exactly halfway between two decimals with `m` digits after the point
