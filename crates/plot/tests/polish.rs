@@ -64,6 +64,36 @@ fn downsampling_keeps_the_mean_intensity() {
     );
     // A uniform block stays exactly its value.
     assert_eq!(downsample_rgb(&[7u8; 12], 2, 2, 2), vec![7, 7, 7]);
+    // The 2 x 2 fast path equals the general block average (k = 2 against a direct sum).
+    let out2 = downsample_rgb(&src, w, h, 2);
+    for oy in 0..h / 2 {
+        for ox in 0..w / 2 {
+            for c in 0..3 {
+                let at = |x: usize, y: usize| u32::from(src[(y * w + x) * 3 + c]);
+                let sum = at(2 * ox, 2 * oy)
+                    + at(2 * ox + 1, 2 * oy)
+                    + at(2 * ox, 2 * oy + 1)
+                    + at(2 * ox + 1, 2 * oy + 1);
+                assert_eq!(u32::from(out2[(oy * (w / 2) + ox) * 3 + c]), (sum + 2) / 4);
+            }
+        }
+    }
+    // k = 3 (the general path) on a 6 x 3 image: two output pixels.
+    let px: Vec<u8> = (0..54).map(|i| (i * 5) as u8).collect();
+    let o3 = downsample_rgb(&px, 6, 3, 3);
+    let want = |ox: usize, c: usize| {
+        let s: u32 = (0..3)
+            .flat_map(|y| (0..3).map(move |x| (x, y)))
+            .map(|(x, y)| u32::from(px[(y * 6 + 3 * ox + x) * 3 + c]))
+            .sum();
+        ((s + 4) / 9) as u8
+    };
+    assert_eq!(
+        o3,
+        (0..2)
+            .flat_map(|ox| (0..3).map(move |c| want(ox, c)))
+            .collect::<Vec<_>>()
+    );
 }
 
 #[test]

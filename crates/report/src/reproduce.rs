@@ -21,10 +21,11 @@ use std::path::{Path, PathBuf};
 /// Averaging of Fig. 9 with `--quick`, s (the paper: 500 s).
 const QUICK_AVERAGE_S: f64 = 15.0;
 
-/// Most full-rate frames of the dump each experiment writes (about 1.6 MB in all formats).
-pub const DUMP_FULL_FRAMES: f64 = 4096.0;
-/// Most decimated frames of that dump (about 0.9 MB).
-pub const DUMP_DECIMATED_FRAMES: f64 = 2048.0;
+/// Most full-rate frames of the dump each experiment writes (12 channels: about 0.8 MB in
+/// all formats; 128 carrier periods at 16 samples per period, Welch bins of fs/512).
+pub const DUMP_FULL_FRAMES: f64 = 2048.0;
+/// Most decimated frames of that dump (14 channels: about 0.5 MB).
+pub const DUMP_DECIMATED_FRAMES: f64 = 1024.0;
 
 /// The dump `reproduce` records of an experiment: every node at the largest rate from the end
 /// of settling (the `[dump]` defaults), the full-rate window cut to [`DUMP_FULL_FRAMES`], the
