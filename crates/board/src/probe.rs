@@ -6,7 +6,8 @@ use gyroemu_core::{Sample, Stage};
 use gyroemu_io::{IoError, SignalRecorder};
 use gyroemu_mixer::{Iq, Stage2Mixer};
 use gyroemu_resonator::PlantOutput;
-use std::path::Path;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 /// Which nodes to record, and the recorders for the full-rate and decimated nodes.
 pub struct Probe {
@@ -102,6 +103,26 @@ impl Probe {
             check_lanes: 0,
             fault: None,
         }
+    }
+
+    /// Records the decimated nodes over `duration_s` from the same start instead of the
+    /// full-rate window's length: the slow nodes (low-pass, stage 2) cost a decimation's
+    /// fraction per second, so they can cover a modulation period the full rate cannot.
+    pub fn with_decimated_duration(mut self, duration_s: f64) -> Self {
+        let fs_out = self.decimated.fs_hz();
+        let start = self.decimated.start();
+        let names = self.decimated.names().to_vec();
+        let t0 = self.decimated.t0_s();
+        let len = (duration_s * fs_out).round().max(1.0) as u64;
+        self.decimated = SignalRecorder::new(names, fs_out, start, len).with_time_origin(t0);
+        self
+    }
+
+    /// Describes the operating point in both recordings' SigMF metadata (`gyroemu:<key>`).
+    pub fn with_extra(mut self, extra: BTreeMap<String, f64>) -> Self {
+        self.full = self.full.with_extra(extra.clone());
+        self.decimated = self.decimated.with_extra(extra);
+        self
     }
 
     /// A probe that records nothing and checks that every node of the first `lanes` lanes
@@ -251,14 +272,16 @@ impl Probe {
             .collect()
     }
 
-    /// Writes `<stem>_fullrate.*` and `<stem>_decimated.*` (CSV, WAV, SigMF) into `dir`.
-    pub fn write(&self, dir: &Path, stem: &str) -> Result<(), IoError> {
+    /// Writes `<stem>_fullrate.{csv,wav,sigmf-data,sigmf-meta}` and the same of
+    /// `<stem>_decimated` into `dir` (each when it has channels); returns the paths written.
+    pub fn write(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, IoError> {
+        let mut files = Vec::new();
         if !self.full.names().is_empty() {
-            self.full.write(dir, &format!("{stem}_fullrate"))?;
+            files.extend(self.full.write(dir, &format!("{stem}_fullrate"))?);
         }
         if !self.decimated.names().is_empty() {
-            self.decimated.write(dir, &format!("{stem}_decimated"))?;
+            files.extend(self.decimated.write(dir, &format!("{stem}_decimated"))?);
         }
-        Ok(())
+        Ok(files)
     }
 }

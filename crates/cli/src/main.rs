@@ -88,6 +88,17 @@ enum Command {
         #[arg(long, default_value_t = 5)]
         repeats: usize,
     },
+    /// Print each channel's RMS, peak and strongest tones of a signal dump, and render its
+    /// signals.png (nodes in time) and spectrum.png (Welch spectra, carrier and sidebands
+    /// marked).
+    Inspect {
+        /// The dump: a .sigmf-meta, .sigmf-data or .csv file, their common stem, the stem of
+        /// a `_fullrate`/`_decimated` pair (e.g. out/dump), or a folder holding dump_*.
+        dump: PathBuf,
+        /// Folder for the figures (default: the dump's own folder).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Print a complete, commented config that `run` accepts.
     Config {
         /// Preset name (default: m2tfg-coriolis); `--list` shows them.
@@ -196,6 +207,7 @@ fn run_cli() -> ExitCode {
             Some(path) => cmd::config::resolved_command(&path),
             None => cmd::config::config_command(preset.as_deref(), list),
         },
+        Command::Inspect { dump, out } => cmd::inspect::inspect_command(&dump, out.as_deref()),
         Command::Bench {
             preset,
             samples,

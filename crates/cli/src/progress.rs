@@ -1,6 +1,6 @@
 //! Progress on long runs: a bar on a terminal, a periodic log line otherwise (CI, pipes).
 
-use gyroemu_experiment::{Reporter, Task};
+use gyroemu_experiment::{Reporter, Task, Written};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::Mutex;
@@ -58,17 +58,14 @@ impl Progress {
         }
     }
 
-    /// Closes the bar and prints the throughput.
-    fn finish_counted(&self, point_samples: u64) {
+    /// Closes the bar and prints the emulation's throughput, then what writing the dumps
+    /// took (its time is not counted as emulation).
+    fn finish_counted(&self, point_samples: u64, written: Written) {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
         }
-        let s = self.start.elapsed().as_secs_f64();
-        eprintln!(
-            "{}: {point_samples} point-samples in {s:.1} s ({:.0} M point-samples/s)",
-            self.label,
-            point_samples as f64 / s.max(1e-9) / 1e6
-        );
+        let s = (self.start.elapsed().as_secs_f64() - written.seconds).max(0.0);
+        eprintln!("{}", counted_line(&self.label, point_samples, s, written));
     }
 
     /// Closes the bar and prints the elapsed time (for runs whose size is not in point-samples).
@@ -84,13 +81,36 @@ impl Progress {
     }
 }
 
+/// `label: N point-samples in T s (R M point-samples/s)`, then `; writing dumps: X MB in
+/// Y s (Z MB/s)` when files were written. Emulation and writing are timed apart: a dump's
+/// CSV can take longer to write than the emulation that produced it.
+pub fn counted_line(label: &str, point_samples: u64, emulation_s: f64, written: Written) -> String {
+    let mut line = format!(
+        "{label}: {point_samples} point-samples in {emulation_s:.1} s ({:.0} M point-samples/s)",
+        point_samples as f64 / emulation_s.max(1e-9) / 1e6
+    );
+    if written.files > 0 {
+        let mb = written.bytes as f64 / 1e6;
+        line.push_str(&format!(
+            "; writing dumps: {mb:.1} MB in {} files in {:.2} s ({:.0} MB/s)",
+            written.files,
+            written.seconds,
+            mb / written.seconds.max(1e-9)
+        ));
+    }
+    line
+}
+
 impl Task for Progress {
     fn update(&self, done: u64, total: u64) {
         self.update_now(done, total);
     }
     fn finish(&self, point_samples: Option<u64>) {
+        self.finish_writing(point_samples, Written::default());
+    }
+    fn finish_writing(&self, point_samples: Option<u64>, written: Written) {
         match point_samples {
-            Some(n) => self.finish_counted(n),
+            Some(n) => self.finish_counted(n, written),
             None => self.finish_elapsed(),
         }
     }

@@ -183,14 +183,69 @@ fn reproduce_quick_writes_every_figure_and_the_slope_ratio() {
     ] {
         assert!(out.join(f).metadata().unwrap().len() > 1000, "{f}");
     }
+    // Every file on disk is in the closing list, and each experiment has its small dump of
+    // every node and the two figures drawn from it.
+    let listed: std::collections::BTreeSet<String> = stderr(&o)
+        .lines()
+        .skip_while(|l| !l.starts_with("wrote "))
+        .skip(1)
+        .map(|l| l.trim().to_string())
+        .collect();
+    let mut on_disk = std::collections::BTreeSet::new();
+    for e in std::fs::read_dir(&out).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        if p.is_dir() {
+            for f in std::fs::read_dir(&p).unwrap() {
+                let f = f.unwrap().file_name().to_string_lossy().into_owned();
+                on_disk.insert(format!("{name}/{f}"));
+            }
+        } else {
+            on_disk.insert(name);
+        }
+    }
+    assert_eq!(listed, on_disk, "{}", stderr(&o));
     for d in [
         "m2tfg-coriolis",
         "m2tfg-rotating",
         "baw-coriolis",
         "baw-rotating",
+        "m2tfg-ratetable",
     ] {
         assert!(out.join(d).join("results.csv").exists(), "{d}");
+        let mut dump_bytes = 0;
+        for stem in ["dump_fullrate", "dump_decimated"] {
+            for ext in ["csv", "wav", "sigmf-data", "sigmf-meta"] {
+                let p = out.join(d).join(format!("{stem}.{ext}"));
+                dump_bytes += p.metadata().unwrap_or_else(|_| panic!("{p:?}")).len();
+            }
+        }
+        assert!(dump_bytes < 4_000_000, "{d}: dump of {dump_bytes} bytes");
+        for f in ["signals.png", "spectrum.png"] {
+            assert!(
+                out.join(d).join(f).metadata().unwrap().len() > 10_000,
+                "{d}/{f}"
+            );
+        }
     }
+    // Emulation and writing are reported apart.
+    assert!(stderr(&o).contains("; writing dumps: "), "{}", stderr(&o));
+    // inspect reads a dump back: the Coriolis drive is F1 cos(w0 t) with F1 = 1, a tone of
+    // -3.01 dB re 1 m/s^2 rms at f0 = 15 kHz.
+    let o = gyroemu(&[
+        "inspect",
+        out.join("m2tfg-coriolis").to_str().unwrap(),
+        "--out",
+        dir.path().join("insp").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    let drive = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("drive1"))
+        .unwrap();
+    assert!(drive.contains("15000.0: -3.0 dB re 1 m/s²"), "{drive}");
+    assert!(dir.path().join("insp").join("spectrum.png").exists());
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     // Fig. 6: the Coriolis slope over the rotating slope is lambda.
@@ -204,6 +259,43 @@ fn reproduce_quick_writes_every_figure_and_the_slope_ratio() {
             "{fig}"
         );
     }
+}
+
+#[test]
+fn inspect_refuses_missing_or_damaged_dumps_with_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nothing.sigmf-meta");
+    let o = gyroemu(&["inspect", missing.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("nothing.sigmf-meta"), "{}", stderr(&o));
+    let bad = dir.path().join("bad.sigmf-meta");
+    std::fs::write(
+        &bad,
+        r#"{"global": {"core:datatype": "rf64_le", "core:sample_rate": -1}}"#,
+    )
+    .unwrap();
+    let o = gyroemu(&["inspect", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("core:sample_rate = -1"),
+        "{}",
+        stderr(&o)
+    );
+    let o = gyroemu(&["inspect", dir.path().to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no dump there"), "{}", stderr(&o));
+    // Nothing was rendered.
+    let pngs = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .path()
+                .extension()
+                .is_some_and(|x| x == "png")
+        })
+        .count();
+    assert_eq!(pngs, 0);
 }
 
 /// `bench` measures the whole chain and every stage on 1 and on all threads (the figures are

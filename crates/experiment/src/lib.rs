@@ -4,13 +4,15 @@
 //! paper's line fits, and the throughput measurement.
 
 pub mod bench;
+pub mod dump;
 pub mod fit;
 pub mod progress;
 pub mod readout;
 pub mod sweep;
 pub mod work;
 
-pub use progress::{Progress, Quiet, Reporter, Task};
+pub use dump::{dump_extra, DumpPlan};
+pub use progress::{Progress, Quiet, Reporter, Task, Written};
 pub use readout::{post_process, theory_deg, Compensation, PointResult, SweepResult};
 pub use sweep::{
     dump_point, finish_sweep, run_sweep, run_sweep_with, OnGroup, SweepError, SweepOptions,

@@ -11,6 +11,24 @@ pub trait Task: Sync {
     /// The task ended; `point_samples` when its work is counted in operating-point samples
     /// (the emulation's throughput unit), `None` otherwise.
     fn finish(&self, point_samples: Option<u64>);
+    /// The task ended after writing files besides its results (signal dumps): `written`
+    /// says how many, how large and how long they took, which the closing line reports apart
+    /// from the emulation's throughput. By default the same as [`finish`](Self::finish).
+    fn finish_writing(&self, point_samples: Option<u64>, written: Written) {
+        let _ = written;
+        self.finish(point_samples);
+    }
+}
+
+/// Files a task wrote besides its results, and the time that took.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Written {
+    /// Files written.
+    pub files: usize,
+    /// Their total size, bytes.
+    pub bytes: u64,
+    /// Wall time spent writing them, s.
+    pub seconds: f64,
 }
 
 /// A source of tasks, and where the library's notes to the user go.

@@ -2,16 +2,18 @@
 //! group, groups in parallel; any subset (a shard, a resumed run) gives every point the bits
 //! of a whole run. `readout.rs` turns the averages into phases.
 
-use crate::progress::Progress;
+use crate::dump::DumpPlan;
+use crate::progress::{Progress, Written};
 use crate::readout::{post_process, SweepResult};
 use gyroemu_board::{Board, LaneResult, NonFinite, Point, Probe, RunOptions, MAX_LANES};
 use gyroemu_config::Config;
 use gyroemu_core::{f64x4, ParamError};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
+use std::time::Instant;
 
 /// Why a sweep failed after validation.
 #[derive(Debug, thiserror::Error)]
@@ -55,9 +57,11 @@ pub fn run_sweep(
     finish_sweep(cfg, &run.lanes)
 }
 
-/// Called from the worker threads with each finished lane group's points, `(index in
-/// emulated_rates_dps, lane result)`, after the group's dump (if any) is written, and with
-/// the finished points of a group a cancel stopped. An error stops the sweep (groups not
+/// Called with each finished lane group's points, `(index in emulated_rates_dps, lane
+/// result)`, and with the finished points of a group a cancel stopped: from the worker
+/// threads, except for the group that records the dump, whose dump is written and points
+/// passed after every group has run (so the write is timed apart from the emulation, and a
+/// group's points are never saved without its dump). An error stops the sweep (groups not
 /// started are skipped) and is returned.
 pub type OnGroup<'a> = &'a (dyn Fn(&[(usize, LaneResult)]) -> Result<(), String> + Sync);
 
@@ -74,6 +78,9 @@ pub struct SweepOptions<'a> {
     pub cancel: Option<Arc<AtomicBool>>,
     /// Receives each finished group (e.g. to write its point files).
     pub on_group: Option<OnGroup<'a>>,
+    /// The dump to record instead of the config's `[dump]` (if any); written into the
+    /// `dump_dir` given to [`run_sweep_with`].
+    pub dump: Option<DumpPlan>,
 }
 
 /// The points a [`run_sweep_with`] call has, and whether it was cancelled.
@@ -87,6 +94,23 @@ pub struct SweepRun {
     pub cancelled: bool,
     /// Operating-point samples emulated by the groups that finished.
     pub point_samples: u64,
+    /// The dump files written (`dump_fullrate.*`, `dump_decimated.*`), if any.
+    pub dump_files: Vec<PathBuf>,
+    /// Their total size, bytes.
+    pub dump_bytes: u64,
+    /// Wall time spent writing them, s (after the emulation, not part of its time).
+    pub dump_write_s: f64,
+}
+
+impl SweepRun {
+    /// The dump written, for a progress line.
+    pub fn written(&self) -> Written {
+        Written {
+            files: self.dump_files.len(),
+            bytes: self.dump_bytes,
+            seconds: self.dump_write_s,
+        }
+    }
 }
 
 /// Input samples a lane group of `points` runs: settling plus its longest window.
@@ -149,12 +173,14 @@ pub fn run_sweep_with(
         |g: &[usize]| group_samples(cfg, &g.iter().map(|&i| plan(i)).collect::<Vec<_>>());
     let total: u64 = groups.iter().map(|g| samples_of(g)).sum();
     let done = AtomicU64::new(0);
-    let dump = cfg.dump_resolved().map(|d| {
-        let idx = dump_point(cfg).unwrap_or(0);
-        let nodes = d.nodes.clone().unwrap_or_default();
-        let window = (d.start_s.unwrap_or(0.0), d.duration_s.unwrap_or(0.0));
-        (idx, nodes, window)
-    });
+    let dump = opts
+        .dump
+        .clone()
+        .or_else(|| DumpPlan::from_config(cfg))
+        .map(|d| {
+            let idx = rates.iter().position(|&r| r == d.rate_dps).unwrap_or(0);
+            (idx, d)
+        });
     // Raised by the caller's flag (copied at each progress report) or by a failed group.
     let stop = Arc::new(AtomicBool::new(false));
     let user_cancel = || {
@@ -173,8 +199,11 @@ pub fn run_sweep_with(
         board.set_cancel(stop.clone());
         boards.push(board);
     }
-    // Per group: skipped (None), or its points with their work and whether all finished.
-    type Outcome = Option<Result<(Vec<(usize, LaneResult)>, u64, bool), SweepError>>;
+    // Per group: skipped (None), or its points, their work, whether all finished, and its
+    // probe when it recorded the dump (then the dump is written and the points passed on
+    // after the parallel section).
+    type Finished = (Vec<(usize, LaneResult)>, u64, bool, Option<Probe>);
+    type Outcome = Option<Result<Finished, SweepError>>;
     let outcomes: Vec<Outcome> = boards
         .into_par_iter()
         .zip(groups.par_iter())
@@ -186,21 +215,11 @@ pub fn run_sweep_with(
                 return None;
             }
             let points: Vec<Point> = g.iter().map(|&i| plan(i)).collect();
-            let mut probe = dump
-                .as_ref()
-                .and_then(|(idx, nodes, (start_s, duration_s))| {
-                    g.iter().position(|i| i == idx).map(|lane| {
-                        let p = Probe::new(
-                            nodes,
-                            cfg.fs_hz(),
-                            cfg.decimation(),
-                            *start_s,
-                            *duration_s,
-                            lane,
-                        );
-                        (lane, p)
-                    })
-                });
+            let mut probe = dump.as_ref().and_then(|(idx, plan)| {
+                g.iter()
+                    .position(|i| i == idx)
+                    .map(|lane| (lane, plan.probe(cfg, lane)))
+            });
             let last = AtomicU64::new(0);
             let report = |n: u64| {
                 add_group_progress(&done, &last, n, total, progress);
@@ -230,13 +249,11 @@ pub fn run_sweep_with(
                     })
                     .map(|(_, (p, _))| p)
                     .collect();
-                if whole {
-                    if let (Some((_, p)), Some(dir)) = (probe, dump_dir) {
-                        p.write(dir, DUMP_STEM)
-                            .map_err(|e| SweepError::Output(e.to_string()))?;
-                    }
-                }
-                if let (Some(f), false) = (opts.on_group, pts.is_empty()) {
+                // A whole group that recorded the dump hands its probe on.
+                let probe = probe
+                    .filter(|_| whole && dump_dir.is_some())
+                    .map(|(_, p)| p);
+                if let (None, Some(f), false) = (&probe, opts.on_group, pts.is_empty()) {
                     f(&pts).map_err(SweepError::Output)?;
                 }
                 let work = if whole {
@@ -244,7 +261,7 @@ pub fn run_sweep_with(
                 } else {
                     0
                 };
-                Ok((pts, work, whole))
+                Ok((pts, work, whole, probe))
             })();
             if finished.is_err() {
                 stop.store(true, Ordering::Relaxed);
@@ -257,6 +274,9 @@ pub fn run_sweep_with(
         computed: Vec::new(),
         cancelled: false,
         point_samples: 0,
+        dump_files: Vec::new(),
+        dump_bytes: 0,
+        dump_write_s: 0.0,
     };
     let mut first_err = None;
     for o in outcomes {
@@ -265,7 +285,34 @@ pub fn run_sweep_with(
             Some(Err(e)) => {
                 first_err.get_or_insert(e);
             }
-            Some(Ok((pts, work, whole))) => {
+            Some(Ok((pts, work, whole, probe))) => {
+                if let (Some(p), Some(dir)) = (probe, dump_dir) {
+                    // The dump first, then its group's points: a failed write leaves them
+                    // unsaved, so a rerun records the dump again.
+                    let t = Instant::now();
+                    let written = p.write(dir, DUMP_STEM);
+                    run.dump_write_s += t.elapsed().as_secs_f64();
+                    let written = written
+                        .map_err(|e| SweepError::Output(e.to_string()))
+                        .and_then(|files| match opts.on_group {
+                            Some(f) => f(&pts).map(|_| files).map_err(SweepError::Output),
+                            None => Ok(files),
+                        });
+                    match written {
+                        Ok(files) => {
+                            run.dump_bytes += files
+                                .iter()
+                                .filter_map(|f| std::fs::metadata(f).ok())
+                                .map(|m| m.len())
+                                .sum::<u64>();
+                            run.dump_files.extend(files);
+                        }
+                        Err(e) => {
+                            first_err.get_or_insert(e);
+                            continue;
+                        }
+                    }
+                }
                 run.cancelled |= !whole;
                 run.point_samples += work;
                 for (i, lane) in pts {
@@ -455,5 +502,69 @@ mod resume_tests {
             },
         );
         assert!(matches!(r, Err(SweepError::Output(e)) if e == "disk full"));
+    }
+
+    #[test]
+    fn a_dump_only_records_and_is_listed_with_its_size() {
+        let cfg = small();
+        let whole = run_sweep(&cfg, &|_, _| {}, None).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let plan = DumpPlan {
+            rate_dps: 75.0,
+            start_s: 0.03,
+            duration_s: 0.001,
+            decimated_duration_s: 0.05,
+            nodes: gyroemu_board::DUMP_NODES.map(String::from).to_vec(),
+        };
+        let saved = Mutex::new(Vec::new());
+        let on_group = |pts: &[(usize, LaneResult)]| {
+            // The dump group's points come after its dump is on disk.
+            let dumped = dir.path().join("dump_fullrate.sigmf-meta").exists();
+            saved
+                .lock()
+                .unwrap()
+                .extend(pts.iter().map(|p| (p.0, dumped)));
+            Ok(())
+        };
+        let run = run_sweep_with(
+            &cfg,
+            &|_, _| {},
+            Some(dir.path()),
+            SweepOptions {
+                dump: Some(plan),
+                on_group: Some(&on_group),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(finish_sweep(&cfg, &run.lanes).unwrap(), whole);
+        let names: Vec<String> = run
+            .dump_files
+            .iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+            .collect();
+        for stem in ["dump_fullrate", "dump_decimated"] {
+            for ext in ["csv", "wav", "sigmf-data", "sigmf-meta"] {
+                assert!(names.contains(&format!("{stem}.{ext}")), "{names:?}");
+            }
+        }
+        let on_disk: u64 = run
+            .dump_files
+            .iter()
+            .map(|p| std::fs::metadata(p).unwrap().len())
+            .sum();
+        assert_eq!(run.dump_bytes, on_disk);
+        assert_eq!(run.written().files, 8);
+        // 75 deg/s is point 2 of the first lane group: saved after the dump was written.
+        let saved = saved.into_inner().unwrap();
+        assert!(saved.iter().any(|&(i, dumped)| i == 2 && dumped));
+        // Windows: 1 ms at the full rate, 50 ms decimated (0.05 fs_out frames).
+        let full = gyroemu_io::read_dump(&dir.path().join("dump_fullrate")).unwrap();
+        let dec = gyroemu_io::read_dump(&dir.path().join("dump_decimated")).unwrap();
+        assert_eq!(full.frames(), (0.001 * cfg.fs_hz()).round() as usize);
+        assert_eq!(dec.frames(), (0.05 * cfg.fs_out_hz()).round() as usize);
+        assert_eq!(full.extra["f0_hz"], cfg.device.f0_hz);
+        assert_eq!(full.extra["rate_dps"], 75.0);
+        assert_eq!(dec.extra["decimation"], cfg.decimation() as f64);
     }
 }

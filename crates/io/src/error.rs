@@ -114,4 +114,12 @@ pub enum IoError {
         /// The producer's error.
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    /// A recording cannot be read back (missing, malformed, or not what its metadata says).
+    #[error("cannot read {}: {reason}", .path.display())]
+    Read {
+        /// The file that was being read.
+        path: PathBuf,
+        /// What is wrong, naming the key or line.
+        reason: String,
+    },
 }

@@ -2,13 +2,15 @@
 //! a window, so memory is bounded by the window and not by the run length.
 
 use crate::atomic::atomic_stream;
-use crate::csv_table::CsvSink;
+use crate::fast_text::{push_f64, push_i64};
 use crate::sigmf::{
     check_request, unit_from_name, write_sigmf_frames, SigmfChannel, SigmfMeta, DEFAULT_HW,
 };
 use crate::wav::{check_wav_f32_size, write_interleaved};
 use crate::IoError;
-use std::path::Path;
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 
 /// Records frames of `names.len()` channels for sample indices `n` in `[start, start + len)`.
 #[derive(Clone, Debug)]
@@ -21,6 +23,8 @@ pub struct SignalRecorder {
     len: u64,
     /// Interleaved frames, `data.len() / names.len()` of them; capacity reserved up front.
     data: Vec<f64>,
+    /// Written into the SigMF metadata as `gyroemu:<key>`.
+    extra: BTreeMap<String, f64>,
 }
 
 impl SignalRecorder {
@@ -42,6 +46,7 @@ impl SignalRecorder {
             start: start_sample,
             len,
             data: Vec::with_capacity(cap),
+            extra: BTreeMap::new(),
         }
     }
 
@@ -50,6 +55,13 @@ impl SignalRecorder {
     /// (M - 1)/fs_in.
     pub fn with_time_origin(mut self, t0_s: f64) -> Self {
         self.t0_s = t0_s;
+        self
+    }
+
+    /// Describes the recording in its SigMF metadata: each `(key, value)` becomes
+    /// `gyroemu:<key>` (keys carry their unit, e.g. `f0_hz`).
+    pub fn with_extra(mut self, extra: BTreeMap<String, f64>) -> Self {
+        self.extra = extra;
         self
     }
 
@@ -77,6 +89,21 @@ impl SignalRecorder {
         let m = ch.min(frame.len());
         dst[..m].copy_from_slice(&frame[..m]);
         dst[m..].fill(f64::NAN);
+    }
+
+    /// Sample rate, Hz.
+    pub fn fs_hz(&self) -> f64 {
+        self.fs_hz
+    }
+
+    /// First sample index of the window.
+    pub fn start(&self) -> u64 {
+        self.start
+    }
+
+    /// Time of sample index 0, s.
+    pub fn t0_s(&self) -> f64 {
+        self.t0_s
     }
 
     /// Channel names in column order.
@@ -120,8 +147,9 @@ impl SignalRecorder {
     ///   `gyroemu:t0_s` = time origin, `gyroemu:channels` = names with units read from their
     ///   suffixes): `np.fromfile(path, dtype="<f8").reshape(-1, n_channels)`.
     ///
-    /// The WAV size and the SigMF request are checked before any file is written.
-    pub fn write(&self, dir: &Path, stem: &str) -> Result<(), IoError> {
+    /// The WAV size and the SigMF request are checked before any file is written. Returns the
+    /// four paths written (CSV, WAV, SigMF data, SigMF meta).
+    pub fn write(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, IoError> {
         let csv_path = dir.join(format!("{stem}.csv"));
         let wav_path = dir.join(format!("{stem}.wav"));
         let rate = self.fs_hz.round();
@@ -141,24 +169,51 @@ impl SignalRecorder {
         let meta = self.sigmf_meta(stem);
         check_request(&dir.join(format!("{stem}.sigmf-data")), &meta, ch)?;
 
+        self.write_csv(&csv_path)?;
+        write_interleaved(&wav_path, rate, ch, frames, |i, k| self.data[i * ch + k])?;
+        let sigmf = write_sigmf_frames(dir, stem, &meta, ch, frames, |i, k| self.data[i * ch + k])?;
+        Ok(vec![csv_path, wav_path, sigmf.data_path, sigmf.meta_path])
+    }
+
+    /// Writes only the CSV (columns `sample`, `time_s`, then one per name), atomically. The
+    /// text is byte for byte what [`write_csv`](crate::write_csv) writes for the same cells;
+    /// numbers are laid out by hand (ryu digits) instead of through `fmt` and the csv crate,
+    /// which is what makes a dump of millions of values take a fraction of a second.
+    pub fn write_csv(&self, csv_path: &Path) -> Result<(), IoError> {
+        let ch = self.names.len();
         let mut headers = vec!["sample".to_string(), "time_s".to_string()];
         headers.extend(self.names.iter().cloned());
-        atomic_stream(&csv_path, |w| {
-            let mut sink = CsvSink::new(w, &csv_path, &headers)?;
-            for (i, frame) in self.data.chunks_exact(ch).enumerate() {
+        let io_err = |source| IoError::Write {
+            path: csv_path.to_path_buf(),
+            source,
+        };
+        atomic_stream(csv_path, |w| {
+            // The header through the csv crate (its quoting rules), the rows by hand.
+            let mut head = csv::Writer::from_writer(Vec::new());
+            head.write_record(&headers)
+                .and_then(|_| head.flush().map_err(csv::Error::from))
+                .map_err(|source| IoError::Csv {
+                    path: csv_path.to_path_buf(),
+                    source,
+                })?;
+            let head = head.into_inner().map_err(|e| io_err(e.into_error()))?;
+            w.write_all(&head).map_err(io_err)?;
+            let mut line = Vec::with_capacity(32 * (ch + 2));
+            for (i, frame) in self.data.chunks_exact(ch.max(1)).enumerate() {
                 let n = self.start + i as u64;
-                sink.int(n as i64)?;
-                sink.f64(self.t0_s + n as f64 / self.fs_hz)?;
+                line.clear();
+                push_i64(n as i64, &mut line);
+                line.push(b',');
+                push_f64(self.t0_s + n as f64 / self.fs_hz, &mut line);
                 for &x in frame {
-                    sink.f64(x)?;
+                    line.push(b',');
+                    push_f64(x, &mut line);
                 }
-                sink.end_row()?;
+                line.push(b'\n');
+                w.write_all(&line).map_err(io_err)?;
             }
-            sink.finish()
-        })?;
-        write_interleaved(&wav_path, rate, ch, frames, |i, k| self.data[i * ch + k])?;
-        write_sigmf_frames(dir, stem, &meta, ch, frames, |i, k| self.data[i * ch + k])?;
-        Ok(())
+            w.flush().map_err(io_err)
+        })
     }
 
     /// SigMF description of this recorder's dump `stem`.
@@ -181,6 +236,7 @@ impl SignalRecorder {
             hw: DEFAULT_HW.to_string(),
             global_index: self.start,
             t0_s: self.t0_s,
+            extra: self.extra.clone(),
         }
     }
 }

@@ -12,12 +12,15 @@
 //!   dimensionless or unknown);
 //! - `gyroemu:t0_s`: time in seconds of global sample index 0, so sample `k` of the file is at
 //!   `t0_s + (core:global_index + k) / core:sample_rate`;
-//! - `gyroemu:doc`: this description in one sentence, so the file documents itself.
+//! - `gyroemu:doc`: this description in one sentence, so the file documents itself;
+//! - (1.1.0) numeric keys describing the operating point, from [`SigmfMeta::extra`]: e.g.
+//!   `gyroemu:f0_hz`, `gyroemu:rate_dps`, `gyroemu:omega_hz`, `gyroemu:decimation`.
 
 use crate::atomic::atomic_stream;
 use crate::json::write_json;
 use crate::IoError;
 use sha2::{Digest, Sha512};
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -28,12 +31,14 @@ pub const SIGMF_VERSION: &str = "1.2.0";
 pub const SIGMF_DATATYPE_REAL_F64: &str = "rf64_le";
 
 /// Version of the `gyroemu` metadata extension declared in `core:extensions`.
-pub const GYROEMU_EXTENSION_VERSION: &str = "1.0.0";
+pub const GYROEMU_EXTENSION_VERSION: &str = "1.1.0";
 
 /// One-sentence description of the `gyroemu` extension, stored as `gyroemu:doc`.
 const GYROEMU_EXTENSION_DOC: &str = "gyroemu:channels lists each channel's name and unit in \
 interleave order (unit \"\" = dimensionless or unknown); gyroemu:t0_s is the time in seconds of \
-global sample index 0, so file sample k is at t0_s + (core:global_index + k) / core:sample_rate.";
+global sample index 0, so file sample k is at t0_s + (core:global_index + k) / core:sample_rate; \
+any other numeric gyroemu:<name>_<unit> key describes the recorded operating point (e.g. \
+gyroemu:f0_hz the carrier, gyroemu:omega_hz the rotating excitation's frequency).";
 
 /// Name and physical unit of one recorded channel (stored in `gyroemu:channels`).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -59,6 +64,9 @@ pub struct SigmfMeta {
     pub global_index: u64,
     /// Time of global sample index 0, s (`gyroemu:t0_s`); must be finite.
     pub t0_s: f64,
+    /// Numbers describing the recording (the operating point), each written as
+    /// `gyroemu:<key>`; keys carry their unit (`f0_hz`). Non-finite values are left out.
+    pub extra: BTreeMap<String, f64>,
 }
 
 impl SigmfMeta {
@@ -78,6 +86,7 @@ impl SigmfMeta {
             hw: DEFAULT_HW.to_string(),
             global_index: 0,
             t0_s: 0.0,
+            extra: BTreeMap::new(),
         }
     }
 }
@@ -194,7 +203,7 @@ fn meta_json(meta: &SigmfMeta, n_ch: usize, sha512_hex: &str) -> serde_json::Val
         .iter()
         .map(|c| serde_json::json!({ "name": c.name, "unit": c.unit }))
         .collect();
-    serde_json::json!({
+    let mut doc = serde_json::json!({
         "global": {
             "core:datatype": SIGMF_DATATYPE_REAL_F64,
             "core:sample_rate": meta.sample_rate_hz,
@@ -218,7 +227,13 @@ fn meta_json(meta: &SigmfMeta, n_ch: usize, sha512_hex: &str) -> serde_json::Val
             "core:global_index": meta.global_index
         }],
         "annotations": []
-    })
+    });
+    if let Some(g) = doc["global"].as_object_mut() {
+        for (k, v) in meta.extra.iter().filter(|(_, v)| v.is_finite()) {
+            g.insert(format!("gyroemu:{k}"), serde_json::json!(v));
+        }
+    }
+    doc
 }
 
 /// A writer that feeds every byte to SHA-512 on its way to the file.

@@ -200,3 +200,47 @@ fn wav_refuses_bad_requests_before_writing() {
     assert!(write_wav_f32(&path, 0, &[&a]).is_err());
     assert!(only_entries(dir.path()).is_empty());
 }
+
+#[test]
+fn recorder_csv_is_byte_for_byte_the_table_writers_csv() {
+    // The dump's hand-laid text against the csv crate + std formatting path of write_csv.
+    use gyroemu_io::SignalRecorder;
+    let dir = tempfile::tempdir().unwrap();
+    let names = vec!["a_v".to_string(), "b".to_string(), "q1_m".to_string()];
+    let (fs, start) = (240_000.0, 12_345u64);
+    let mut rec = SignalRecorder::new(names.clone(), fs, start, 500).with_time_origin(3.7e-4);
+    let mut s: u64 = 0x1234_5678_9abc_def1;
+    let mut table = CsvTable {
+        headers: ["sample", "time_s"]
+            .iter()
+            .map(|h| h.to_string())
+            .chain(names.iter().cloned())
+            .collect(),
+        rows: Vec::new(),
+    };
+    for n in start..start + 500 {
+        let mut frame = [0.0; 3];
+        for v in frame.iter_mut() {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            *v = match n % 7 {
+                0 => f64::from_bits(s),
+                1 => 0.0,
+                _ => (s >> 11) as f64 * 1e-19 - 1e-3,
+            };
+        }
+        rec.record(n, &frame);
+        let mut row = vec![CsvCell::Int(n as i64), CsvCell::F64(3.7e-4 + n as f64 / fs)];
+        row.extend(frame.iter().map(|&v| CsvCell::F64(v)));
+        table.rows.push(row);
+    }
+    rec.write_csv(&dir.path().join("fast.csv")).unwrap();
+    write_csv(&dir.path().join("ref.csv"), &table).unwrap();
+    let fast = std::fs::read(dir.path().join("fast.csv")).unwrap();
+    let reference = std::fs::read(dir.path().join("ref.csv")).unwrap();
+    assert_eq!(
+        String::from_utf8(fast).unwrap(),
+        String::from_utf8(reference).unwrap()
+    );
+}

@@ -21,6 +21,8 @@ pub struct AxisScale {
     pub exp10: i32,
     /// Decimals of every tick label (same for all ticks, as in printed figures).
     pub decimals: usize,
+    /// Logarithmic: `lo`/`hi` are decades (log10 of the data) and ticks read 10^n.
+    pub log: bool,
     factor: f64,
 }
 
@@ -75,18 +77,90 @@ impl AxisScale {
             hi,
             exp10,
             decimals,
+            log: false,
             factor: 10f64.powi(exp10),
         }
     }
 
-    /// Maps a data value to plotted (scaled) units.
-    #[inline]
-    pub fn map(&self, v: f64) -> f64 {
-        v / self.factor
+    /// Logarithmic axis over the positive finite values of `vals`: their span in decades with
+    /// 5 % margins when that holds two whole decades or more (each gets a tick), else the
+    /// whole decades around them (at least one) with 2 % margins; `[1, 10]` when there is no
+    /// positive value.
+    pub fn log_from_values(vals: impl IntoIterator<Item = f64>) -> Self {
+        let logs = vals.into_iter().filter(|v| *v > 0.0).map(f64::log10);
+        let (lo, hi) = match finite_bounds(logs) {
+            None => (-0.02, 1.02),
+            Some((lo, hi)) => {
+                let pad = MARGIN_FRACTION * (hi - lo);
+                let (tlo, thi) = (lo - pad, hi + pad);
+                if thi.floor() - tlo.ceil() >= 1.0 {
+                    (tlo, thi)
+                } else {
+                    let (lo, mut hi) = (lo.floor(), hi.ceil());
+                    if hi <= lo {
+                        hi = lo + 1.0;
+                    }
+                    let pad = 0.02 * (hi - lo);
+                    (lo - pad, hi + pad)
+                }
+            }
+        };
+        AxisScale {
+            lo,
+            hi,
+            exp10: 0,
+            decimals: 0,
+            log: true,
+            factor: 1.0,
+        }
     }
 
-    /// Tick label for the scaled value `v`, never "-0".
+    /// Tick positions, in plotted units, about `n` of them: plotters' round steps on a linear
+    /// axis; on a log axis whole decades every `ceil(decades / (n - 1))`, at least two.
+    pub fn ticks(&self, n: usize) -> Vec<f64> {
+        if !self.log {
+            return RangedCoordf64::from(self.lo..self.hi).key_points(n.max(2));
+        }
+        let span = (self.hi.floor() - self.lo.ceil()).max(1.0);
+        let step = (span / (n.max(2) - 1) as f64).ceil().max(1.0);
+        let first = (self.lo / step).ceil() * step;
+        let mut t: Vec<f64> = (0..)
+            .map(|i| first + i as f64 * step)
+            .take_while(|&v| v <= self.hi)
+            .collect();
+        if t.len() < 2 {
+            // A step wider than the axis: its first and last whole decades instead.
+            t = vec![self.lo.ceil(), self.hi.floor()];
+            t.dedup();
+        }
+        t
+    }
+
+    /// Maps a data value to plotted (scaled) units: log10 on a log axis (NaN for v <= 0, so
+    /// the point is skipped).
+    #[inline]
+    pub fn map(&self, v: f64) -> f64 {
+        if self.log {
+            if v > 0.0 {
+                v.log10()
+            } else {
+                f64::NAN
+            }
+        } else {
+            v / self.factor
+        }
+    }
+
+    /// Tick label for the scaled value `v`, never "-0"; `10ⁿ` on a log axis.
     pub fn label(&self, v: f64) -> String {
+        if self.log {
+            let n = v.round();
+            return if (v - n).abs() < 1e-9 {
+                power_of_ten(n as i32)
+            } else {
+                format!("{:.3}", 10f64.powf(v))
+            };
+        }
         let s = format!("{:.*}", self.decimals, v);
         match s.strip_prefix('-') {
             Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
@@ -99,16 +173,21 @@ impl AxisScale {
         if self.exp10 == 0 {
             return None;
         }
-        const SUP: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
-        let mut s = String::from("×10");
-        if self.exp10 < 0 {
-            s.push('⁻');
-        }
-        for d in self.exp10.unsigned_abs().to_string().bytes() {
-            s.push(SUP[(d - b'0') as usize]);
-        }
-        Some(s)
+        Some(format!("×{}", power_of_ten(self.exp10)))
     }
+}
+
+/// "10ⁿ" with a superscript exponent.
+fn power_of_ten(n: i32) -> String {
+    const SUP: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let mut s = String::from("10");
+    if n < 0 {
+        s.push('⁻');
+    }
+    for d in n.unsigned_abs().to_string().bytes() {
+        s.push(SUP[(d - b'0') as usize]);
+    }
+    s
 }
 
 /// Fewest decimals (0..=12) that print every tick exactly to within 1e-6 of the tick spacing.
@@ -192,6 +271,43 @@ mod tests {
             AxisScale::from_values([19_990.0, 20_010.0], 8).exponent_text(),
             None
         );
+    }
+
+    #[test]
+    fn log_axes_span_whole_decades_and_tick_on_them() {
+        let a = AxisScale::log_from_values([3e-9, 0.0, -1.0, f64::NAN, 2e-2]);
+        assert!(a.log && a.exp10 == 0);
+        // The data's decades with 5 % margins: they hold the ticks -8 .. -2.
+        let (l, h) = (3e-9f64.log10(), 2e-2f64.log10());
+        let pad = 0.05 * (h - l);
+        assert!((a.lo - (l - pad)).abs() < 1e-12 && (a.hi - (h + pad)).abs() < 1e-12);
+        assert!((a.map(1e-5) + 5.0).abs() < 1e-12);
+        assert!(a.map(0.0).is_nan() && a.map(-3.0).is_nan());
+        assert_eq!(a.label(-5.0), "10⁻⁵");
+        assert_eq!(a.label(0.0), "10⁰");
+        assert_eq!(a.label(12.0), "10¹²");
+        for n in [2usize, 3, 6, 10] {
+            let ticks = a.ticks(n);
+            assert!(
+                ticks.len() >= 2 && ticks.len() <= n.max(2),
+                "{n}: {ticks:?}"
+            );
+            for t in &ticks {
+                assert!((t - t.round()).abs() < 1e-12, "tick {t} is not a decade");
+                assert!(a.lo <= *t && *t <= a.hi);
+            }
+        }
+        assert_eq!(a.ticks(10), [-8.0, -7.0, -6.0, -5.0, -4.0, -3.0, -2.0]);
+        // Less than two decades of data: whole decades around them.
+        let c = AxisScale::log_from_values([0.08, 0.7]);
+        assert!(
+            (c.lo + 2.04).abs() < 1e-12 && (c.hi - 0.04).abs() < 1e-12,
+            "{c:?}"
+        );
+        // One value: one whole decade around it; nothing positive: 10^0 .. 10^1.
+        let b = AxisScale::log_from_values([5.0]);
+        assert!(b.lo < 0.0 && b.hi > 1.0 && b.hi < 1.1);
+        assert!(AxisScale::log_from_values([0.0, -1.0]).lo < 0.0);
     }
 
     #[test]

@@ -5,9 +5,11 @@ use plotters::style::RGBColor;
 /// How a series is drawn.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SeriesStyle {
-    /// Filled circle markers (measurements).
+    /// Filled markers (measurements): the first `Points` series of a figure gets circles, the
+    /// next smaller triangles, squares and diamonds, so coincident series stay visible.
     Points,
-    /// Larger hollow circles, for a second measured series drawn over the first.
+    /// Larger hollow circles, drawn after every filled marker and line so they are never
+    /// hidden (a second measured series over the first).
     OpenPoints,
     /// Solid line (simulation, theory).
     Line,
@@ -57,6 +59,21 @@ pub struct Figure {
     pub width_px: u32,
     /// Image height.
     pub height_px: u32,
+    /// Logarithmic x axis (decades labelled 10^n; values <= 0 are skipped).
+    pub x_log: bool,
+    /// Logarithmic y axis, for quantities spanning decades (spectra, Allan deviation).
+    pub y_log: bool,
+    /// Labelled vertical lines at known abscissae (a carrier, its sidebands).
+    pub markers: Vec<Marker>,
+}
+
+/// A dashed vertical line at `x` with a short label at the top of the plot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Marker {
+    /// Abscissa, in data units.
+    pub x: f64,
+    /// Text drawn beside the line's top (empty: none).
+    pub label: String,
 }
 
 impl Figure {
@@ -73,7 +90,31 @@ impl Figure {
             series: Vec::new(),
             width_px: 900,
             height_px: 650,
+            x_log: false,
+            y_log: false,
+            markers: Vec::new(),
         }
+    }
+
+    /// A logarithmic x axis (builder style).
+    pub fn log_x(mut self) -> Self {
+        self.x_log = true;
+        self
+    }
+
+    /// A logarithmic y axis (builder style).
+    pub fn log_y(mut self) -> Self {
+        self.y_log = true;
+        self
+    }
+
+    /// Adds a labelled vertical marker (builder style).
+    pub fn with_marker(mut self, x: f64, label: impl Into<String>) -> Self {
+        self.markers.push(Marker {
+            x,
+            label: label.into(),
+        });
+        self
     }
 
     /// Adds a series (builder style).

@@ -5,6 +5,7 @@
 //! Files are written atomically through `gyroemu-io`.
 
 mod axis;
+mod draw;
 mod error;
 mod figure;
 mod font;
@@ -12,6 +13,9 @@ mod render;
 
 pub use axis::{finite_bounds, AxisScale, MARGIN_FRACTION};
 pub use error::PlotError;
-pub use figure::{Figure, Series, SeriesStyle, PALETTE};
+pub use figure::{Figure, Marker, Series, SeriesStyle, PALETTE};
 pub use font::{ensure_font, FONT_FAMILY};
-pub use render::{render_panels_png, render_png, render_rgb, MAX_SIDE_PX, MIN_SIDE_PX};
+pub use render::{
+    downsample_rgb, render_panels_png, render_png, render_rgb, render_rgb_antialiased, MAX_SIDE_PX,
+    MIN_SIDE_PX, SUPERSAMPLE,
+};

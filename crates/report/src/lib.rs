@@ -3,11 +3,17 @@
 //! presets). Every file is written atomically (`gyroemu-io`) and every function returns the
 //! paths it wrote, so a program can list them.
 
+pub mod dump_figures;
+pub mod dump_set;
+pub mod dump_stats;
 mod error;
 pub mod reproduce;
 pub mod selfcal_report;
 pub mod sweep_report;
 
+pub use dump_figures::write_dump_figures;
+pub use dump_set::{read_dump_set, DumpSet};
+pub use dump_stats::{channel_stats, inspect_text, ChannelStats};
 pub use error::{check_problems, ReportError};
 pub use reproduce::{plan_reproduce, reproduce, ReproducePlan};
 pub use selfcal_report::{write_selfcal, SelfcalFiles, SELFCAL_ANALYSIS_FILES};

@@ -1,20 +1,52 @@
 //! `gyroemu reproduce`: the paper's Figs. 4, 5, 6, 8 and 9 from the emulated board, on the
 //! embedded presets, with the exact theory beside every point.
 
+use crate::dump_figures::write_dump_figures;
+use crate::dump_set::read_dump_set;
 use crate::error::{check_problems, create_dir, ReportError};
 use crate::sweep_report::{sweep_figure, theory_series, write_run};
 use gyroemu_analysis::bandwidth::{bandwidth, BANDWIDTH_AMPLITUDE_DPS, BANDWIDTH_FREQS_HZ};
 use gyroemu_config::presets::preset;
-use gyroemu_config::Config;
-use gyroemu_experiment::{run_sweep, Reporter, SweepResult};
+use gyroemu_config::{Config, DumpConfig};
+use gyroemu_experiment::{
+    finish_sweep, run_sweep_with, DumpPlan, Reporter, SweepOptions, SweepResult,
+};
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
 use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
 use gyroemu_theory::rate_table_gain;
+use rayon::prelude::*;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
 /// Averaging of Fig. 9 with `--quick`, s (the paper: 500 s).
 const QUICK_AVERAGE_S: f64 = 15.0;
+
+/// Most full-rate frames of the dump each experiment writes (12 channels: about 0.8 MB in
+/// all formats; 128 carrier periods at 16 samples per period, Welch bins of fs/512).
+pub const DUMP_FULL_FRAMES: f64 = 2048.0;
+/// Most decimated frames of that dump (14 channels: about 0.5 MB).
+pub const DUMP_DECIMATED_FRAMES: f64 = 1024.0;
+
+/// The dump `reproduce` records of an experiment: every node at the largest rate from the end
+/// of settling (the `[dump]` defaults), the full-rate window cut to [`DUMP_FULL_FRAMES`], the
+/// decimated one [`DUMP_DECIMATED_FRAMES`] long, both within the point's run.
+pub fn reproduce_dump(cfg: &Config) -> DumpPlan {
+    let mut with_dump = cfg.clone();
+    with_dump.dump = Some(DumpConfig {
+        rate_dps: None,
+        start_s: None,
+        duration_s: None,
+        nodes: None,
+    });
+    let d = DumpPlan::from_config(&with_dump).expect("the config has a dump section now");
+    let p = cfg.plan_point(d.rate_dps);
+    let end_s = (cfg.n_settle_out() + p.window.samples()) as f64 / cfg.fs_out_hz();
+    DumpPlan {
+        duration_s: d.duration_s.min(DUMP_FULL_FRAMES / cfg.fs_hz()),
+        decimated_duration_s: (DUMP_DECIMATED_FRAMES / cfg.fs_out_hz()).min(end_s - d.start_s),
+        ..d
+    }
+}
 
 struct Job {
     preset: &'static str,
@@ -99,16 +131,38 @@ pub fn reproduce(
     let (jobs, quick) = (&plan.jobs, plan.quick);
     let mut files = Vec::new();
     let mut results = Vec::new();
+    // Where each experiment's dump figures go in the list, and its folder.
+    let mut dump_dirs = Vec::new();
     for job in jobs {
         let progress = reporter.task(job.preset);
-        let r = run_sweep(&job.cfg, &|d, t| progress.update(d, t), None)?;
-        progress.finish(Some(r.point_samples));
-        files.extend(write_run(&out.join(job.preset), &job.cfg, &r, job.title)?);
+        let dir = out.join(job.preset);
+        create_dir(&dir)?;
+        // The dump only records: the results are those of a run without it.
+        let opts = SweepOptions {
+            dump: Some(reproduce_dump(&job.cfg)),
+            ..Default::default()
+        };
+        let run = run_sweep_with(&job.cfg, &|d, t| progress.update(d, t), Some(&dir), opts)?;
+        let r = finish_sweep(&job.cfg, &run.lanes)?;
+        progress.finish_writing(Some(r.point_samples), run.written());
+        files.extend(write_run(&dir, &job.cfg, &r, job.title)?);
+        files.extend(run.dump_files.iter().cloned());
+        dump_dirs.push((files.len(), dir));
         for w in &r.warnings {
             reporter.warn(&format!("{}: {w}", job.preset));
         }
         check_problems(job.preset, &r.problems)?;
         results.push(r);
+    }
+    // The dumps' figures, read back from the files, drawn in parallel once every sweep is
+    // done (so they do not compete with the emulation for the cores).
+    let figures: Vec<Result<Vec<PathBuf>, ReportError>> = dump_dirs
+        .par_iter()
+        .map(|(_, dir)| write_dump_figures(&read_dump_set(&dir.join("dump"))?, dir))
+        .collect();
+    for ((at, _), figs) in dump_dirs.iter().zip(figures).rev() {
+        let figs = figs?;
+        files.splice(at..at, figs);
     }
     let get = |name: &str| {
         let i = jobs.iter().position(|j| j.preset == name).unwrap_or(0);
@@ -217,8 +271,9 @@ fn bandwidth_outputs(base: &Config, out: &Path) -> Result<(Figure, PathBuf), Rep
     )?;
     let theory = |f: f64| rate_table_gain(d.f0_hz, d.q, d.angular_gain, 1.0, 1.0, f);
     let fmax = BANDWIDTH_FREQS_HZ[BANDWIDTH_FREQS_HZ.len() - 1];
+    // Log-spaced: the figure's axes are logarithmic (a low-pass is a line in decades).
     let fs: Vec<f64> = (0..=200)
-        .map(|i| 0.01 + (fmax - 0.01) * i as f64 / 200.0)
+        .map(|i| 0.01 * (fmax / 0.01).powf(i as f64 / 200.0))
         .collect();
     let corner = d.f0_hz / (2.0 * d.q);
     let figure = Figure::new(
@@ -229,6 +284,8 @@ fn bandwidth_outputs(base: &Config, out: &Path) -> Result<(Figure, PathBuf), Rep
         "Rate-table frequency (Hz)",
         "Phase amplitude per unit rate (deg per deg/s)",
     )
+    .log_x()
+    .log_y()
     .with(Series {
         name: format!("mode 1 emulated ({BANDWIDTH_AMPLITUDE_DPS} deg/s amplitude)"),
         style: SeriesStyle::Points,

@@ -264,8 +264,8 @@ fn log_series(name: &str, style: SeriesStyle, pts: &[AllanPoint], scale: f64) ->
     Series::new(
         name,
         style,
-        pts.iter().map(|p| p.tau_s.log10()).collect(),
-        pts.iter().map(|p| (p.adev * scale).log10()).collect(),
+        pts.iter().map(|p| p.tau_s).collect(),
+        pts.iter().map(|p| p.adev * scale).collect(),
     )
 }
 
@@ -277,8 +277,10 @@ fn allan_figure(a: &AllanResult) -> Figure {
         ),
         None => "Allan deviation at zero rate".to_string(),
     };
-    let mut fig =
-        Figure::new(title, "log10(tau / s)", "log10(Allan deviation / (deg/h))").with(log_series(
+    let mut fig = Figure::new(title, "tau (s)", "Allan deviation (deg/h)")
+        .log_x()
+        .log_y()
+        .with(log_series(
             "rate-equivalent output (phase / scale factor)",
             SeriesStyle::Points,
             &a.rate_dps,
@@ -291,10 +293,8 @@ fn allan_figure(a: &AllanResult) -> Figure {
         fig = fig.with(Series::new(
             "angle random walk: N / sqrt(tau)",
             SeriesStyle::DashedLine,
-            ends.iter().map(|t| t.log10()).collect(),
-            ends.iter()
-                .map(|t| (n / t.sqrt() * 3600.0).log10())
-                .collect(),
+            ends.clone(),
+            ends.iter().map(|t| n / t.sqrt() * 3600.0).collect(),
         ));
     }
     fig
@@ -328,22 +328,24 @@ fn tau_table(t: &[TauPoint]) -> CsvTable {
 }
 
 fn tau_figure(t: &[TauPoint], average_s: f64) -> Figure {
-    let lg = |v: f64| v.abs().max(1e-12).log10();
+    let lg = |v: f64| v.abs().max(1e-12);
     let mut fig = Figure::new(
         "Self-calibration error against averaging time",
-        "log10(averaging time / s)",
-        "log10 |relative error|",
+        "Averaging time (s)",
+        "|relative error|",
     )
+    .log_x()
+    .log_y()
     .with(Series::new(
         "|predicted / rate table - 1|",
         SeriesStyle::Points,
-        t.iter().map(|p| p.tau_s.log10()).collect(),
+        t.iter().map(|p| p.tau_s).collect(),
         t.iter().map(|p| lg(p.relative_error)).collect(),
     ))
     .with(Series::new(
         "95 % confidence half-width",
         SeriesStyle::DashedLine,
-        t.iter().map(|p| p.tau_s.log10()).collect(),
+        t.iter().map(|p| p.tau_s).collect(),
         t.iter().map(|p| lg(p.relative_error_ci95)).collect(),
     ));
     for (name, at) in [("500 s (the paper)", 500.0), ("this config", average_s)] {
@@ -351,7 +353,7 @@ fn tau_figure(t: &[TauPoint], average_s: f64) -> Figure {
             fig = fig.with(Series::new(
                 name,
                 SeriesStyle::OpenPoints,
-                vec![p.tau_s.log10()],
+                vec![p.tau_s],
                 vec![lg(p.relative_error)],
             ));
         }

@@ -180,6 +180,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         only: req.shard.as_ref().map(|_| mine.clone()),
         cancel: Some(req.cancel.clone()),
         on_group: Some(&on_group),
+        dump: None,
     };
     let swept = match run_sweep_with(cfg, &|d, t| task.update(d, t), Some(out), opts) {
         Ok(s) => s,
@@ -192,7 +193,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
             return Err(fail(e.into(), &done));
         }
     };
-    task.finish(Some(swept.point_samples));
+    task.finish_writing(Some(swept.point_samples), swept.written());
     let missing = mine.iter().filter(|i| !swept.lanes.contains_key(i)).count();
     if swept.cancelled || missing > 0 {
         let mut m = manifest("interrupted", &swept.lanes);
@@ -232,6 +233,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     live.write_final(&manifest_path, &m)
         .map_err(|e| fail(e, &swept.lanes))?;
     files.push(manifest_path);
+    files.extend(swept.dump_files.iter().cloned());
     for w in &r.warnings {
         reporter.warn(w);
     }

@@ -2,6 +2,7 @@
 
 pub mod bench;
 pub mod config;
+pub mod inspect;
 pub mod merge;
 pub mod reproduce;
 pub mod run;

@@ -1,0 +1,18 @@
+//! `gyroemu inspect DUMP [--out DIR]`.
+
+use crate::input::{list_written, print_out, BadInput};
+use anyhow::Result;
+use gyroemu_report::{inspect_text, read_dump_set, write_dump_figures};
+use std::path::Path;
+
+/// Prints each channel's RMS, peak and strongest tones, and renders `signals.png` and
+/// `spectrum.png` beside the dump (or into `out`).
+pub fn inspect_command(dump: &Path, out: Option<&Path>) -> Result<()> {
+    let set = read_dump_set(dump).map_err(|e| BadInput(e.to_string()))?;
+    let dir = out.unwrap_or(&set.dir);
+    gyroemu_runs::prepare_out(dir)?;
+    print_out(&inspect_text(&set))?;
+    let files = write_dump_figures(&set, dir)?;
+    list_written(dir, &files);
+    Ok(())
+}

@@ -1,0 +1,317 @@
+//! The two figures of a signal dump, from the files alone (so `gyroemu inspect` and
+//! `reproduce` draw the same): `signals.png`, every node against time, and `spectrum.png`,
+//! Welch spectra of the full-rate nodes and of the low-pass output, with the carrier, the
+//! rotating excitation's sidebands, the 2 f0 mixer product and the low-pass residual marked
+//! and their levels read by the tone finder.
+
+use crate::dump_set::{groups, DumpSet, Group};
+use crate::error::ReportError;
+use gyroemu_io::Dump;
+use gyroemu_plot::{render_panels_png, Figure, Series, SeriesStyle};
+use gyroemu_spectrum::{tone_near, welch, Psd};
+use std::path::{Path, PathBuf};
+
+/// Carrier periods of the full-rate nodes shown in `signals.png` (the waveforms stay legible).
+pub const SHOWN_CARRIER_PERIODS: f64 = 10.0;
+/// Full-rate samples shown when the carrier is unknown (a recording without metadata).
+const SHOWN_SAMPLES_UNKNOWN_F0: usize = 400;
+/// Spectra are drawn down to this far below their peak (f64 arithmetic's own floor is lower
+/// still and would stretch the axis over 30 decades).
+pub const SPECTRUM_RANGE_DB: f64 = 200.0;
+/// Width of the figures, px; each row of panels is this high.
+const WIDTH_PX: u32 = 1600;
+const ROW_PX: u32 = 430;
+
+/// `x` with three significant digits, plainly written.
+fn sig3(x: f64) -> String {
+    let d = (2 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.d$}")
+}
+
+/// "dBV" for volts, else "dB re 1 <unit>" (or "dB" when dimensionless).
+pub fn db_unit(unit: &str) -> String {
+    match unit {
+        "V" => "dBV".into(),
+        "" => "dB".into(),
+        u => format!("dB re 1 {u}"),
+    }
+}
+
+/// The density unit of samples in `unit`: `V²/Hz`, `(m/s)²/Hz`.
+fn density_unit(unit: &str) -> String {
+    match unit {
+        "" => "1/Hz".into(),
+        u if u.contains('/') => format!("({u})²/Hz"),
+        u => format!("{u}²/Hz"),
+    }
+}
+
+/// Writes `signals.png` and `spectrum.png` of `set` into `dir`; returns their paths.
+pub fn write_dump_figures(set: &DumpSet, dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
+    let render = |file: &str, (title, panels): (String, Vec<Figure>)| {
+        let path = dir.join(file);
+        let rows = panels.len().div_ceil(2).max(1) as u32;
+        render_panels_png(&title, &panels, 2, WIDTH_PX, 80 + ROW_PX * rows, &path).map(|_| path)
+    };
+    // The two figures are independent: draw them on two threads.
+    let (a, b) = rayon::join(
+        || render("signals.png", signal_panels(set)),
+        || render("spectrum.png", spectrum_panels(set)),
+    );
+    Ok(vec![a?, b?])
+}
+
+/// "m2tfg-rotating/dump at 175 deg/s": the dump's folder and name, and the operating point
+/// when the metadata says it.
+fn heading(set: &DumpSet) -> String {
+    let p = std::path::Path::new(&set.name);
+    let last: Vec<String> = p
+        .components()
+        .rev()
+        .take(2)
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    let short: Vec<&str> = last.iter().rev().map(String::as_str).collect();
+    let rate = set
+        .extra("rate_dps")
+        .map(|r| format!(" at {r} deg/s"))
+        .unwrap_or_default();
+    format!("{}{rate}", short.join("/"))
+}
+
+/// The panels of `signals.png` and its title.
+pub fn signal_panels(set: &DumpSet) -> (String, Vec<Figure>) {
+    let mut panels = Vec::new();
+    let mut zero = Vec::new();
+    for (d, decimated) in set
+        .full
+        .iter()
+        .map(|d| (d, false))
+        .chain(set.decimated.iter().map(|d| (d, true)))
+    {
+        let n = d.frames();
+        let shown = if decimated {
+            n
+        } else {
+            let per = set
+                .extra("f0_hz")
+                .map(|f0| (SHOWN_CARRIER_PERIODS * d.sample_rate_hz / f0).ceil() as usize);
+            n.min(per.unwrap_or(SHOWN_SAMPLES_UNKNOWN_F0)).max(2.min(n))
+        };
+        let x_label = if shown < n {
+            format!("Time (s): the first {shown} of {n} samples")
+        } else {
+            format!("Time (s): {n} samples at {} Hz", d.sample_rate_hz)
+        };
+        let ts: Vec<f64> = (0..shown).map(|k| d.time_s(k)).collect();
+        for (title, unit, chans) in groups(d) {
+            if chans.iter().all(|(_, x)| x.iter().all(|&v| v == 0.0)) {
+                zero.push(title);
+                continue;
+            }
+            let y_label = if unit.is_empty() {
+                "value".to_string()
+            } else {
+                format!("({unit})")
+            };
+            let mut f = Figure::new(title, x_label.as_str(), y_label);
+            for (name, x) in chans {
+                f = f.with(Series::new(
+                    name,
+                    SeriesStyle::Line,
+                    ts.clone(),
+                    x[..shown].to_vec(),
+                ));
+            }
+            panels.push(f);
+        }
+    }
+    let mut title = format!("{}: every node in time", heading(set));
+    if !zero.is_empty() {
+        title.push_str(&format!(" (zero throughout: {})", zero.join(", ")));
+    }
+    (title, panels)
+}
+
+/// A known frequency to mark: what it is and where.
+struct Mark {
+    what: String,
+    freq_hz: f64,
+}
+
+/// The markers of a full-rate panel: the carrier(s), the rotating excitation's sidebands when
+/// the spectrum resolves them, 2 f0 on the mixer's output (and DC there).
+fn full_rate_marks(set: &DumpSet, psd: &Psd, stage1: bool) -> (Vec<Mark>, Option<String>) {
+    let mut marks = Vec::new();
+    let mut note = None;
+    let Some(f0) = set.extra("f0_hz") else {
+        return (marks, Some("carrier unknown (no gyroemu:f0_hz)".into()));
+    };
+    let f0b = set.extra("f0_mode2_hz").unwrap_or(f0);
+    if stage1 {
+        marks.push(Mark {
+            what: "DC".into(),
+            freq_hz: 0.0,
+        });
+        marks.push(Mark {
+            what: "2 f0".into(),
+            freq_hz: 2.0 * f0,
+        });
+        return (marks, None);
+    }
+    marks.push(Mark {
+        what: "f0".into(),
+        freq_hz: f0,
+    });
+    if (f0b - f0).abs() > 2.0 * psd.bin_hz() {
+        marks.push(Mark {
+            what: "f0 mode 2".into(),
+            freq_hz: f0b,
+        });
+    }
+    if let Some(om) = set.extra("omega_hz").filter(|&o| o > 0.0) {
+        if om > 2.0 * psd.bin_hz() {
+            marks.push(Mark {
+                what: "f0 − Ω".into(),
+                freq_hz: f0 - om,
+            });
+            marks.push(Mark {
+                what: "f0 + Ω".into(),
+                freq_hz: f0 + om,
+            });
+        } else {
+            note = Some(format!(
+                "f0 ± Ω unresolved (Ω = {} Hz, bins {} Hz)",
+                sig3(om),
+                sig3(psd.bin_hz())
+            ));
+        }
+    }
+    (marks, note)
+}
+
+/// The markers of the low-pass panel: DC, the modulation (rotating: Ω; rate table: its
+/// frequency) and where the 2 f0 residual lands after decimation.
+fn lowpass_marks(set: &DumpSet, psd: &Psd) -> (Vec<Mark>, Option<String>) {
+    let mut marks = vec![Mark {
+        what: "DC".into(),
+        freq_hz: 0.0,
+    }];
+    let mut notes = Vec::new();
+    for (key, what) in [("omega_hz", "Ω"), ("table_freq_hz", "table frequency")] {
+        match set.extra(key).filter(|&f| f > 0.0) {
+            Some(f) if f > 2.0 * psd.bin_hz() => marks.push(Mark {
+                what: what.into(),
+                freq_hz: f,
+            }),
+            Some(f) => notes.push(format!(
+                "{what} ({} Hz) unresolved in {} Hz bins",
+                sig3(f),
+                sig3(psd.bin_hz())
+            )),
+            None => {}
+        }
+    }
+    let Some(f0) = set.extra("f0_hz") else {
+        return (marks, notes.pop());
+    };
+    let fs = psd.fs_hz;
+    let alias = (2.0 * f0 - fs * (2.0 * f0 / fs).round()).abs();
+    if alias > 2.0 * psd.bin_hz() {
+        marks.push(Mark {
+            what: "2 f0 residual (aliased)".into(),
+            freq_hz: alias,
+        });
+    } else {
+        notes.push("the 2 f0 residual aliases onto DC".into());
+    }
+    (marks, (!notes.is_empty()).then(|| notes.join("; ")))
+}
+
+/// One spectrum panel: the channels' densities (log axis, down to the display floor), the
+/// marks with each channel's level there.
+fn spectrum_panel(
+    title: &str,
+    unit: &str,
+    chans: &[(&str, &[f64])],
+    fs_hz: f64,
+    marks: impl Fn(&Psd) -> (Vec<Mark>, Option<String>),
+) -> Option<Figure> {
+    let psds: Vec<(&str, Psd)> = chans
+        .iter()
+        .filter(|(_, x)| x.iter().any(|&v| v != 0.0))
+        .filter_map(|(name, x)| Some((*name, welch(x, fs_hz, None).ok()?)))
+        .collect();
+    let first = &psds.first()?.1;
+    let peak = psds
+        .iter()
+        .flat_map(|(_, p)| p.density())
+        .fold(0.0, f64::max);
+    let floor = peak * 10f64.powf(-SPECTRUM_RANGE_DB / 10.0);
+    let (marks, note) = marks(first);
+    let mut f = Figure::new(
+        match note {
+            Some(n) => format!("{title}: {n}"),
+            None => title.to_string(),
+        },
+        format!(
+            "Frequency (Hz): {} segment(s) of {}, ENBW {} Hz",
+            first.segments,
+            first.segment_len,
+            sig3(first.enbw_hz)
+        ),
+        format!("PSD ({})", density_unit(unit)),
+    )
+    .log_y();
+    for (name, p) in &psds {
+        let ys = p.density().into_iter().map(|d| d.max(floor)).collect();
+        f = f.with(Series::new(*name, SeriesStyle::Line, p.freqs_hz(), ys));
+    }
+    for m in marks {
+        let levels: Vec<String> = psds
+            .iter()
+            .map(|(_, p)| {
+                tone_near(p, m.freq_hz, 2).map_or("-".into(), |t| format!("{:.1}", t.level_db()))
+            })
+            .collect();
+        f = f.with_marker(
+            m.freq_hz,
+            format!("{}: {} {}", m.what, levels.join(" / "), db_unit(unit)),
+        );
+    }
+    Some(f)
+}
+
+/// The panels of `spectrum.png` and its title.
+pub fn spectrum_panels(set: &DumpSet) -> (String, Vec<Figure>) {
+    let mut panels = Vec::new();
+    let full_groups = set.full.as_ref().map(groups).unwrap_or_default();
+    if let Some(d) = &set.full {
+        for (title, unit, chans) in &full_groups {
+            let stage1 = chans.iter().any(|(n, _)| n.starts_with("mix1_"));
+            panels.extend(spectrum_panel(title, unit, chans, d.sample_rate_hz, |p| {
+                full_rate_marks(set, p, stage1)
+            }));
+        }
+    }
+    if let Some(d) = &set.decimated {
+        let lp = lowpass_group(d);
+        if let Some((title, unit, chans)) = &lp {
+            panels.extend(spectrum_panel(title, unit, chans, d.sample_rate_hz, |p| {
+                lowpass_marks(set, p)
+            }));
+        }
+    }
+    let title = format!(
+        "{}: Welch PSD (one-sided, Hann, 50 % overlap); marked levels in dB re 1 unit rms",
+        heading(set)
+    );
+    (title, panels)
+}
+
+/// The low-pass output's channels of a decimated recording.
+fn lowpass_group(d: &Dump) -> Option<Group<'_>> {
+    groups(d)
+        .into_iter()
+        .find(|(_, _, c)| c.iter().any(|(n, _)| n.starts_with("lp_")))
+}

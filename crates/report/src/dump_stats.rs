@@ -1,0 +1,101 @@
+//! What `gyroemu inspect` prints about a dump: per channel the RMS, the peak and the
+//! strongest tones (frequency and level).
+
+use crate::dump_figures::{db_unit, SPECTRUM_RANGE_DB};
+use crate::dump_set::{channel_unit, DumpSet};
+use gyroemu_spectrum::{find_tones, welch, Tone};
+
+/// Tones listed per channel.
+pub const TONES_LISTED: usize = 4;
+/// A tone must stand this far above the spectrum's median bin to be listed, dB.
+pub const TONE_MIN_SNR_DB: f64 = 20.0;
+
+/// The numbers of one channel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChannelStats {
+    /// Channel name.
+    pub name: String,
+    /// Unit of its samples.
+    pub unit: String,
+    /// Root mean square over the recording.
+    pub rms: f64,
+    /// Largest |sample|.
+    pub peak: f64,
+    /// The strongest tones, strongest first, within [`SPECTRUM_RANGE_DB`] of the first (empty
+    /// when the spectrum cannot be computed).
+    pub tones: Vec<Tone>,
+    /// Why there are no tones, when the spectrum was refused (e.g. non-finite samples).
+    pub spectrum_error: Option<String>,
+}
+
+/// The statistics of every channel of `d`.
+pub fn channel_stats(d: &gyroemu_io::Dump) -> Vec<ChannelStats> {
+    d.channels
+        .iter()
+        .zip(&d.data)
+        .map(|(c, x)| {
+            let n = x.len().max(1) as f64;
+            let rms = (x.iter().map(|v| v * v).sum::<f64>() / n).sqrt();
+            let peak = x.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+            let (mut tones, spectrum_error) = match welch(x, d.sample_rate_hz, None) {
+                Ok(p) => (find_tones(&p, TONES_LISTED, TONE_MIN_SNR_DB), None),
+                Err(e) => (Vec::new(), Some(e.to_string())),
+            };
+            // Below that range lies f64 arithmetic's own floor, not the signal.
+            if let Some(top) = tones.first().map(Tone::level_db) {
+                tones.retain(|t| t.level_db() >= top - SPECTRUM_RANGE_DB);
+            }
+            ChannelStats {
+                name: c.name.clone(),
+                unit: channel_unit(&c.name, &c.unit).to_string(),
+                rms,
+                peak,
+                tones,
+                spectrum_error,
+            }
+        })
+        .collect()
+}
+
+/// The table `gyroemu inspect` prints: one block per recording, one line per channel.
+pub fn inspect_text(set: &DumpSet) -> String {
+    let mut out = String::new();
+    for d in set.recordings() {
+        let n = d.frames();
+        // A rate read from a CSV's time column carries its rounding: show it to 12 digits.
+        let fs = format!("{:.12e}", d.sample_rate_hz)
+            .parse::<f64>()
+            .unwrap_or(d.sample_rate_hz);
+        out.push_str(&format!(
+            "{}: {} channel(s), {n} samples at {fs} Hz, t = {:.6} .. {:.6} s\n",
+            d.path.display(),
+            d.channels.len(),
+            d.time_s(0),
+            d.time_s(n.saturating_sub(1)),
+        ));
+        out.push_str(&format!(
+            "  {:<10} {:<5} {:>11} {:>11}  strongest tones (Hz: level)\n",
+            "channel", "unit", "rms", "peak"
+        ));
+        for s in channel_stats(d) {
+            let tones = match (&s.spectrum_error, s.tones.is_empty()) {
+                (Some(e), _) => format!("no spectrum: {e}"),
+                (None, true) => format!("none {TONE_MIN_SNR_DB} dB above the median bin"),
+                (None, false) => s
+                    .tones
+                    .iter()
+                    .map(|t| format!("{:.1}: {:.1} {}", t.freq_hz, t.level_db(), db_unit(&s.unit)))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            };
+            out.push_str(&format!(
+                "  {:<10} {:<5} {:>11.4e} {:>11.4e}  {tones}\n",
+                s.name,
+                if s.unit.is_empty() { "-" } else { &s.unit },
+                s.rms,
+                s.peak
+            ));
+        }
+    }
+    out
+}

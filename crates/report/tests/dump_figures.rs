@@ -1,0 +1,156 @@
+//! The figures and statistics of a dump, on a synthetic recording of known tones: the tone
+//! finder's levels are the closed forms 20 log10(A / sqrt 2), the marks sit at f0, f0 +- Omega
+//! and 2 f0, and every way of naming the dump reads the same pair.
+
+use gyroemu_io::SignalRecorder;
+use gyroemu_report::dump_figures::{signal_panels, spectrum_panels};
+use gyroemu_report::{channel_stats, read_dump_set, write_dump_figures};
+use std::collections::BTreeMap;
+use std::f64::consts::PI;
+use std::path::Path;
+
+const FS: f64 = 48_000.0;
+const F0: f64 = 3_010.0;
+const OMEGA: f64 = 700.0;
+const M: usize = 48;
+
+fn write_pair(dir: &Path) {
+    let extra = BTreeMap::from([
+        ("f0_hz".to_string(), F0),
+        ("omega_hz".into(), OMEGA),
+        ("rate_dps".into(), OMEGA * 360.0),
+        ("decimation".into(), M as f64),
+    ]);
+    let names = ["drive1", "tia1_v", "mix1_i1"].map(String::from).to_vec();
+    let mut full = SignalRecorder::new(names, FS, 0, 8192).with_extra(extra.clone());
+    for n in 0..8192u64 {
+        let t = n as f64 / FS;
+        let w = 2.0 * PI * F0 * t;
+        full.record(
+            n,
+            &[
+                0.8 * w.cos(),
+                1e-3 * (w + 0.3).sin() + 2e-5 * (2.0 * PI * (F0 + OMEGA) * t).sin(),
+                0.5e-3 + 1e-3 * (2.0 * w).cos(),
+            ],
+        );
+    }
+    full.write(dir, "dump_fullrate").unwrap();
+    let fs_out = FS / M as f64;
+    let mut dec = SignalRecorder::new(vec!["lp_i1".into()], fs_out, 0, 2048).with_extra(extra);
+    for k in 0..2048u64 {
+        let t = k as f64 / fs_out;
+        dec.record(k, &[0.5e-3 + 1e-6 * (2.0 * PI * 123.0 * t).cos()]);
+    }
+    dec.write(dir, "dump_decimated").unwrap();
+}
+
+fn db(a: f64) -> f64 {
+    20.0 * (a / 2f64.sqrt()).log10()
+}
+
+#[test]
+fn stats_give_the_closed_form_tones_and_units() {
+    let dir = tempfile::tempdir().unwrap();
+    write_pair(dir.path());
+    let set = read_dump_set(dir.path()).unwrap();
+    let full = channel_stats(set.full.as_ref().unwrap());
+    let tia = &full[1];
+    assert_eq!((tia.name.as_str(), tia.unit.as_str()), ("tia1_v", "V"));
+    assert_eq!(full[0].unit, "m/s²");
+    assert_eq!(full[2].unit, "V");
+    assert!((tia.peak - 1e-3).abs() < 3e-5);
+    let near = |f: f64| {
+        tia.tones
+            .iter()
+            .find(|t| (t.freq_hz - f).abs() < 1.0)
+            .unwrap_or_else(|| panic!("no tone at {f} in {:?}", tia.tones))
+    };
+    assert!((near(F0).level_db() - db(1e-3)).abs() < 0.05);
+    assert!((near(F0 + OMEGA).level_db() - db(2e-5)).abs() < 0.05);
+    // RMS of two sinusoids: sqrt(A1^2/2 + A2^2/2), over whole-ish periods.
+    let rms = ((1e-6 + 4e-10) / 2.0f64).sqrt();
+    assert!((tia.rms / rms - 1.0).abs() < 1e-3, "{} vs {rms}", tia.rms);
+    // Mixer: DC 0.5 mV and 2 f0 at 1 mV amplitude.
+    let mix = &full[2];
+    assert!(mix
+        .tones
+        .iter()
+        .any(|t| t.freq_hz == 0.0 && (t.amplitude() - 0.5e-3).abs() < 1e-7));
+    assert!(mix
+        .tones
+        .iter()
+        .any(|t| (t.freq_hz - 2.0 * F0).abs() < 1.0 && (t.level_db() - db(1e-3)).abs() < 0.05));
+}
+
+#[test]
+fn spectrum_marks_the_carrier_sidebands_and_mixer_product_with_their_levels() {
+    let dir = tempfile::tempdir().unwrap();
+    write_pair(dir.path());
+    let set = read_dump_set(&dir.path().join("dump")).unwrap();
+    let (title, panels) = spectrum_panels(&set);
+    assert!(title.contains("at 252000 deg/s"), "{title}");
+    let tia = panels.iter().find(|f| f.title.starts_with("TIA")).unwrap();
+    assert!(tia.y_log);
+    let xs: Vec<f64> = tia.markers.iter().map(|m| m.x).collect();
+    assert_eq!(xs, [F0, F0 - OMEGA, F0 + OMEGA]);
+    let f0_label = &tia.markers[0].label;
+    assert!(
+        f0_label.contains(&format!("{:.1} dBV", db(1e-3))),
+        "{f0_label}"
+    );
+    let mix = panels
+        .iter()
+        .find(|f| f.title.starts_with("Stage-1"))
+        .unwrap();
+    assert!(mix
+        .markers
+        .iter()
+        .any(|m| m.x == 2.0 * F0 && m.label.starts_with("2 f0")));
+    // The low-pass panel: DC and the 2 f0 residual where decimation folds it (6020 Hz at
+    // 1 kHz: 20 Hz).
+    let lp = panels
+        .iter()
+        .find(|f| f.title.starts_with("Low-pass"))
+        .unwrap();
+    let alias = lp
+        .markers
+        .iter()
+        .find(|m| m.label.contains("residual"))
+        .unwrap();
+    assert!((alias.x - 20.0).abs() < 1e-9, "{}", alias.x);
+    let (_, sig) = signal_panels(&set);
+    assert_eq!(sig.len(), 4);
+}
+
+#[test]
+fn every_name_of_the_dump_reads_the_same_pair_and_figures_are_written() {
+    let dir = tempfile::tempdir().unwrap();
+    write_pair(dir.path());
+    let d = dir.path();
+    for p in [
+        d.to_path_buf(),
+        d.join("dump"),
+        d.join("dump_fullrate.sigmf-meta"),
+        d.join("dump_decimated.sigmf-data"),
+        d.join("dump_fullrate"),
+        d.join("dump_decimated.csv"),
+    ] {
+        let set = read_dump_set(&p).unwrap_or_else(|e| panic!("{p:?}: {e}"));
+        assert_eq!(set.full.as_ref().map(|f| f.frames()), Some(8192), "{p:?}");
+        assert_eq!(
+            set.decimated.as_ref().map(|f| f.frames()),
+            Some(2048),
+            "{p:?}"
+        );
+    }
+    assert!(read_dump_set(&d.join("dump_fullrate.wav")).is_err());
+    let set = read_dump_set(d).unwrap();
+    let out = d.join("figs");
+    std::fs::create_dir(&out).unwrap();
+    let files = write_dump_figures(&set, &out).unwrap();
+    assert_eq!(files, [out.join("signals.png"), out.join("spectrum.png")]);
+    for f in files {
+        assert_eq!(&std::fs::read(f).unwrap()[..4], b"\x89PNG");
+    }
+}

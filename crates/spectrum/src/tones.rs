@@ -1,0 +1,115 @@
+//! Tones in a Welch spectrum: peaks, their frequency between bins and their level corrected
+//! for the window's scalloping.
+
+use crate::window::hann_response;
+use crate::Psd;
+
+/// One tone found in a spectrum.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tone {
+    /// Frequency, Hz, refined between bins (0 for the DC level).
+    pub freq_hz: f64,
+    /// Mean square of the tone, unit^2 (A^2/2 for a sinusoid of amplitude A; c^2 for DC).
+    pub mean_square: f64,
+    /// Bin of the peak.
+    pub bin: usize,
+}
+
+impl Tone {
+    /// Level in dB re 1 unit rms (dBV for volts): `10 log10(mean_square)`.
+    pub fn level_db(&self) -> f64 {
+        10.0 * self.mean_square.log10()
+    }
+
+    /// Peak amplitude: `sqrt(2 mean_square)` for a sinusoid, `|c|` for DC.
+    pub fn amplitude(&self) -> f64 {
+        if self.bin == 0 {
+            self.mean_square.sqrt()
+        } else {
+            (2.0 * self.mean_square).sqrt()
+        }
+    }
+}
+
+/// The tone whose peak is bin `k`: between bins k and its larger neighbour the Hann response
+/// ratio `H(1 - d) / H(d)` (0.5 at d = 0, 1 at d = 1/2) is solved for the offset d, then the
+/// peak power is divided by `H(d)^2`. Exact for one stationary sinusoid far (a few bins) from
+/// DC, fs/2 and other tones; the bins at 0 and L/2 are read as they are.
+fn refine(psd: &Psd, k: usize) -> Tone {
+    let p = &psd.power;
+    let l = psd.segment_len;
+    if k == 0 || k + 1 >= p.len() {
+        return Tone {
+            freq_hz: psd.freq_hz(k),
+            mean_square: p[k],
+            bin: k,
+        };
+    }
+    let (side, neighbour) = if p[k + 1] >= p[k - 1] {
+        (1.0, p[k + 1])
+    } else {
+        (-1.0, p[k - 1])
+    };
+    let r = (neighbour / p[k]).sqrt();
+    let ratio = |d: f64| hann_response(1.0 - d, l) / hann_response(d, l);
+    let d = if r <= ratio(0.0) {
+        0.0
+    } else {
+        // The ratio grows monotonically on [0, 1): bisect to full precision.
+        let (mut lo, mut hi) = (0.0, 0.999_999);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if ratio(mid) < r {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    };
+    let g = hann_response(d, l);
+    Tone {
+        freq_hz: (k as f64 + side * d) * psd.bin_hz(),
+        mean_square: p[k] / (g * g),
+        bin: k,
+    }
+}
+
+/// The strongest `max` tones of `psd`, strongest first: local maxima of the power spectrum (DC
+/// counts when bin 0 exceeds bin 1) at least `min_snr_db` above the median bin. A single
+/// sinusoid's leakage, sampled at the bins, falls monotonically away from its peak, so its
+/// sidelobes are not reported as tones.
+pub fn find_tones(psd: &Psd, max: usize, min_snr_db: f64) -> Vec<Tone> {
+    let p = &psd.power;
+    if p.len() < 2 {
+        return Vec::new();
+    }
+    let mut sorted = p.clone();
+    sorted.sort_by(f64::total_cmp);
+    let floor = sorted[sorted.len() / 2] * 10f64.powf(min_snr_db / 10.0);
+    let last = p.len() - 1;
+    let mut peaks: Vec<usize> = (0..p.len())
+        .filter(|&k| {
+            let left = k == 0 || p[k] > p[k - 1];
+            let right = k == last || p[k] >= p[k + 1];
+            left && right && p[k] > floor && p[k] > 0.0
+        })
+        .collect();
+    peaks.sort_by(|&a, &b| p[b].total_cmp(&p[a]));
+    peaks.truncate(max);
+    peaks.into_iter().map(|k| refine(psd, k)).collect()
+}
+
+/// The tone at the strongest bin within `bins` bins of `freq_hz` (a known frequency such as
+/// the carrier), refined like [`find_tones`]; `None` outside the spectrum.
+pub fn tone_near(psd: &Psd, freq_hz: f64, bins: usize) -> Option<Tone> {
+    let c = (freq_hz / psd.bin_hz()).round();
+    if !(c >= 0.0 && (c as usize) < psd.power.len()) {
+        return None;
+    }
+    let c = c as usize;
+    let lo = c.saturating_sub(bins);
+    let hi = (c + bins).min(psd.power.len() - 1);
+    let k = (lo..=hi).max_by(|&a, &b| psd.power[a].total_cmp(&psd.power[b]))?;
+    Some(refine(psd, k))
+}
