@@ -6,7 +6,7 @@
 
 mod common;
 
-use gyroemu::analysis::selfcal::{run_selfcal_core, validate_selfcal};
+use gyroemu::analysis::selfcal::{linearised_slope, run_selfcal_core, validate_selfcal};
 use gyroemu::analysis::selfcal_analyses::{drift_analysis, tau_analysis};
 use gyroemu::config::presets::preset;
 use gyroemu::config::{Config, NoiseConfig, SelfcalConfig};
@@ -57,14 +57,41 @@ fn drift_selfcal_tracks_the_scale_factor_and_a_stale_one_misses_by_the_q_over_f0
     let deltas = [-30.0, 40.0];
     let d = drift_analysis(&c, &deltas, nominal, &quiet).unwrap();
     for (p, dt) in d.iter().zip(deltas) {
-        assert!(p.selfcal_relative_error.abs() < 1e-4, "{p:?}");
+        // PLL-tracked: the carrier sits on the drifted resonance.
+        let pll = p.pll.as_ref().expect("the default loop fits this board");
+        assert!((pll.carrier_hz / p.f0_hz - 1.0).abs() < 1e-7, "{p:?}");
+        assert!(pll.selfcal_relative_error.abs() < 1e-4, "{p:?}");
         // Scale factor 2 Q lambda / w0: the stale calibration is off by (Q/f0)/(Q'/f0') - 1.
         let ratio = (1.0 - 30e-6 * dt) / (1.0 - 3000e-6 * dt);
         assert!(
-            (p.stale_relative_error - (ratio - 1.0)).abs() < 1e-4,
+            (pll.stale_relative_error - (ratio - 1.0)).abs() < 1e-4,
             "{p:?}, expected stale error {}",
             ratio - 1.0
         );
+        // Open loop: the carrier stays at the nominal f0, detuned from the drifted mode by
+        // -30 ppm/K; both sweeps read a detuned drive, as the exact theory of a drive at that
+        // carrier says (its slopes read like the sweeps').
+        let open = gyroemu::analysis::selfcal::drifted(&c, dt);
+        assert_eq!(p.open_loop.carrier_hz, c.device.f0_hz);
+        let dev = open.driven_device();
+        let rates = &c.experiment.rates_dps;
+        let deg = |r: [f64; 2]| r[0].to_degrees();
+        let rot: Vec<f64> = rates
+            .iter()
+            .map(|&r| deg(dev.rotating_psi_rad(r.to_radians())))
+            .collect();
+        let cor: Vec<f64> = rates
+            .iter()
+            .map(|&r| deg(dev.coriolis_phase_rad(r.to_radians())))
+            .collect();
+        let slope = |ph: &[f64]| linearised_slope(rates, ph).slope_deg_per_dps;
+        let want = c.device.angular_gain * slope(&rot) / slope(&cor) - 1.0;
+        assert!(
+            (p.open_loop.selfcal_relative_error - want).abs() < 1e-4,
+            "{p:?}: theory {want}"
+        );
+        // Detuned by 4.8 (at -40 K) half-bandwidths, the open loop's error is far from 0.
+        assert!(p.open_loop.selfcal_relative_error.abs() > 1e-2, "{p:?}");
     }
 }
 

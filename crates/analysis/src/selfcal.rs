@@ -123,8 +123,9 @@ pub fn drifted(cfg: &Config, delta_t_k: f64) -> Config {
     c.device.mode2_f0_offset_hz *= f_scale;
     c.device.q *= q_scale;
     c.device.q_mode2 = c.device.q_mode2.map(|q| q * q_scale);
-    // The carrier follows the resonance (a perfectly tracked drive).
-    c.drive.carrier_hz = c.drive.carrier_hz.map(|f| f * f_scale);
+    // The board does not drift: its carrier stays where it was set (open loop); a PLL can
+    // lock it onto the drifted resonance (`drift_analysis`).
+    c.drive.carrier_hz = Some(cfg.carrier_hz());
     c
 }
 
@@ -183,6 +184,16 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
     add("rotating sweep", rot.validate());
     add("rate-table sweep", cor.validate());
     if let Some(s) = &cfg.selfcal {
+        if !s.drift_delta_t_k.is_empty() && cfg.pll.is_none() {
+            // The PLL-tracked half of the drift scenario locks with the default loop; where
+            // none fits the board, that half is left out (null), and said so.
+            if let Err(e) = crate::selfcal_analyses::drift_pll_design(cfg).validate() {
+                add("drift scenario", Ok(vec![format!(
+                    "selfcal.drift_delta_t_k: the drift scenario's PLL-tracked half is left out (null): the default carrier PLL does not fit this board ({}); add a [pll] section that fits to get it",
+                    e.problems().iter().map(|p| p.to_string()).collect::<Vec<_>>().join("; ")
+                )]));
+            }
+        }
         for &dt in &s.drift_delta_t_k {
             let (r, c) = sweep_configs(&drifted(cfg, dt));
             let what = format!("drift scenario at {dt} K");

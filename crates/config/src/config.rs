@@ -21,6 +21,33 @@ pub struct Config {
     /// The analyses of `gyroemu selfcal` (absent: only the two sweeps and their comparison).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub selfcal: Option<SelfcalConfig>,
+    /// A carrier PLL that locks the drive onto the resonance before the sweep (absent: the
+    /// carrier is `drive.carrier_hz`, open loop).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pll: Option<PllConfig>,
+}
+
+/// The carrier PLL (`crates/pll`): at zero rate the board drives the device and the PLL steers
+/// the carrier onto the resonance of one mode from its demodulated output; the sweep then runs
+/// with the carrier held where the lock ended.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PllConfig {
+    /// The loop's natural frequency, Hz; default the geometric mean of the slowest loop a PI
+    /// on the frequency can make (2 zeta w_n tau >= 1) and the fastest the low-pass allows
+    /// (read it with [`Config::pll_natural_hz`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub natural_hz: Option<f64>,
+    /// The loop's damping ratio.
+    #[serde(default = "default_damping")]
+    pub damping: f64,
+    /// Length of the lock run, s; default 16 mechanical time constants plus 10 loop time
+    /// constants 1/(zeta w_n) (read it with [`Config::pll_lock_s`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lock_s: Option<f64>,
+    /// The mode whose output the PLL locks on: 1 or 2.
+    #[serde(default = "default_pll_mode")]
+    pub mode: usize,
 }
 
 /// The resonator (THEORY.md section 2).
@@ -253,6 +280,12 @@ pub struct DumpConfig {
     pub nodes: Option<Vec<String>>,
 }
 
+fn default_damping() -> f64 {
+    core::f64::consts::FRAC_1_SQRT_2
+}
+fn default_pll_mode() -> usize {
+    1
+}
 fn default_transduction() -> f64 {
     1e-6
 }

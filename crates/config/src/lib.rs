@@ -19,7 +19,7 @@ mod validate_regime;
 
 pub use config::{
     BoardConfig, Config, DeviceConfig, DriveConfig, DumpConfig, ExperimentConfig, ExperimentKind,
-    NoiseConfig, RateTable, SelfcalConfig, WindowKind,
+    NoiseConfig, PllConfig, RateTable, SelfcalConfig, WindowKind,
 };
 pub use error::ConfigError;
 pub use parse::{parse_config, parse_config_explained, plain_words};

@@ -208,6 +208,35 @@ impl Config {
                 ),
             });
         }
+        if let Some(pll) = self.pll.clone() {
+            if pll.natural_hz.is_none() {
+                let f = self.pll_natural_hz().unwrap_or(f64::NAN);
+                let (lo, hi) = pll_bounds_hz(self, pll.damping, pll.mode);
+                if let Some(p) = self.pll.as_mut() {
+                    p.natural_hz = Some(f);
+                }
+                out.push(Derived {
+                    key: "pll.natural_hz",
+                    value: fmt(f),
+                    rule: format!(
+                        "geometric mean of the slowest loop a PI on the frequency can make ({}) and the fastest the low-pass allows ({})",
+                        fmt(lo),
+                        fmt(hi)
+                    ),
+                });
+            }
+            if pll.lock_s.is_none() {
+                let t = self.pll_lock_s().unwrap_or(f64::NAN);
+                if let Some(p) = self.pll.as_mut() {
+                    p.lock_s = Some(t);
+                }
+                out.push(Derived {
+                    key: "pll.lock_s",
+                    value: fmt(t),
+                    rule: "16 mechanical time constants plus 10 loop time constants 1/(damping x 2 pi natural_hz)".into(),
+                });
+            }
+        }
         if let (Some(given), Some(full)) = (self.dump.clone(), self.dump_resolved()) {
             let pairs = [
                 ("dump.rate_dps", given.rate_dps.is_none(), "the largest listed rate"),
@@ -243,4 +272,51 @@ impl Config {
 /// A number as TOML writes it.
 fn fmt(x: f64) -> String {
     toml::Value::Float(x).to_string()
+}
+
+/// The loop bounds of the carrier PLL a config allows, Hz: `(lowest, highest)` natural
+/// frequency. A PI on the frequency cannot make a loop slower than the envelope damps it
+/// (2 zeta w_n tau >= 1, tau = Q/(pi f0) of the locked mode), and the loop must stay within a
+/// tenth of the update rate and lag the demodulation low-pass's group delay d by at most
+/// `w_n d = 0.05` rad (`gyroemu_pll::MAX_NATURAL_PER_UPDATE`, `MAX_LOWPASS_LAG_RAD`).
+pub fn pll_bounds_hz(cfg: &Config, damping: f64, mode: usize) -> (f64, f64) {
+    let (f0, q) = if mode == 2 {
+        (
+            cfg.f0_mode2_hz(),
+            cfg.device.q_mode2.unwrap_or(cfg.device.q),
+        )
+    } else {
+        (cfg.device.f0_hz, cfg.device.q)
+    };
+    let tau = q / (core::f64::consts::PI * f0);
+    let lowest = 1.0 / (2.0 * damping * tau * core::f64::consts::TAU);
+    let delay_s = gyroemu_lpf::LowPass::<f64>::new(cfg.lowpass_design(), cfg.fs_hz())
+        .map(|lp| gyroemu_core::Stage::latency_samples(&lp) / cfg.fs_hz())
+        .unwrap_or(f64::NAN);
+    let highest = (0.1 * cfg.fs_out_hz()).min(0.05 / (core::f64::consts::TAU * delay_s));
+    (lowest, highest)
+}
+
+impl Config {
+    /// The carrier PLL's natural frequency, Hz (set, or the geometric mean of the bounds of
+    /// [`pll_bounds_hz`]); `None` without a `[pll]` section.
+    pub fn pll_natural_hz(&self) -> Option<f64> {
+        let p = self.pll.as_ref()?;
+        Some(p.natural_hz.unwrap_or_else(|| {
+            let (lo, hi) = pll_bounds_hz(self, p.damping, p.mode);
+            (lo * hi).sqrt()
+        }))
+    }
+
+    /// The lock run's length, s (set, or 16 mechanical time constants of the locked mode plus
+    /// 10 loop time constants 1/(zeta w_n)); `None` without a `[pll]` section.
+    pub fn pll_lock_s(&self) -> Option<f64> {
+        let p = self.pll.as_ref()?;
+        let natural = self.pll_natural_hz()?;
+        Some(p.lock_s.unwrap_or_else(|| {
+            let q = self.device.q.max(self.device.q_mode2.unwrap_or(0.0));
+            16.0 * q / (core::f64::consts::PI * self.device.f0_hz)
+                + 10.0 / (p.damping * core::f64::consts::TAU * natural)
+        }))
+    }
 }

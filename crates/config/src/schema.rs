@@ -155,6 +155,16 @@ pub(crate) const SECTIONS: &[Section] = &[
             opt("q_tc_ppm_per_k", Number),
         ],
     },
+    Section {
+        name: "pll",
+        required: false,
+        fields: &[
+            opt("natural_hz", Number),
+            opt("damping", Number),
+            opt("lock_s", Number),
+            opt("mode", COUNT),
+        ],
+    },
 ];
 
 /// `` `a` ``, `` `a` or `b` ``, `` one of `a`, `b`, `c` `` (what follows "expected").

@@ -33,6 +33,9 @@ pub enum SweepError {
     /// Points without a result (indices in `emulated_rates_dps`).
     #[error("the sweep is missing the results of points {0:?}")]
     Missing(Vec<usize>),
+    /// The carrier PLL did not lock (the sweep would run at a carrier still moving).
+    #[error("{0}")]
+    NotLocked(String),
 }
 
 /// The file stem of a sweep's signal dump in its output folder (see [`Probe::write`]).

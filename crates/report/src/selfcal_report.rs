@@ -5,7 +5,7 @@ use crate::error::ReportError;
 use crate::sweep_report::health_json;
 use gyroemu_analysis::allan::AllanPoint;
 use gyroemu_analysis::selfcal::SelfcalCore;
-use gyroemu_analysis::selfcal_analyses::{AllanResult, DriftPoint, TauPoint};
+use gyroemu_analysis::selfcal_analyses::{AllanResult, DriftCase, DriftPoint, TauPoint};
 use gyroemu_analysis::SelfcalReport;
 use gyroemu_config::Config;
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
@@ -362,18 +362,25 @@ fn tau_figure(t: &[TauPoint], average_s: f64) -> Figure {
 }
 
 fn drift_table(d: &[DriftPoint]) -> CsvTable {
+    let case = |c: Option<&DriftCase>| {
+        c.map_or([f64::NAN; 5], |c| {
+            [
+                c.carrier_hz,
+                c.measured_deg_per_dps,
+                c.selfcal_deg_per_dps,
+                c.selfcal_relative_error,
+                c.stale_relative_error,
+            ]
+        })
+    };
     let rows = d
         .iter()
         .map(|p| {
-            vec![
-                p.delta_t_k,
-                p.f0_hz,
-                p.q,
-                p.measured_deg_per_dps,
-                p.selfcal_deg_per_dps,
-                p.selfcal_relative_error,
-                p.stale_relative_error,
-            ]
+            let mut r = vec![p.delta_t_k, p.f0_hz, p.q];
+            r.extend(case(Some(&p.open_loop)));
+            r.extend(case(p.pll.as_ref()));
+            r.push(p.pll_lock_time_s.unwrap_or(f64::NAN));
+            r
         })
         .collect();
     table(
@@ -381,10 +388,17 @@ fn drift_table(d: &[DriftPoint]) -> CsvTable {
             "delta_t_k",
             "f0_hz",
             "q",
-            "measured_deg_per_dps",
-            "selfcal_deg_per_dps",
-            "selfcal_relative_error",
-            "stale_relative_error",
+            "open_loop_carrier_hz",
+            "open_loop_measured_deg_per_dps",
+            "open_loop_selfcal_deg_per_dps",
+            "open_loop_selfcal_relative_error",
+            "open_loop_stale_relative_error",
+            "pll_carrier_hz",
+            "pll_measured_deg_per_dps",
+            "pll_selfcal_deg_per_dps",
+            "pll_selfcal_relative_error",
+            "pll_stale_relative_error",
+            "pll_lock_time_s",
         ],
         rows,
     )
@@ -393,21 +407,37 @@ fn drift_table(d: &[DriftPoint]) -> CsvTable {
 fn drift_figure(d: &[DriftPoint]) -> Figure {
     let xs: Vec<f64> = d.iter().map(|p| p.delta_t_k).collect();
     let pct = |v: f64| 100.0 * v;
+    let series = |name: &str, style: SeriesStyle, f: &dyn Fn(&DriftPoint) -> Option<f64>| {
+        let (x, y): (Vec<f64>, Vec<f64>) = xs
+            .iter()
+            .zip(d)
+            .filter_map(|(&x, p)| f(p).map(|y| (x, y)))
+            .unzip();
+        Series::new(name, style, x, y)
+    };
     Figure::new(
-        "Drift: the self-calibration tracks the Coriolis scale factor",
+        "Drift: self-calibration with the carrier open loop and PLL-tracked",
         "Temperature offset (K)",
         "Scale-factor error against the rate table (%)",
     )
-    .with(Series::new(
-        "self-calibrated at that temperature",
+    .with(series(
+        "self-calibrated, PLL-tracked carrier",
         SeriesStyle::Points,
-        xs.clone(),
-        d.iter().map(|p| pct(p.selfcal_relative_error)).collect(),
+        &|p| p.pll.as_ref().map(|c| pct(c.selfcal_relative_error)),
     ))
-    .with(Series::new(
-        "calibrated once at the nominal temperature",
+    .with(series(
+        "self-calibrated, open loop at the nominal carrier",
+        SeriesStyle::Points,
+        &|p| Some(pct(p.open_loop.selfcal_relative_error)),
+    ))
+    .with(series(
+        "calibrated once, PLL-tracked carrier",
         SeriesStyle::OpenPoints,
-        xs,
-        d.iter().map(|p| pct(p.stale_relative_error)).collect(),
+        &|p| p.pll.as_ref().map(|c| pct(c.stale_relative_error)),
+    ))
+    .with(series(
+        "calibrated once, open loop",
+        SeriesStyle::OpenPoints,
+        &|p| Some(pct(p.open_loop.stale_relative_error)),
     ))
 }

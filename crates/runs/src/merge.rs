@@ -8,7 +8,7 @@ use crate::error::RunError;
 use crate::manifest::{read_manifest, shard_manifest_paths, Manifest, RUN_MANIFEST};
 use crate::points::{config_hash, scan_points, PointFile, POINTS_DIR};
 use gyroemu_config::parse_config;
-use gyroemu_experiment::{finish_sweep, Reporter};
+use gyroemu_experiment::{finish_sweep, resolve_lock, Reporter};
 use gyroemu_report::{check_problems, run_title, write_run};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -180,11 +180,16 @@ pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunErr
             lost.join(", ")
         )));
     }
-    let r = finish_sweep(&cfg, &lanes)?;
+    // The shards swept at the carrier a [pll] locked: lock again (the same bits) to read out.
+    let (held, lock) = resolve_lock(&cfg)?;
+    if let Some(l) = &lock {
+        reporter.note(&crate::run::lock_note(l));
+    }
+    let r = finish_sweep(&held, &lanes)?;
     let all: Vec<usize> = (0..n).collect();
     let mut m = Manifest::new("complete", &hash, &first.config_toml, None, n, &all, &lanes);
     let path = dir.join(RUN_MANIFEST);
-    let mut files = match write_run(dir, &cfg, &r, &run_title(&cfg)) {
+    let mut files = match write_run(dir, &held, &r, &run_title(&cfg)) {
         Ok(f) => f,
         Err(e) => {
             // The run manifest says the merge failed and why (the shards' stay as they are).
