@@ -130,9 +130,8 @@ impl<S: Sample> Resonator<S> {
     /// [`Resonator::tick_with_rate_split`] applies.
     pub fn rate_split_by_mode(&self) -> bool {
         let mode = |j: usize| j % 2;
-        let zero = |b: &[[S; 6]; 4], i: usize, j: usize| {
-            (0..S::LANES).all(|l| b[i][j].lane(l) == 0.0)
-        };
+        let zero =
+            |b: &[[S; 6]; 4], i: usize, j: usize| (0..S::LANES).all(|l| b[i][j].lane(l) == 0.0);
         (0..4).all(|i| {
             (0..6).all(|j| {
                 if mode(j) == mode(i) {

@@ -180,7 +180,9 @@ fn rate_split_step_equals_the_full_time_varying_step() {
     }
     let mut pk = p;
     pk.quadrature_coupling_rad2_s2 = 1e-3;
-    assert!(!Resonator::<f64>::new(&pk, 0.0).unwrap().rate_split_by_mode());
+    assert!(!Resonator::<f64>::new(&pk, 0.0)
+        .unwrap()
+        .rate_split_by_mode());
     assert!(!Resonator::<f64>::new(&p, 0.5).unwrap().rate_split_by_mode());
     let plain = Resonator::<f64>::new(&p, 0.0).unwrap();
     let coupled = Resonator::<f64>::new(&pk, 0.0).unwrap();
