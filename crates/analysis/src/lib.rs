@@ -7,6 +7,7 @@ pub mod allan;
 pub mod bandwidth;
 pub mod selfcal;
 pub mod selfcal_analyses;
+pub mod selfcal_combined;
 mod selfcal_run;
 
 pub use selfcal_run::{run_selfcal, selfcal_work, SelfcalReport};

@@ -4,6 +4,7 @@
 
 use crate::allan::{noise_readings, overlapping_adev, AllanPoint, NoiseReadings};
 use crate::selfcal::{drifted, linearised_slope, run_selfcal_core, sweep_configs};
+use crate::selfcal_combined::combined_slope;
 use gyroemu_board::{Board, LaneResult, Point, RunOptions, MAX_LANES};
 use gyroemu_config::{Config, PllConfig};
 use gyroemu_core::f64x4;
@@ -130,6 +131,11 @@ pub struct TauPoint {
     /// Predicted over the small-angle theory of an ideal device, minus one (noise and
     /// truncation only, without the rate table's own error).
     pub relative_error_vs_theory: f64,
+    /// Both modes together: lambda times the geometric mean of their rotating slopes.
+    pub combined_predicted_deg_per_dps: f64,
+    /// That over the combined Coriolis slope measured by the sweep, minus one.
+    pub combined_relative_error: f64,
+    pub combined_relative_error_ci95: f64,
 }
 
 /// The averaging times read: 1, 2, 5 per decade up to `tau_max_s`, plus the config's
@@ -150,12 +156,14 @@ pub fn tau_grid(tau_max_s: f64, average_s: f64) -> Vec<f64> {
 
 /// One rotating run of `tau_max_s`, read at every averaging time of [`tau_grid`] (each point
 /// averaged over whole half periods once tau spans one, as the sweep does), compared with
-/// the measured Coriolis slope of mode 1.
+/// the measured Coriolis slope of mode 1, and the two modes' combined prediction with their
+/// combined measured slope (`combined_measured_deg_per_dps`, NaN to leave it out).
 pub fn tau_analysis(
     cfg: &Config,
     tau_max_s: f64,
     measured_deg_per_dps: f64,
     theory_deg_per_dps: f64,
+    combined_measured_deg_per_dps: f64,
     progress: Progress,
 ) -> Result<Vec<TauPoint>, SweepError> {
     let (mut rot, _) = sweep_configs(cfg);
@@ -243,8 +251,13 @@ pub fn tau_analysis(
             c.experiment.average_s = tau;
             let res = post_process(&c, &rates, &windows[ti], &lanes)?;
             let xs: Vec<f64> = res.points.iter().map(|p| p.rate_dps).collect();
-            let ys: Vec<f64> = res.points.iter().map(|p| p.phase_deg[0]).collect();
+            let [ys, ys2]: [Vec<f64>; 2] =
+                [0, 1].map(|k| res.points.iter().map(|p| p.phase_deg[k]).collect());
             let s = linearised_slope(&xs, &ys);
+            let comb = combined_slope(&xs, [&ys, &ys2]);
+            let comb_predicted = lambda * comb.slope_deg_per_dps;
+            let comb_ratio = comb_predicted / combined_measured_deg_per_dps;
+            let comb_ci = gyroemu_experiment::fit::t95(comb.dof) * comb_ratio * comb.rel_std_err;
             let predicted = lambda * s.slope_deg_per_dps;
             let ratio = predicted / measured_deg_per_dps;
             let ci = gyroemu_experiment::fit::t95(s.dof) * ratio * s.std_err_deg_per_dps
@@ -256,6 +269,9 @@ pub fn tau_analysis(
                 relative_error: ratio - 1.0,
                 relative_error_ci95: ci.abs(),
                 relative_error_vs_theory: predicted / theory_deg_per_dps - 1.0,
+                combined_predicted_deg_per_dps: comb_predicted,
+                combined_relative_error: comb_ratio - 1.0,
+                combined_relative_error_ci95: comb_ci.abs(),
             })
         })
         .collect()
@@ -274,6 +290,8 @@ pub struct DriftCase {
     pub selfcal_relative_error: f64,
     /// Error of keeping the nominal-temperature calibration instead.
     pub stale_relative_error: f64,
+    /// Self-calibration error of both modes together at this temperature.
+    pub combined_selfcal_relative_error: f64,
 }
 
 /// The self-calibration at one temperature offset: the drive open loop at the nominal
@@ -343,6 +361,7 @@ pub fn drift_analysis(
                 selfcal_deg_per_dps: m.predicted_deg_per_dps,
                 selfcal_relative_error: m.relative_error,
                 stale_relative_error: nominal_deg_per_dps / m.coriolis.slope_deg_per_dps - 1.0,
+                combined_selfcal_relative_error: core.combined.relative_error,
             })
         };
         let open_loop = case(&open, 0)?;

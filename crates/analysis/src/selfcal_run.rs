@@ -60,6 +60,7 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
                 t,
                 m.coriolis.slope_deg_per_dps,
                 m.theory_coriolis_deg_per_dps,
+                core.combined.coriolis.slope_deg_per_dps,
                 &|d, n| p.update(d, n),
             )?;
             p.finish(None);
