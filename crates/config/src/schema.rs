@@ -155,6 +155,18 @@ pub(crate) const SECTIONS: &[Section] = &[
             opt("q_tc_ppm_per_k", Number),
         ],
     },
+    Section {
+        name: "sweep",
+        required: false,
+        fields: &[
+            opt("start_hz", Number),
+            opt("stop_hz", Number),
+            opt("points", COUNT),
+            opt("spacing", Choice(&["resonance", "linear", "log"])),
+            opt("settle_s", Number),
+            opt("average_s", Number),
+        ],
+    },
 ];
 
 /// `` `a` ``, `` `a` or `b` ``, `` one of `a`, `b`, `c` `` (what follows "expected").
