@@ -3,8 +3,11 @@
 //! the configured device; the natural frequencies and Q of the coupled plant (the eigenvalues
 //! of its state matrix: quadrature coupling moves the modes apart); and the same fit applied
 //! to the plant's exact held-drive steady state at the same frequencies, which is what a
-//! perfect emulation of this board measures (hold images and coupling included).
+//! perfect emulation of this board measures (hold images and coupling included). Beside the
+//! one-mode fits, the whole 2 x 2 response identifies the plant's matrices (`matrix_fit`):
+//! each mode's own f0 and Q and the quadrature coupling, comparable with `[device]` as set.
 
+use crate::matrix_fit::{fit_matrix, MatrixFit};
 use crate::resonance_fit::{fit_resonance, ResonanceFit};
 use crate::stepped_sine::{run_stepped_sine, SteppedSine};
 use gyroemu_config::Config;
@@ -60,6 +63,9 @@ pub struct FrequencyResponse {
     pub measured: SteppedSine,
     /// Mode 1 and mode 2.
     pub modes: [ModeCheck; 2],
+    /// The plant's matrices identified from the whole 2 x 2 response (`None`: too few
+    /// usable frequencies).
+    pub matrix: Option<MatrixFit>,
 }
 
 impl FrequencyResponse {
@@ -151,7 +157,13 @@ pub fn frequency_response_from(cfg: &Config, measured: SteppedSine) -> Frequency
             expected,
         }
     });
-    FrequencyResponse { measured, modes }
+    let responses: Vec<_> = measured.points.iter().map(|p| p.response).collect();
+    let matrix = fit_matrix(&freqs, &responses);
+    FrequencyResponse {
+        measured,
+        modes,
+        matrix,
+    }
 }
 
 /// Runs `gyroemu sweep` on `cfg` (validated with `validate_sweep`): the measurement as one

@@ -6,6 +6,7 @@
 pub mod allan;
 pub mod bandwidth;
 pub mod freq_response;
+pub mod matrix_fit;
 pub mod resonance_fit;
 pub mod selfcal;
 pub mod selfcal_analyses;
