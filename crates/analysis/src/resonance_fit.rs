@@ -182,7 +182,7 @@ pub fn fit_resonance(f_hz: &[f64], h: &[Complex64]) -> Option<ResonanceFit> {
     let peak = (0..n).max_by(|&a, &b| h[a].norm().total_cmp(&h[b].norm()))?;
     let fc = f[peak];
     let hmax = h[peak].norm();
-    if !(hmax > 0.0) {
+    if hmax.is_nan() || hmax <= 0.0 {
         return None;
     }
     let h: Vec<Complex64> = h.iter().map(|v| v / hmax).collect();

@@ -155,12 +155,15 @@ pub fn run_stepped_sine(cfg: &Config, progress: Progress) -> Result<SteppedSine,
     })
 }
 
-/// Refuses what no signal supports (a dead DAC or ADC, a phasor of exactly 0, a value that is
-/// not finite): its response becomes NaN and a problem is listed. A cross-coupling of exactly
-/// 0 is kept (an uncoupled device at rest has none). Clipping is a warning.
+/// Refuses what no signal supports (a dead DAC or ADC on the driven mode, a driven phasor of
+/// exactly 0, a value that is not finite): its response becomes NaN and a problem is listed.
+/// A cross-coupling of exactly 0 is kept (an uncoupled device at rest has none), unless the
+/// ADC of the mode read put out only zeros: then it is below the ADC's resolution, NaN, and a
+/// warning says so. Clipping is a warning.
 fn check_points(cfg: &Config, points: &mut [ResponsePoint]) -> (Vec<String>, Vec<String>) {
     let mut problems = Vec::new();
     let mut total = Health::default();
+    let mut unresolved = [[0usize; 2]; 2];
     let b = &cfg.board;
     let zero = Complex64::new(0.0, 0.0);
     let nan = Complex64::new(f64::NAN, f64::NAN);
@@ -169,39 +172,76 @@ fn check_points(cfg: &Config, points: &mut [ResponsePoint]) -> (Vec<String>, Vec
             let h = p.health[m];
             total.add(&h);
             let all = |n: u64| h.samples > 0 && n == h.samples;
-            let drive_key = ["drive.f1", "drive.f2"][m];
-            let mut why: [Option<String>; 2] = [None, None];
-            if b.dac_bits.is_some() && all(h.dac_zero[m]) {
-                let w = format!("the DAC put out every sample of drive {} as 0 ({drive_key} is below half an LSB of board.dac_full_scale / 2^(board.dac_bits - 1))", m + 1);
-                why = [Some(w.clone()), Some(w)];
-            }
-            for k in 0..2 {
-                if why[k].is_none() && b.adc_bits.is_some() && all(h.adc_zero[k]) && k == m {
-                    why[k] = Some(format!("the ADC put out every sample of mode {} as 0 (the TIA output is below half an LSB)", k + 1));
-                }
-                if why[k].is_none() && k == m && p.z[m][k] == zero {
-                    why[k] = Some(format!(
-                        "mode {}'s read-out averaged to exactly 0 (no signal reached the mixer)",
-                        k + 1
-                    ));
-                }
-                let r = p.response[m][k];
-                if why[k].is_none() && !(r.re.is_finite() && r.im.is_finite()) {
-                    why[k] = Some(format!("the response is not a finite number ({r}): the chain's values overflowed or underflowed"));
-                }
-                if let Some(w) = &why[k] {
+            let adc_dead = |k: usize| b.adc_bits.is_some() && all(h.adc_zero[k]);
+            let dac = (b.dac_bits.is_some() && all(h.dac_zero[m])).then(|| {
+                let key = ["drive.f1", "drive.f2"][m];
+                format!(
+                    "the DAC put out every sample of drive {} as 0 ({key} is below half an LSB \
+                     of board.dac_full_scale / 2^(board.dac_bits - 1))",
+                    m + 1
+                )
+            });
+            // Why the driven response has no signal, if it has none.
+            let driven = if let Some(d) = &dac {
+                Some(d.clone())
+            } else if adc_dead(m) {
+                Some(format!(
+                    "the ADC put out every sample of mode {} as 0 (the TIA output is below half \
+                     an LSB)",
+                    m + 1
+                ))
+            } else if p.z[m][m] == zero {
+                Some(format!(
+                    "mode {}'s read-out averaged to exactly 0 (no signal reached the mixer)",
+                    m + 1
+                ))
+            } else {
+                None
+            };
+            for (k, r) in p.response[m].iter_mut().enumerate() {
+                let why = if k == m {
+                    driven.clone()
+                } else {
+                    if dac.is_none() && adc_dead(k) {
+                        unresolved[m][k] += 1;
+                        *r = nan;
+                    }
+                    dac.clone()
+                };
+                // A cross reading below the ADC's resolution is already NaN (a warning).
+                let fine = (r.re.is_finite() && r.im.is_finite()) || (k != m && adc_dead(k));
+                let why = why.or_else(|| {
+                    (!fine).then(|| {
+                        format!(
+                            "the response is not a finite number ({r}): the chain's values \
+                             overflowed or underflowed"
+                        )
+                    })
+                });
+                if let Some(w) = why {
                     problems.push(format!(
                         "{} Hz, mode {} driven, mode {} read: no response: {w}",
                         p.freq_hz,
                         m + 1,
                         k + 1
                     ));
-                    p.response[m][k] = nan;
+                    *r = nan;
                 }
             }
         }
     }
     let mut warnings = Vec::new();
+    for (m, row) in unresolved.iter().enumerate() {
+        for (k, &n) in row.iter().enumerate() {
+            if n > 0 {
+                warnings.push(format!(
+                    "at {n} frequencies the ADC put out every sample of mode {} as 0 while mode {} was driven: the cross-coupling is below the ADC's resolution and is written as NaN",
+                    k + 1,
+                    m + 1
+                ));
+            }
+        }
+    }
     let pct = |n: u64| 100.0 * n as f64 / total.samples.max(1) as f64;
     for (what, counts, setting) in [
         ("the DAC clipped", total.dac_clipped, "board.dac_full_scale"),

@@ -234,7 +234,7 @@ fn bode_panels(r: &FrequencyResponse) -> Vec<Figure> {
     }
     for (m, k) in [(0, 1), (1, 0)] {
         let data: Vec<Complex64> = pts.iter().map(|p| p.response[m][k]).collect();
-        if data.iter().all(|v| !(v.norm() > 0.0)) {
+        if data.iter().all(|v| v.norm().is_nan() || v.norm() == 0.0) {
             continue;
         }
         let name = format!("cross: mode {} read, mode {} driven", k + 1, m + 1);
