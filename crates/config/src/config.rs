@@ -21,6 +21,10 @@ pub struct Config {
     /// The analyses of `gyroemu selfcal` (absent: only the two sweeps and their comparison).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub selfcal: Option<SelfcalConfig>,
+    /// The stepped-sine frequency response of `gyroemu sweep` (absent: every key at its
+    /// default, derived from the device; read it with [`Config::sweep_resolved`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sweep: Option<SweepConfig>,
     /// A carrier PLL that locks the drive onto the resonance before the sweep (absent: the
     /// carrier is `drive.carrier_hz`, open loop).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -204,6 +208,60 @@ pub struct SelfcalConfig {
     pub q_tc_ppm_per_k: f64,
 }
 
+/// How the stepped-sine frequencies are spaced between `start_hz` and `stop_hz`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Spacing {
+    /// Evenly in the sum of the two modes' resonance phases `atan((f - f0_k) / b_k)`
+    /// (`b_k = f0_k / (2 Q_k)`): dense near each resonance, sparse on the skirts.
+    Resonance,
+    /// Evenly in frequency.
+    Linear,
+    /// Evenly in log frequency.
+    Log,
+}
+
+/// The stepped-sine frequency response of `gyroemu sweep`: each mode driven alone at each
+/// frequency, at zero rate, settled, then averaged. Every key has a default derived from the
+/// device (see `Config::sweep_resolved`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepConfig {
+    /// Lowest frequency, Hz; default 10 half-bandwidths f0/(2Q) below the lower mode.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_hz: Option<f64>,
+    /// Highest frequency, Hz; default 10 half-bandwidths above the upper mode.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stop_hz: Option<f64>,
+    /// Number of frequencies (start and stop included).
+    #[serde(default = "default_sweep_points")]
+    pub points: usize,
+    /// How the frequencies are spaced.
+    #[serde(default = "default_spacing")]
+    pub spacing: Spacing,
+    /// Time discarded at each frequency before averaging, s; default 16 mechanical time
+    /// constants Q/(pi f0) of the slower mode plus the low-pass settling.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settle_s: Option<f64>,
+    /// Averaging time at each frequency, s; default 2 mechanical time constants.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub average_s: Option<f64>,
+}
+
+impl Default for SweepConfig {
+    /// Every key at the default it has when left out of a `[sweep]` table.
+    fn default() -> Self {
+        Self {
+            start_hz: None,
+            stop_hz: None,
+            points: default_sweep_points(),
+            spacing: default_spacing(),
+            settle_s: None,
+            average_s: None,
+        }
+    }
+}
+
 /// Which excitation the sweep uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -285,6 +343,15 @@ fn default_damping() -> f64 {
 }
 fn default_pll_mode() -> usize {
     1
+}
+/// Frequencies of a `[sweep]` by default.
+pub const DEFAULT_SWEEP_POINTS: usize = 61;
+
+fn default_sweep_points() -> usize {
+    DEFAULT_SWEEP_POINTS
+}
+fn default_spacing() -> Spacing {
+    Spacing::Resonance
 }
 fn default_transduction() -> f64 {
     1e-6

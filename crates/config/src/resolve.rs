@@ -3,7 +3,7 @@
 //! `parse_config` fills them in, so a config is always complete once parsed; `gyroemu config
 //! --resolved FILE` prints the result with the rule behind each derived value.
 
-use crate::config::{Config, DumpConfig};
+use crate::config::{Config, DumpConfig, SweepConfig};
 use gyroemu_board::{Shape, DUMP_NODES};
 
 /// Samples per carrier period of the default sample rate (the DAC's hold then moves the
@@ -20,6 +20,16 @@ pub const F0_OVER_MAX_CUTOFF: f64 = 10.0;
 pub const OUTPUT_SAMPLES_PER_CUTOFF: f64 = 20.0;
 /// A default dump holds at most this many full-rate frames (small files).
 pub const DEFAULT_DUMP_FRAMES: f64 = 50_000.0;
+
+/// The default frequency sweep reaches this many half-bandwidths f0/(2Q) beyond each mode's
+/// resonance (the response there is 1/20 of its peak, the phase within 6 degrees of +-90).
+pub const SWEEP_SPAN_HALF_BANDWIDTHS: f64 = 10.0;
+/// The default settling at each swept frequency, in mechanical time constants of the slower
+/// mode (what is left of the start-up transient, e^-16 = 1e-7 of the response, is far below
+/// the fit's resolution), plus the low-pass settling of the rate sweeps.
+pub const SWEEP_SETTLE_TAUS: f64 = 16.0;
+/// The default averaging at each swept frequency, in mechanical time constants.
+pub const SWEEP_AVERAGE_TAUS: f64 = 2.0;
 
 /// A key the config left out, filled with a derived value.
 #[derive(Clone, Debug, PartialEq)]
@@ -151,6 +161,43 @@ impl Config {
         })
     }
 
+    /// Each mode's resonance and half-bandwidth f0/(2Q), Hz, as configured (uncoupled).
+    pub fn mode_resonances_hz(&self) -> [(f64, f64); 2] {
+        let d = &self.device;
+        let q2 = d.q_mode2.unwrap_or(d.q);
+        let f2 = self.f0_mode2_hz();
+        [(d.f0_hz, d.f0_hz / (2.0 * d.q)), (f2, f2 / (2.0 * q2))]
+    }
+
+    /// The longer mechanical time constant Q/(pi f0) of the two modes, s.
+    pub fn slowest_tau_s(&self) -> f64 {
+        let d = &self.device;
+        let q2 = d.q_mode2.unwrap_or(d.q);
+        gyroemu_theory::mechanical_tau_s(d.f0_hz, d.q)
+            .max(gyroemu_theory::mechanical_tau_s(self.f0_mode2_hz(), q2))
+    }
+
+    /// The `[sweep]` section with every key filled in (the section's defaults when it is
+    /// absent): `start_hz`/`stop_hz` 10 half-bandwidths beyond the lower/upper resonance,
+    /// `settle_s` 16 mechanical time constants of the slower mode plus 40 low-pass time
+    /// constants, `average_s` 2 mechanical time constants.
+    pub fn sweep_resolved(&self) -> SweepConfig {
+        let given = self.sweep.clone().unwrap_or_default();
+        let [(f1, b1), (f2, b2)] = self.mode_resonances_hz();
+        let n = SWEEP_SPAN_HALF_BANDWIDTHS;
+        let tau = self.slowest_tau_s();
+        SweepConfig {
+            start_hz: Some(given.start_hz.unwrap_or((f1 - n * b1).min(f2 - n * b2))),
+            stop_hz: Some(given.stop_hz.unwrap_or((f1 + n * b1).max(f2 + n * b2))),
+            settle_s: Some(given.settle_s.unwrap_or_else(|| {
+                SWEEP_SETTLE_TAUS * tau
+                    + 40.0 / (2.0 * core::f64::consts::PI * self.lpf_cutoff_hz())
+            })),
+            average_s: Some(given.average_s.unwrap_or(SWEEP_AVERAGE_TAUS * tau)),
+            ..given
+        }
+    }
+
     /// Fills every key left out with its derived value (idempotent) and says what it derived.
     pub fn resolve(&mut self) -> Vec<Derived> {
         let mut out = Vec::new();
@@ -264,6 +311,45 @@ impl Config {
                 }
             }
             self.dump = Some(full);
+        }
+        if let Some(given) = self.sweep.clone() {
+            let full = self.sweep_resolved();
+            let rules = [
+                (
+                    "sweep.start_hz",
+                    given.start_hz.is_none(),
+                    full.start_hz,
+                    format!("{SWEEP_SPAN_HALF_BANDWIDTHS} half-bandwidths f0/(2Q) below the lower resonance"),
+                ),
+                (
+                    "sweep.stop_hz",
+                    given.stop_hz.is_none(),
+                    full.stop_hz,
+                    format!("{SWEEP_SPAN_HALF_BANDWIDTHS} half-bandwidths f0/(2Q) above the upper resonance"),
+                ),
+                (
+                    "sweep.settle_s",
+                    given.settle_s.is_none(),
+                    full.settle_s,
+                    format!("{SWEEP_SETTLE_TAUS} mechanical time constants Q/(pi f0) of the slower mode plus 40 low-pass time constants"),
+                ),
+                (
+                    "sweep.average_s",
+                    given.average_s.is_none(),
+                    full.average_s,
+                    format!("{SWEEP_AVERAGE_TAUS} mechanical time constants Q/(pi f0) of the slower mode"),
+                ),
+            ];
+            for (key, derived, value, rule) in rules {
+                if derived {
+                    out.push(Derived {
+                        key,
+                        value: fmt(value.unwrap_or(f64::NAN)),
+                        rule,
+                    });
+                }
+            }
+            self.sweep = Some(full);
         }
         out
     }

@@ -156,6 +156,18 @@ pub(crate) const SECTIONS: &[Section] = &[
         ],
     },
     Section {
+        name: "sweep",
+        required: false,
+        fields: &[
+            opt("start_hz", Number),
+            opt("stop_hz", Number),
+            opt("points", COUNT),
+            opt("spacing", Choice(&["resonance", "linear", "log"])),
+            opt("settle_s", Number),
+            opt("average_s", Number),
+        ],
+    },
+    Section {
         name: "pll",
         required: false,
         fields: &[

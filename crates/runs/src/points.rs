@@ -26,12 +26,13 @@ pub fn canonical_toml(cfg: &Config) -> String {
 }
 
 /// The part of a config that decides a sweep's results: all but `[dump]` (what is recorded
-/// on the way) and `[selfcal]` (what `selfcal` adds), so a config differing only there
-/// reuses the saved points.
+/// on the way), `[selfcal]` (what `selfcal` adds) and `[sweep]` (what `sweep` measures), so a
+/// config differing only there reuses the saved points.
 pub fn result_config(cfg: &Config) -> Config {
     Config {
         dump: None,
         selfcal: None,
+        sweep: None,
         ..cfg.clone()
     }
 }

@@ -7,3 +7,4 @@ pub mod merge;
 pub mod reproduce;
 pub mod run;
 pub mod selfcal;
+pub mod sweep;
