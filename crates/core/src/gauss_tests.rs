@@ -3,8 +3,7 @@
 
 use super::*;
 use crate::gauss_tables::{V, X};
-use crate::noise::splitmix64;
-use crate::noise::tests::Reference;
+use crate::noise::tests::{reference_streams, Reference};
 
 /// f(x) = exp(-x^2 / 2), libm (the tests' own reference, not the generator's polynomial).
 fn f(x: f64) -> f64 {
@@ -137,13 +136,7 @@ fn plain_normal(r: &mut Reference, paths: &mut Paths) -> f64 {
 fn each_stream_is_the_plain_ziggurat_on_its_xoshiro_stream() {
     let seeds = [7, 0, 0x1234_5678_9ABC_DEF0, u64::MAX - 3];
     let mut rng = NoiseRng::new(seeds);
-    let mut plain: Vec<[Reference; 2]> = seeds
-        .iter()
-        .map(|&s| {
-            let mut sm = s;
-            [(); 2].map(|_| Reference([(); 4].map(|_| splitmix64(&mut sm))))
-        })
-        .collect();
+    let mut plain = reference_streams(seeds);
     let mut paths = Paths::default();
     let mut out = vec![f64x4::ZERO; 2 * 4096];
     for _ in 0..256 {

@@ -109,18 +109,23 @@ pub(crate) mod tests {
         assert_eq!(splitmix64(&mut s), 0x06C4_5D18_8009_454F);
     }
 
-    #[test]
-    fn each_stream_of_each_lane_is_the_reference_stream_of_its_seed() {
-        let seeds = [1, 2, 0xDEAD_BEEF, u64::MAX];
-        let mut rng = NoiseRng::new(seeds);
-        // Lane l: SplitMix64 from its seed gives stream a's four words, then stream b's.
-        let mut refs: Vec<[Reference; 2]> = seeds
+    /// Each lane's two reference streams, `[lane][stream]`: SplitMix64 from the lane's seed
+    /// gives stream a's four words, then stream b's.
+    pub(crate) fn reference_streams(seeds: [u64; 4]) -> Vec<[Reference; 2]> {
+        seeds
             .iter()
             .map(|&seed| {
                 let mut sm = seed;
                 [(); 2].map(|_| Reference([(); 4].map(|_| splitmix64(&mut sm))))
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn each_stream_of_each_lane_is_the_reference_stream_of_its_seed() {
+        let seeds = [1, 2, 0xDEAD_BEEF, u64::MAX];
+        let mut rng = NoiseRng::new(seeds);
+        let mut refs = reference_streams(seeds);
         for _ in 0..10_000 {
             for (h, st) in rng.s.iter_mut().enumerate() {
                 let v = step(st).to_array();
