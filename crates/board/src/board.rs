@@ -261,10 +261,15 @@ impl<S: Sample> Board<S> {
             .map_err(|k| self.locate_fault(k))
     }
 
-    /// The plant takes its decoupled step (exact zeros across the modes in every lane: no
-    /// rotation and no quadrature coupling; never on a rate table, whose step varies). Public
-    /// so tests can check that a run took the shortcut it is compared through.
+    /// The plant takes its sparse step: at a constant rate the decoupled one (exact zeros
+    /// across the modes in every lane: no rotation and no quadrature coupling), on a rate
+    /// table the one split by mode (`Resonator::rate_split_by_mode`). Both leave out only
+    /// products by exact zeros. Public so tests can check that a run took the shortcut it is
+    /// compared through.
     pub fn plant_decoupled(&self) -> bool {
-        !matches!(self.shape, Shape::RateTable { .. }) && self.plant.decoupled()
+        match self.shape {
+            Shape::RateTable { .. } => self.plant.rate_split_by_mode(),
+            _ => self.plant.decoupled(),
+        }
     }
 }

@@ -75,7 +75,8 @@ impl<S: Sample> Board<S> {
     }
 
     /// The sample loop of experiment shape `K`; `NOISY`: the noise sources and the ADC are in
-    /// the chain; `DECOUPLED`: the plant takes its decoupled step.
+    /// the chain; `DECOUPLED`: the plant takes its sparse step (decoupled, or split by mode on
+    /// a rate table: [`Board::plant_decoupled`]).
     ///
     /// Its own function per shape: inlined into the dispatcher beside the other shapes, the
     /// sample loop's registers were allocated worse (measurably slower).
@@ -324,7 +325,12 @@ impl<S: Sample> Board<S> {
                 }
                 let mut p = if K == RATE_TABLE {
                     let (_, sin_t) = self.table_nco.tick(());
-                    self.plant.tick_with_rate(u, self.rate * S::splat(sin_t))
+                    let rate = self.rate * S::splat(sin_t);
+                    if DECOUPLED {
+                        self.plant.tick_with_rate_split(u, rate)
+                    } else {
+                        self.plant.tick_with_rate(u, rate)
+                    }
                 } else if DECOUPLED {
                     self.plant.tick_decoupled(u)
                 } else {
