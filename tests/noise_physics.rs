@@ -21,6 +21,7 @@ fn noise(mass: Option<f64>, i_n: f64, e_n: f64) -> NoiseConfig {
         effective_mass_kg: mass,
         tia_current_noise_a_per_rthz: i_n,
         tia_voltage_noise_v_per_rthz: e_n,
+        ..Default::default()
     }
 }
 

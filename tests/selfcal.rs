@@ -142,6 +142,7 @@ fn noisy_selfcal_errors_scatter_as_their_reported_confidence() {
             effective_mass_kg: None,
             tia_current_noise_a_per_rthz: 3e-11,
             tia_voltage_noise_v_per_rthz: 0.0,
+            ..Default::default()
         });
         let core = run_selfcal_core(&c, &quiet, &quiet).unwrap();
         let comb = core.combined;
@@ -177,6 +178,7 @@ fn noisy_selfcal_errors_scatter_as_their_reported_confidence() {
         effective_mass_kg: None,
         tia_current_noise_a_per_rthz: 3e-11,
         tia_voltage_noise_v_per_rthz: 0.0,
+        ..Default::default()
     });
     let again = run_selfcal_core(&c, &quiet, &quiet).unwrap().modes[0].relative_error;
     assert_eq!(again.to_bits(), errs[0].to_bits());

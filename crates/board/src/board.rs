@@ -3,6 +3,7 @@
 //! carrier NCO is shared, each lane has its own rate, plant and noise stream).
 
 use crate::fault::NonFinite;
+use crate::flicker::FlickerSources;
 use crate::params::{build_adc, build_dac, build_lowpass, build_tia, BoardParams, Shape};
 use crate::point::{Point, RunOptions, RunOutput};
 use gyroemu_am::{AmModulator, Dac, DrivePattern, Quantizer};
@@ -144,6 +145,8 @@ pub struct Board<S: Sample> {
     /// Phase-shifter error on the modulation's quadrature copy (rotating runs): (cos, sin).
     pub(crate) mod_shift: Option<(S, S)>,
     pub(crate) noise: NoiseState<S>,
+    /// The flicker sources (absent: none asked for).
+    pub(crate) flicker: Option<FlickerSources<S>>,
     /// ADC after each TIA (absent: ideal).
     pub(crate) adc: Option<[Quantizer<S>; 2]>,
     /// Noise sources present (their draws are made).
@@ -225,6 +228,7 @@ impl<S: Sample> Board<S> {
             },
             adc,
             noise_on: p.noise.is_some(),
+            flicker: FlickerSources::new(p, streams)?,
             imperfect,
             pristine: None,
             cancel: None,

@@ -4,6 +4,7 @@
 
 use crate::board::{Board, CORIOLIS, RATE_TABLE, ROTATING};
 use crate::fault::NonFinite;
+use crate::flicker::{turn, BlockFlicker};
 use crate::health::{Counters, Health, ADC_CLIP, ADC_ZERO, DAC_CLIP, DAC_ZERO, TIA_RAIL};
 use crate::params::Shape;
 use crate::point::{LaneResult, Point, RunOptions, RunOutput};
@@ -266,6 +267,14 @@ impl<S: Sample> Board<S> {
         let mut out = ([Iq::<S>::default(); 2], [zero; 2]);
         let m = self.decimation as u64;
         let noisy = NOISY && self.noise_on;
+        // The slow flicker sources move once per block and hold over it.
+        let fb = match &mut self.flicker {
+            Some(f) if NOISY => {
+                f.next_block();
+                Some(f.block)
+            }
+            _ => None,
+        };
         let mut j0 = 0;
         // In runs that the drawn-ahead normals cover: drawing more is a call, kept out of the
         // per-sample loop.
@@ -295,12 +304,21 @@ impl<S: Sample> Board<S> {
                     Some((ce, se)) if K == ROTATING => mod_sin * ce - mod_cos * se,
                     _ => mod_sin,
                 };
-                let drive = self.am.tick(AmInput {
-                    carrier_i: S::splat(c_re),
-                    carrier_q: S::splat(cq),
-                    mod_cos,
-                    mod_sin: drive_sin,
-                });
+                let drive = match &fb {
+                    None => self.am.tick(AmInput {
+                        carrier_i: S::splat(c_re),
+                        carrier_q: S::splat(cq),
+                        mod_cos,
+                        mod_sin: drive_sin,
+                    }),
+                    Some(b) => flicker_drive::<K, S>(
+                        &mut self.am,
+                        &self.shifter,
+                        b,
+                        (c_re, c_im),
+                        (mod_cos, drive_sin),
+                    ),
+                };
                 let mut u = drive;
                 for md in 0..2 {
                     u[md] = match self.dac[md].quantizer() {
@@ -343,6 +361,12 @@ impl<S: Sample> Board<S> {
                     p.current[1] =
                         S::from_x4(nz[3]).mul_add(self.noise.sigma_current[1], p.current[1]);
                 }
+                if let (Some(f), true) = (&mut self.flicker, fb.is_some()) {
+                    // The TIA voltage noise's flicker, referred to the input likewise.
+                    let t = f.tia_current();
+                    p.current[0] += t[0];
+                    p.current[1] += t[1];
+                }
                 let mut y = [
                     self.tia[0].tick(p.current[0]),
                     self.tia[1].tick(p.current[1]),
@@ -366,11 +390,23 @@ impl<S: Sample> Board<S> {
                 // Both stage-1 mixers see the same carrier: when their reference phases agree
                 // (always, as built) they share one set of carrier factors.
                 let carrier = Complex64::new(c_re, c_im);
-                let f0 = self.mix1[0].factors(carrier);
-                let f1 = if self.mix1_same_ref {
-                    f0
-                } else {
-                    self.mix1[1].factors(carrier)
+                let (f0, f1) = match &fb {
+                    // The carrier's phase flicker turns the demodulation too, lane by lane
+                    // (the board's mixers have a zero reference phase).
+                    Some(b) => {
+                        let (cr, ci) = turn(c_re, c_im, b.carrier_rot);
+                        let f = (cr + cr, -(ci + ci));
+                        (f, f)
+                    }
+                    None => {
+                        let f0 = self.mix1[0].factors(carrier);
+                        let f1 = if self.mix1_same_ref {
+                            f0
+                        } else {
+                            self.mix1[1].factors(carrier)
+                        };
+                        (f0, f1)
+                    }
                 };
                 let z = [Stage1Mixer::mix(y[0], f0), Stage1Mixer::mix(y[1], f1)];
                 if let Some(pr) = probe.as_deref_mut() {
@@ -459,4 +495,47 @@ pub(crate) fn table_harmonics_of(table: &[f64], n: usize) -> [[Complex64; TABLE_
             Complex64::new(table[ch], table[ch + 1])
         })
     })
+}
+
+/// The two drives with the slow flicker's values of the block: each drive's carrier turned by
+/// the carrier's and its own phase, its amplitude scaled (the same arithmetic as the
+/// modulator's on the turned carriers; the reference board does it alike).
+#[inline(always)]
+pub(crate) fn flicker_drive<const K: u8, S: Sample>(
+    am: &mut gyroemu_am::AmModulator<S>,
+    shifter: &gyroemu_nco::PhaseShifter,
+    b: &BlockFlicker<S>,
+    (c_re, c_im): (f64, f64),
+    (mod_cos, mod_sin): (S, S),
+) -> [S; 2] {
+    let zero = S::splat(0.0);
+    let c1 = turn(c_re, c_im, b.drive_rot[0]);
+    let c2 = turn(c_re, c_im, b.drive_rot[1]);
+    let d = if K == ROTATING {
+        // Both drives ride the in-phase carrier, each its own.
+        let d1 = am.tick(AmInput {
+            carrier_i: c1.0,
+            carrier_q: zero,
+            mod_cos,
+            mod_sin,
+        });
+        let d2 = am.tick(AmInput {
+            carrier_i: c2.0,
+            carrier_q: zero,
+            mod_cos,
+            mod_sin,
+        });
+        [d1[0], d2[1]]
+    } else {
+        // Re{c2 rot}: the phase shifter's rotation on mode 2's carrier.
+        let r = shifter.rotation();
+        let cq = c2.0 * S::splat(r.re) - c2.1 * S::splat(r.im);
+        am.tick(AmInput {
+            carrier_i: c1.0,
+            carrier_q: cq,
+            mod_cos,
+            mod_sin,
+        })
+    };
+    [d[0] * b.amplitude[0], d[1] * b.amplitude[1]]
 }

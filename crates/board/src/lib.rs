@@ -10,6 +10,7 @@
 mod board;
 mod chain;
 mod fault;
+mod flicker;
 mod health;
 mod kernel;
 mod lock;

@@ -56,6 +56,18 @@ pub struct NoiseParams {
     pub tia_current_noise_a_per_rthz: f64,
     /// TIA output voltage noise density, V/sqrt(Hz).
     pub tia_voltage_noise_v_per_rthz: f64,
+    /// Corner of the TIA voltage noise's flicker: its density is `e_n^2 (1 + corner / f)`,
+    /// Hz (0: white only).
+    pub tia_voltage_flicker_corner_hz: f64,
+    /// Flicker of each drive's relative amplitude, density at 1 Hz, 1/sqrt(Hz) (0: none).
+    pub drive_amplitude_flicker_per_rthz: f64,
+    /// Flicker of each drive's phase, density at 1 Hz, rad/sqrt(Hz) (0: none).
+    pub drive_phase_flicker_rad_per_rthz: f64,
+    /// Flicker of the carrier's phase (drives and demodulation alike), density at 1 Hz,
+    /// rad/sqrt(Hz) (0: none).
+    pub carrier_phase_flicker_rad_per_rthz: f64,
+    /// Low corner of every flicker source, Hz: below it their densities flatten.
+    pub flicker_f_lo_hz: f64,
 }
 
 /// The whole board: plant, drive, converters, front end, read-out and the experiment shape.
@@ -148,6 +160,29 @@ impl BoardParams {
                 "noise.tia_voltage_noise_v_per_rthz",
                 n.tia_voltage_noise_v_per_rthz,
             )?;
+            for (key, v) in [
+                (
+                    "noise.tia_voltage_flicker_corner_hz",
+                    n.tia_voltage_flicker_corner_hz,
+                ),
+                (
+                    "noise.drive_amplitude_flicker_per_rthz",
+                    n.drive_amplitude_flicker_per_rthz,
+                ),
+                (
+                    "noise.drive_phase_flicker_rad_per_rthz",
+                    n.drive_phase_flicker_rad_per_rthz,
+                ),
+                (
+                    "noise.carrier_phase_flicker_rad_per_rthz",
+                    n.carrier_phase_flicker_rad_per_rthz,
+                ),
+            ] {
+                non_negative(STAGE, key, v)?;
+            }
+            if crate::flicker::has_flicker(n) {
+                positive(STAGE, "noise.flicker_f_lo_hz", n.flicker_f_lo_hz)?;
+            }
         }
         build_dac::<f64>(self)?;
         build_tia::<f64>(self)?;

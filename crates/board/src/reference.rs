@@ -7,6 +7,7 @@
 use crate::board::{
     modulation_hz, noise_sigmas, pattern, plant_rate, shifter, table_harmonics, table_nco,
 };
+use crate::flicker::FlickerSources;
 use crate::health::Health;
 use crate::kernel::table_harmonics_of;
 use crate::params::{build_adc, build_dac, build_tia, BoardParams, Shape};
@@ -60,6 +61,7 @@ pub fn run_reference(
     let seed = p.noise.map_or(0, |n| n.seed);
     let mut rng = NoiseRng::new([stream_seed(seed, stream); 4]);
     let (sigma_force, sigma_current) = noise_sigmas(p);
+    let mut flicker = FlickerSources::<f64>::new(p, &[stream])?;
     let eps = p.phase_shifter_error_deg.to_radians();
     let (ce, se) = (eps.cos(), eps.sin());
     let n_out = n_settle + point.window.samples();
@@ -68,6 +70,11 @@ pub fn run_reference(
         ..Default::default()
     };
     for n in 0..n_out * m as u64 {
+        if n % m as u64 == 0 {
+            if let Some(f) = &mut flicker {
+                f.next_block();
+            }
+        }
         let (c_re, c_im) = carrier.tick(());
         let cq = shift.tick(Complex64::new(c_re, c_im)).re;
         let (mod_cos, mod_sin) = modulation.tick(());
@@ -76,12 +83,28 @@ pub fn run_reference(
         } else {
             mod_sin
         };
-        let drive = am.tick(AmInput {
-            carrier_i: c_re,
+        let input = |ci: f64, cq: f64| AmInput {
+            carrier_i: ci,
             carrier_q: cq,
             mod_cos,
             mod_sin: drive_sin,
-        });
+        };
+        let drive = match flicker.as_ref().map(|f| f.block) {
+            None => am.tick(input(c_re, cq)),
+            // Each drive's carrier turned by the carrier's and its own flicker phase, its
+            // amplitude scaled.
+            Some(b) => {
+                let c = Complex64::new(c_re, c_im);
+                let turned = |(co, si): (f64, f64)| c * Complex64::new(co, si);
+                let (c1, c2) = (turned(b.drive_rot[0]), turned(b.drive_rot[1]));
+                let d = if p.shape.is_rotating() {
+                    [am.tick(input(c1.re, 0.0))[0], am.tick(input(c2.re, 0.0))[1]]
+                } else {
+                    am.tick(input(c1.re, shift.tick(c2).re))
+                };
+                [d[0] * b.amplitude[0], d[1] * b.amplitude[1]]
+            }
+        };
         let mut u = [dac[0].tick(drive[0]), dac[1].tick(drive[1])];
         for md in 0..2 {
             if let Some(q) = dac[md].quantizer() {
@@ -106,6 +129,11 @@ pub fn run_reference(
             out.current[0] = Sample::mul_add(a.to_array()[0], sigma_current[0], out.current[0]);
             out.current[1] = Sample::mul_add(b.to_array()[0], sigma_current[1], out.current[1]);
         }
+        if let Some(f) = &mut flicker {
+            let t = f.tia_current();
+            out.current[0] += t[0];
+            out.current[1] += t[1];
+        }
         let mut y = [tia[0].tick(out.current[0]), tia[1].tick(out.current[1])];
         for md in 0..2 {
             health.tia_railed[md] += tia[md].rail_flags(y[md]) as u64;
@@ -119,7 +147,11 @@ pub fn run_reference(
             }
             y = [q[0].tick(y[0]), q[1].tick(y[1])];
         }
-        let carrier_phasor = Complex64::new(c_re, c_im);
+        let carrier_phasor = match flicker.as_ref().map(|f| f.block.carrier_rot) {
+            // The carrier's flicker phase turns the demodulation too.
+            Some((co, si)) => Complex64::new(c_re, c_im) * Complex64::new(co, si),
+            None => Complex64::new(c_re, c_im),
+        };
         let z = [
             mix1[0].tick((y[0], carrier_phasor)),
             mix1[1].tick((y[1], carrier_phasor)),

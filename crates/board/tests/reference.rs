@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{imperfect, m2tfg, noisy, point};
+use common::{flickering, imperfect, m2tfg, noisy, point};
 use gyroemu_board::reference::run_reference;
 use gyroemu_board::{Board, BoardParams, Point, RunOptions, Shape};
 use gyroemu_core::f64x4;
@@ -45,6 +45,15 @@ fn fused_lanes_equal_the_reference_board_for_every_shape() {
         check(
             &format!("{shape:?} imperfect"),
             &imperfect(noisy(p, 7)),
+            &pts,
+            30,
+        );
+        // Every flicker source on: the slow ones per block, the TIA's per sample, the
+        // carrier's in the demodulation too.
+        check(&format!("{shape:?} flicker"), &flickering(p, 5), &pts, 30);
+        check(
+            &format!("{shape:?} imperfect flicker"),
+            &imperfect(flickering(p, 9)),
             &pts,
             30,
         );

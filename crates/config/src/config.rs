@@ -184,6 +184,42 @@ pub struct NoiseConfig {
     /// TIA output voltage noise density, V/sqrt(Hz) (within the TIA's own bandwidth).
     #[serde(default)]
     pub tia_voltage_noise_v_per_rthz: f64,
+    /// Flicker corner of the TIA voltage noise: its density is `e_n^2 (1 + corner / f)`, Hz
+    /// (0: white only).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub tia_voltage_flicker_corner_hz: f64,
+    /// Flicker of each drive's relative amplitude: density at 1 Hz, 1/sqrt(Hz) (0: none).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub drive_amplitude_flicker_per_rthz: f64,
+    /// Flicker of each drive's phase: density at 1 Hz, rad/sqrt(Hz) (0: none).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub drive_phase_flicker_rad_per_rthz: f64,
+    /// Flicker of the carrier oscillator's phase (drives and demodulation alike): density at
+    /// 1 Hz, rad/sqrt(Hz) (0: none).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub carrier_phase_flicker_rad_per_rthz: f64,
+    /// Low corner of the flicker sources, Hz (their densities flatten below it); default 0.02
+    /// over the longest record a run makes (read it with [`Config::flicker_f_lo_hz`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flicker_f_lo_hz: Option<f64>,
+}
+
+impl Default for NoiseConfig {
+    /// Seed 0 at 300 K with every source off (each key at the default it has when left out).
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            temperature_k: default_temperature(),
+            effective_mass_kg: None,
+            tia_current_noise_a_per_rthz: 0.0,
+            tia_voltage_noise_v_per_rthz: 0.0,
+            tia_voltage_flicker_corner_hz: 0.0,
+            drive_amplitude_flicker_per_rthz: 0.0,
+            drive_phase_flicker_rad_per_rthz: 0.0,
+            carrier_phase_flicker_rad_per_rthz: 0.0,
+            flicker_f_lo_hz: None,
+        }
+    }
 }
 
 /// The analyses `gyroemu selfcal` adds to its two sweeps; each runs only when its key is set.
@@ -338,6 +374,11 @@ pub struct DumpConfig {
     pub nodes: Option<Vec<String>>,
 }
 
+/// A flicker level left at 0 is not written (configs without flicker keep their text, and the
+/// hash that names their saved points).
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
 fn default_damping() -> f64 {
     core::f64::consts::FRAC_1_SQRT_2
 }

@@ -255,6 +255,22 @@ impl Config {
                 ),
             });
         }
+        if self.has_flicker()
+            && self
+                .noise
+                .as_ref()
+                .is_some_and(|n| n.flicker_f_lo_hz.is_none())
+        {
+            let f = self.flicker_f_lo_hz();
+            if let Some(n) = self.noise.as_mut() {
+                n.flicker_f_lo_hz = Some(f);
+            }
+            out.push(Derived {
+                key: "noise.flicker_f_lo_hz",
+                value: fmt(f),
+                rule: "0.02 / the longest record a run makes (settling plus the longest of average_s, selfcal.allan_record_s and selfcal.tau_max_s)".into(),
+            });
+        }
         if let Some(pll) = self.pll.clone() {
             if pll.natural_hz.is_none() {
                 let f = self.pll_natural_hz().unwrap_or(f64::NAN);
@@ -404,5 +420,37 @@ impl Config {
             16.0 * q / (core::f64::consts::PI * self.device.f0_hz)
                 + 10.0 / (p.damping * core::f64::consts::TAU * natural)
         }))
+    }
+}
+
+impl Config {
+    /// Whether `[noise]` asks for any flicker source.
+    pub fn has_flicker(&self) -> bool {
+        self.noise.as_ref().is_some_and(|n| {
+            n.tia_voltage_flicker_corner_hz > 0.0
+                || n.drive_amplitude_flicker_per_rthz > 0.0
+                || n.drive_phase_flicker_rad_per_rthz > 0.0
+                || n.carrier_phase_flicker_rad_per_rthz > 0.0
+        })
+    }
+
+    /// The longest record a run of this config makes, s: settling plus the longest of the
+    /// averaging time and the selfcal analyses' records.
+    pub fn longest_record_s(&self) -> f64 {
+        let s = self.selfcal.clone().unwrap_or_default();
+        let longest = [s.allan_record_s, s.tau_max_s]
+            .into_iter()
+            .flatten()
+            .fold(self.experiment.average_s, f64::max);
+        self.settle_s() + longest
+    }
+
+    /// The flicker sources' low corner, Hz (set, or 0.02 / the longest record: a flicker
+    /// floor then holds up to about that record's length).
+    pub fn flicker_f_lo_hz(&self) -> f64 {
+        self.noise
+            .as_ref()
+            .and_then(|n| n.flicker_f_lo_hz)
+            .unwrap_or_else(|| 0.02 / self.longest_record_s())
     }
 }

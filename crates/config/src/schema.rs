@@ -142,6 +142,11 @@ pub(crate) const SECTIONS: &[Section] = &[
             opt("effective_mass_kg", Number),
             opt("tia_current_noise_a_per_rthz", Number),
             opt("tia_voltage_noise_v_per_rthz", Number),
+            opt("tia_voltage_flicker_corner_hz", Number),
+            opt("drive_amplitude_flicker_per_rthz", Number),
+            opt("drive_phase_flicker_rad_per_rthz", Number),
+            opt("carrier_phase_flicker_rad_per_rthz", Number),
+            opt("flicker_f_lo_hz", Number),
         ],
     },
     Section {

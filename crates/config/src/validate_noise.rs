@@ -31,13 +31,52 @@ impl Config {
                 "noise.tia_voltage_noise_v_per_rthz",
                 n.tia_voltage_noise_v_per_rthz,
             );
+            for (key, v) in [
+                (
+                    "noise.tia_voltage_flicker_corner_hz",
+                    n.tia_voltage_flicker_corner_hz,
+                ),
+                (
+                    "noise.drive_amplitude_flicker_per_rthz",
+                    n.drive_amplitude_flicker_per_rthz,
+                ),
+                (
+                    "noise.drive_phase_flicker_rad_per_rthz",
+                    n.drive_phase_flicker_rad_per_rthz,
+                ),
+                (
+                    "noise.carrier_phase_flicker_rad_per_rthz",
+                    n.carrier_phase_flicker_rad_per_rthz,
+                ),
+            ] {
+                p.non_negative(key, v);
+            }
+            if n.tia_voltage_flicker_corner_hz > 0.0 && n.tia_voltage_noise_v_per_rthz == 0.0 {
+                warnings.push(
+                    "noise.tia_voltage_flicker_corner_hz is set but noise.tia_voltage_noise_v_per_rthz is 0: the TIA's voltage flicker is silent".into(),
+                );
+            }
+            if self.has_flicker() && p.clean(&["board.fs_hz", "board.decimation"]) {
+                // The slow sources run at the output rate: two decades of 1/f below its half.
+                let f_lo = self.flicker_f_lo_hz();
+                let max = 0.005 * self.fs_out_hz();
+                p.check(
+                    f_lo.is_finite() && f_lo > 0.0 && f_lo <= max,
+                    "noise.flicker_f_lo_hz",
+                    f_lo,
+                    format!(
+                        "must be > 0 and at most fs_out/200 = {max} Hz (the slow flicker sources run at the output rate and need two decades of 1/f below its half)"
+                    ),
+                );
+            }
             let silent = n.effective_mass_kg.is_none()
                 && n.tia_current_noise_a_per_rthz == 0.0
                 && n.tia_voltage_noise_v_per_rthz == 0.0
-                && b.adc_bits.is_none();
+                && b.adc_bits.is_none()
+                && !self.has_flicker();
             if silent {
                 warnings.push(
-                    "[noise] is present but sets no source (effective_mass_kg, tia_*_noise, board.adc_bits): the run is noiseless".into(),
+                    "[noise] is present but sets no source (effective_mass_kg, tia_*_noise, the flicker keys, board.adc_bits): the run is noiseless".into(),
                 );
             }
         }

@@ -151,6 +151,7 @@ fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
         effective_mass_kg: Some(1e-9),
         tia_current_noise_a_per_rthz: 1e-12,
         tia_voltage_noise_v_per_rthz: 1e-8,
+        ..Default::default()
     });
     c.selfcal = selfcal.then(|| SelfcalConfig {
         allan_record_s: Some(10.0f64.max(20.0 * out_period)),

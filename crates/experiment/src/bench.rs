@@ -54,6 +54,7 @@ pub fn with_noise(cfg: &Config) -> Config {
         effective_mass_kg: Some(1e-9),
         tia_current_noise_a_per_rthz: 5e-14,
         tia_voltage_noise_v_per_rthz: 2e-8,
+        ..Default::default()
     });
     c.board.dac_bits = Some(16);
     c.board.dac_full_scale = 1.5;

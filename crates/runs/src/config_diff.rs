@@ -83,6 +83,7 @@ mod tests {
             effective_mass_kg: None,
             tia_current_noise_a_per_rthz: 1e-13,
             tia_voltage_noise_v_per_rthz: 0.0,
+            ..Default::default()
         });
         let old = canonical_toml(&base);
         assert_eq!(config_diff(&old, &base).unwrap(), Vec::<String>::new());

@@ -55,6 +55,11 @@ pub fn noisy(mut p: BoardParams, seed: u64) -> BoardParams {
         effective_mass_kg: Some(1e-9),
         tia_current_noise_a_per_rthz: 1e-13,
         tia_voltage_noise_v_per_rthz: 2e-8,
+        tia_voltage_flicker_corner_hz: 0.0,
+        drive_amplitude_flicker_per_rthz: 0.0,
+        drive_phase_flicker_rad_per_rthz: 0.0,
+        carrier_phase_flicker_rad_per_rthz: 0.0,
+        flicker_f_lo_hz: 0.0,
     });
     p.adc = Some(Converter {
         bits: 14,
@@ -64,6 +69,20 @@ pub fn noisy(mut p: BoardParams, seed: u64) -> BoardParams {
         bits: 16,
         full_scale: 1.5,
     });
+    p
+}
+
+/// `noisy(p, seed)` with every flicker source on (levels far above physical ones, so a
+/// mistake in any of them shows).
+pub fn flickering(p: BoardParams, seed: u64) -> BoardParams {
+    let mut p = noisy(p, seed);
+    if let Some(n) = &mut p.noise {
+        n.tia_voltage_flicker_corner_hz = 5e4;
+        n.drive_amplitude_flicker_per_rthz = 1e-3;
+        n.drive_phase_flicker_rad_per_rthz = 2e-3;
+        n.carrier_phase_flicker_rad_per_rthz = 3e-3;
+        n.flicker_f_lo_hz = 0.01;
+    }
     p
 }
 

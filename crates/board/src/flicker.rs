@@ -1,0 +1,165 @@
+//! The board's flicker (1/f) sources (issue 14 point 2), on streams of their own (so turning
+//! them on leaves the white noise's bits as they were):
+//!
+//! * the TIA's voltage noise above its corner, referred to the input like its white part
+//!   (`(e_n / R)^2 corner / f`), drawn every input sample: only its density near the carrier
+//!   reaches the read-out;
+//! * the drive amplitude (relative) and phase of each drive, and the carrier's phase, all
+//!   slow: drawn once per decimation block at the output rate (their band ends at half of
+//!   it) and held over the block. The carrier's phase moves the drives and the stage-1
+//!   demodulation alike; a drive's moves only that drive.
+//!
+//! Every source is a seeded [`Flicker`] started in its stationary state, lane-parallel like
+//! the white noise, so a lane gives the bits of that point alone.
+
+use crate::params::{BoardParams, NoiseParams};
+use gyroemu_core::detmath::sin_cos;
+use gyroemu_core::flicker::{Flicker, FlickerParams};
+use gyroemu_core::noise::{stream_seed, NoiseRng};
+use gyroemu_core::{ParamResult, Sample, Stage};
+
+/// Salt of the flicker streams' seeds (apart from the white noise's).
+const FLICKER_SALT: u64 = 0xF11C_4E25_0000_0001;
+
+/// Whether a noise section asks for any flicker source.
+pub(crate) fn has_flicker(n: &NoiseParams) -> bool {
+    n.tia_voltage_flicker_corner_hz > 0.0
+        || n.drive_amplitude_flicker_per_rthz > 0.0
+        || n.drive_phase_flicker_rad_per_rthz > 0.0
+        || n.carrier_phase_flicker_rad_per_rthz > 0.0
+}
+
+/// One source: its generator, or nothing when its level is 0.
+type Source<S> = Option<Flicker<S>>;
+
+/// The slow sources' values over one decimation block, per lane.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BlockFlicker<S> {
+    /// `1 + a_k`: each drive's relative amplitude.
+    pub(crate) amplitude: [S; 2],
+    /// `(cos, sin)` of the carrier's phase plus drive k's phase.
+    pub(crate) drive_rot: [(S, S); 2],
+    /// `(cos, sin)` of the carrier's phase (the demodulation's).
+    pub(crate) carrier_rot: (S, S),
+}
+
+/// Every flicker source of one board (one point per lane).
+#[derive(Clone, Debug)]
+pub(crate) struct FlickerSources<S: Sample> {
+    rng: NoiseRng,
+    tia: [Source<S>; 2],
+    amplitude: [Source<S>; 2],
+    phase: [Source<S>; 2],
+    carrier: Source<S>,
+    /// The values of the block running now.
+    pub(crate) block: BlockFlicker<S>,
+}
+
+impl<S: Sample> FlickerSources<S> {
+    /// The sources `p` asks for, lane `i` on stream `streams[i]` (lanes past the end repeat
+    /// the last); `None` when there are none.
+    pub(crate) fn new(p: &BoardParams, streams: &[u64]) -> ParamResult<Option<Self>> {
+        let Some(n) = p.noise.filter(has_flicker) else {
+            return Ok(None);
+        };
+        let last = streams.len() - 1;
+        let seeds =
+            core::array::from_fn(|i| stream_seed(n.seed ^ FLICKER_SALT, streams[i.min(last)]));
+        let mut rng = NoiseRng::new(seeds);
+        let (fs, fs_out) = (p.fs_hz(), p.fs_out_hz());
+        let i_v = gyroemu_tia::input_referred_noise_a_per_rthz(
+            0.0,
+            n.tia_voltage_noise_v_per_rthz,
+            p.tia.gain_ohm,
+        );
+        let tia_s1 = i_v * i_v * n.tia_voltage_flicker_corner_hz;
+        let fast = |s1: f64| FlickerParams {
+            fs_hz: fs,
+            psd_at_1hz: s1,
+            f_lo_hz: n.flicker_f_lo_hz,
+            f_hi_hz: 0.5 * fs,
+        };
+        let slow = |x: f64| FlickerParams {
+            fs_hz: fs_out,
+            psd_at_1hz: x * x,
+            f_lo_hz: n.flicker_f_lo_hz,
+            f_hi_hz: 0.5 * fs_out,
+        };
+        let mut source = |params: FlickerParams| -> ParamResult<Source<S>> {
+            if params.psd_at_1hz == 0.0 {
+                return Ok(None);
+            }
+            Flicker::stationary(&params, || S::from_x4(rng.normal_pair().0)).map(Some)
+        };
+        let tia = [source(fast(tia_s1))?, source(fast(tia_s1))?];
+        let amplitude = [
+            source(slow(n.drive_amplitude_flicker_per_rthz))?,
+            source(slow(n.drive_amplitude_flicker_per_rthz))?,
+        ];
+        let phase = [
+            source(slow(n.drive_phase_flicker_rad_per_rthz))?,
+            source(slow(n.drive_phase_flicker_rad_per_rthz))?,
+        ];
+        let carrier = source(slow(n.carrier_phase_flicker_rad_per_rthz))?;
+        let one = (S::splat(1.0), S::splat(0.0));
+        Ok(Some(Self {
+            rng,
+            tia,
+            amplitude,
+            phase,
+            carrier,
+            block: BlockFlicker {
+                amplitude: [S::splat(1.0); 2],
+                drive_rot: [one; 2],
+                carrier_rot: one,
+            },
+        }))
+    }
+
+    /// Draws the slow sources' next values (at the start of a decimation block), in a fixed
+    /// order: amplitude 1, 2, phase 1, 2, carrier phase (a source that is off draws nothing).
+    pub(crate) fn next_block(&mut self) {
+        let rng = &mut self.rng;
+        let mut draw = |s: &mut Source<S>| match s {
+            Some(f) => f.tick(S::from_x4(rng.normal_pair().0)),
+            None => S::splat(0.0),
+        };
+        let a = [draw(&mut self.amplitude[0]), draw(&mut self.amplitude[1])];
+        let phi = [draw(&mut self.phase[0]), draw(&mut self.phase[1])];
+        let phi_c = draw(&mut self.carrier);
+        let rot = |x: S| {
+            (
+                S::from_fn(|l| sin_cos(x.lane(l)).1),
+                S::from_fn(|l| sin_cos(x.lane(l)).0),
+            )
+        };
+        self.block = BlockFlicker {
+            amplitude: [S::splat(1.0) + a[0], S::splat(1.0) + a[1]],
+            drive_rot: [rot(phi_c + phi[0]), rot(phi_c + phi[1])],
+            carrier_rot: rot(phi_c),
+        };
+    }
+
+    /// This sample's flicker of the TIA's input-referred current, per mode (A).
+    #[inline(always)]
+    pub(crate) fn tia_current(&mut self) -> [S; 2] {
+        if self.tia[0].is_none() {
+            return [S::splat(0.0); 2];
+        }
+        let (w0, w1) = self.rng.normal_pair();
+        let mut out = [S::splat(0.0); 2];
+        for (k, w) in [w0, w1].into_iter().enumerate() {
+            if let Some(f) = &mut self.tia[k] {
+                out[k] = f.tick(S::from_x4(w));
+            }
+        }
+        out
+    }
+}
+
+/// `(re, im)` of the carrier phasor `c` turned by `(cos, sin)` of an angle, per lane.
+#[inline(always)]
+pub(crate) fn turn<S: Sample>(c_re: f64, c_im: f64, (co, si): (S, S)) -> (S, S) {
+    let (re, im) = (S::splat(c_re), S::splat(c_im));
+    (re * co - im * si, im * co + re * si)
+}
