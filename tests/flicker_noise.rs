@@ -248,3 +248,46 @@ fn tia_voltage_flicker_has_its_corner_in_the_tia_output() {
     // 14 segments x ~50 bins: a few per cent of scatter.
     assert!((got / want - 1.0).abs() < 0.1, "{got:e} against {want:e}");
 }
+
+#[test]
+fn flicker_draws_from_its_own_streams() {
+    // The Brownian force is added to the drive node; the TIA's flicker comes after it. With
+    // the TIA's flicker on, the force's bits are those of the white-only board.
+    let drive_node = |corner: f64| {
+        let c = flicker_cfg(|n| {
+            n.effective_mass_kg = Some(1e-9);
+            n.tia_voltage_noise_v_per_rthz = 1e-7;
+            n.tia_voltage_flicker_corner_hz = corner;
+            n.flicker_f_lo_hz = Some(0.1);
+        });
+        let nodes = vec!["drive".to_string(), "tia".to_string()];
+        let mut probe = Probe::new(&nodes, c.fs_hz(), c.decimation(), 0.0, 0.01, 0);
+        let point = Point {
+            rate_rad_s: 0.0,
+            window: Window::Boxcar { n: 10, frac: 0.0 },
+        };
+        Board::<f64>::new(&c.board_params(), &[0.0], &[0])
+            .unwrap()
+            .run(
+                0,
+                &[point],
+                RunOptions {
+                    probe: Some(&mut probe),
+                    ..Default::default()
+                },
+                &|_| {},
+            )
+            .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        probe.write(dir.path(), "d").unwrap();
+        let d = gyroemu_io::read_dump(&dir.path().join("d_fullrate")).unwrap();
+        let bits = |name: &str| -> Vec<u64> {
+            d.channel(name).unwrap().iter().map(|x| x.to_bits()).collect()
+        };
+        (bits("drive1"), bits("tia1_v"))
+    };
+    let (white, white_tia) = drive_node(0.0);
+    let (with, with_tia) = drive_node(1e4);
+    assert_eq!(white, with);
+    assert_ne!(white_tia, with_tia, "the TIA's flicker is on");
+}
