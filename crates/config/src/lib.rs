@@ -14,12 +14,13 @@ mod resolve;
 mod rules;
 mod schema;
 mod validate;
+mod validate_montecarlo;
 mod validate_noise;
 mod validate_regime;
 
 pub use config::{
-    BoardConfig, Config, DeviceConfig, DriveConfig, DumpConfig, ExperimentConfig, ExperimentKind,
-    NoiseConfig, RateTable, SelfcalConfig, WindowKind,
+    BoardConfig, Config, DeviceConfig, Distribution, DriveConfig, DumpConfig, ExperimentConfig,
+    ExperimentKind, MonteCarloConfig, NoiseConfig, RateTable, SelfcalConfig, WindowKind,
 };
 pub use error::ConfigError;
 pub use parse::{parse_config, parse_config_explained, plain_words};

@@ -6,7 +6,7 @@ use crate::error::ConfigError;
 use crate::parse::parse_config;
 
 /// (name, what it reproduces, TOML text).
-pub const PRESETS: [(&str, &str, &str); 6] = [
+pub const PRESETS: [(&str, &str, &str); 7] = [
     (
         "m2tfg-coriolis",
         "Fig. 8: Coriolis run on an M^2-TFG-like gyroscope (default)",
@@ -36,6 +36,11 @@ pub const PRESETS: [(&str, &str, &str); 6] = [
         "m2tfg-selfcal",
         "`gyroemu selfcal` example: imperfect, noisy device, Allan deviation, drift",
         include_str!("../presets/m2tfg-selfcal.toml"),
+    ),
+    (
+        "m2tfg-montecarlo",
+        "`gyroemu montecarlo` example: a lot drawn from tolerances, yield within 2 %",
+        include_str!("../presets/m2tfg-montecarlo.toml"),
     ),
 ];
 
