@@ -57,8 +57,37 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
-    /// Check the shards in DIR (all present, one config, every point once) and write the
-    /// results a one-machine run would have written.
+    /// A production lot: devices drawn from the tolerances of the config's [montecarlo]
+    /// section, each self-calibrated on the emulated board; writes the distribution of the
+    /// self-calibration error and the yield within the spec.
+    Montecarlo {
+        /// The config file (the nominal device, board and sweeps, plus [montecarlo]).
+        config: PathBuf,
+        /// Devices in the lot (device i is the same in a lot of any size).
+        #[arg(long, value_name = "N", required_unless_present = "print_device")]
+        devices: Option<usize>,
+        /// Output folder. Devices already computed there for the same lot are reused, so
+        /// rerunning an interrupted command resumes it.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Run only shard I of N (0-based) of the devices: device d belongs to shard d % N;
+        /// then `gyroemu merge OUT`. Default: from SLURM_ARRAY_TASK_ID or
+        /// JOB_COMPLETION_INDEX when set (see docs/cluster.md).
+        #[arg(long, value_name = "I/N")]
+        shard: Option<String>,
+        /// The shard count N beside JOB_COMPLETION_INDEX (or GYROEMU_SHARD_COUNT).
+        #[arg(long, value_name = "N")]
+        shard_count: Option<usize>,
+        /// Run even when the plan exceeds the cap of 1e11 point-samples, and delete results
+        /// of another config found in the output folder instead of refusing.
+        #[arg(long)]
+        force: bool,
+        /// Print the config of device I (for `gyroemu selfcal`) instead of running the lot.
+        #[arg(long, value_name = "I", conflicts_with_all = ["shard", "shard_count", "force"])]
+        print_device: Option<u64>,
+    },
+    /// Check the shards in DIR (all present, one config, every point or device once) and
+    /// write the results a one-machine run would have written.
     Merge {
         /// The output folder the shards wrote into.
         dir: PathBuf,
@@ -194,6 +223,23 @@ fn run_cli() -> ExitCode {
             shard: shard.as_deref(),
             shard_count,
             force,
+        }),
+        Command::Montecarlo {
+            config,
+            devices,
+            out,
+            shard,
+            shard_count,
+            force,
+            print_device,
+        } => cmd::montecarlo::montecarlo_command(&cmd::montecarlo::MonteCarloArgs {
+            config: &config,
+            devices,
+            out: &out,
+            shard: shard.as_deref(),
+            shard_count,
+            force,
+            print_device,
         }),
         Command::Merge { dir } => cmd::merge::merge_command(&dir),
         Command::Selfcal { config, out, force } => {

@@ -6,7 +6,7 @@
 use crate::abort::LiveManifest;
 use crate::dumps::reconcile_dump;
 use crate::error::RunError;
-use crate::manifest::{Manifest, ShardId, RUN_MANIFEST};
+use crate::manifest::{Manifest, RunKind, ShardId, RUN_MANIFEST};
 use crate::points::{canonical_toml, config_hash, scan_points, write_point, POINTS_DIR};
 use crate::resume::previous_points;
 use crate::shard::Shard;
@@ -140,7 +140,16 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         count: s.count,
     });
     let manifest = |status: &str, done: &BTreeMap<usize, LaneResult>| {
-        Manifest::new(status, &hash, &config_toml, shard_id, n, &mine, done)
+        Manifest::new(
+            RunKind::Run,
+            status,
+            &hash,
+            &config_toml,
+            shard_id,
+            n,
+            &mine,
+            done,
+        )
     };
     manifest("running", &prev).write(&manifest_path)?;
     // What an abrupt exit (a second Ctrl-C) leaves: the points saved until then.

@@ -4,6 +4,7 @@ pub mod bench;
 pub mod config;
 pub mod inspect;
 pub mod merge;
+pub mod montecarlo;
 pub mod reproduce;
 pub mod run;
 pub mod selfcal;
