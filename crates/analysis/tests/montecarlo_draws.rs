@@ -177,7 +177,8 @@ fn drawn_devices_have_the_configured_spreads() {
     let d0 = &base.device;
     // (what, relative or absolute deviation of each device, configured spread)
     let q2_over_q = |c: &Config| c.device.q_mode2.unwrap_or(c.device.q) / c.device.q;
-    let cases: [(&str, Box<dyn Fn(&Config) -> f64>, f64); 6] = [
+    type Deviation<'a> = Box<dyn Fn(&Config) -> f64 + 'a>;
+    let cases: [(&str, Deviation, f64); 6] = [
         (
             "mode split",
             Box::new(|c| c.device.mode2_f0_offset_hz - d0.mode2_f0_offset_hz),
@@ -207,7 +208,7 @@ fn drawn_devices_have_the_configured_spreads() {
     ];
     for (what, dev, sigma) in &cases {
         assert!(*sigma > 0.0, "{what}: the preset spreads every tolerance");
-        let v: Vec<f64> = devs.iter().map(|c| dev(c)).collect();
+        let v: Vec<f64> = devs.iter().map(dev).collect();
         assert_moments(what, &v, sigma * sigma * v_z);
     }
     // Each device its own noise streams; nothing else of the nominal config changes.

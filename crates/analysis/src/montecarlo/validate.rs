@@ -10,7 +10,8 @@ use gyroemu_experiment::{sweep_work, Work};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 
-/// Refused devices named one by one, at most (the rest are counted).
+/// Refused devices, and distinct device warnings, listed one by one at most (the rest are
+/// counted).
 const LISTED_DEVICES: usize = 5;
 
 /// Validates the lot of `cfg` for the devices `indices`, before any sample is computed: the
@@ -77,13 +78,27 @@ pub fn validate_lot(cfg: &Config, indices: &[u64]) -> Result<Vec<String>, Config
     }
     let mut grouped: Vec<(String, (u64, usize))> = device_warnings.into_iter().collect();
     grouped.sort_by_key(|(_, (first, _))| *first);
-    for (w, (first, n)) in &grouped {
+    for (w, (first, n)) in grouped.iter().take(LISTED_DEVICES) {
         let others = if *n > 1 {
             format!(" and {} more devices", n - 1)
         } else {
             String::new()
         };
         warnings.push(format!("device {first}{others}: {w}"));
+    }
+    if grouped.len() > LISTED_DEVICES {
+        let devices: std::collections::BTreeSet<u64> = grouped
+            .iter()
+            .skip(LISTED_DEVICES)
+            .map(|(_, (f, _))| *f)
+            .collect();
+        warnings.push(format!(
+            "{} more distinct device warnings (from device {} on); to see a device's, run \
+             `gyroemu config --resolved` on its config from `gyroemu montecarlo CONFIG \
+             --print-device I`",
+            grouped.len() - LISTED_DEVICES,
+            devices.iter().next().copied().unwrap_or_default()
+        ));
     }
     Ok(warnings)
 }
