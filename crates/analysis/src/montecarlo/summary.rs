@@ -88,3 +88,56 @@ impl LotSummary {
             .map(|(_, s)| s)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A device whose every column holds `e` (the headline among them).
+    fn device(index: u64, e: f64, problem: bool) -> DeviceResult {
+        DeviceResult {
+            index,
+            values: vec![e; COLUMNS.len()],
+            problems: if problem {
+                vec!["a phase refused".into()]
+            } else {
+                vec![]
+            },
+            warnings: vec![],
+            point_samples: 0,
+        }
+    }
+
+    #[test]
+    fn yield_and_spreads_of_a_hand_computed_lot() {
+        let lot = [
+            device(0, 0.01, false),
+            device(1, -0.03, false),
+            device(2, 0.02, false),
+            device(3, 0.001, true),
+            device(4, f64::NAN, false),
+            device(5, -0.005, false),
+        ];
+        let s = LotSummary::of(&lot, 0.02);
+        // Within |e| <= 0.02: devices 0, 2 (on the limit) and 5; 3 and 4 cannot be trusted.
+        assert_eq!(s.unreliable, vec![3, 4]);
+        let y = &s.yield_within_spec;
+        assert_eq!((y.passed, y.devices), (3, 6));
+        assert_eq!(y.fraction, 0.5);
+        assert_eq!((y.ci95_low, y.ci95_high), wilson_interval(3, 6));
+        // The headline's spread over 0.01, -0.03, 0.02, -0.005: mean -0.00125; sorted
+        // -0.03 -0.005 0.01 0.02, median (-0.005 + 0.01) / 2; |e| sorted 0.005 0.01 0.02
+        // 0.03, P95 at rank 2.85: 0.02 + 0.85 * 0.01.
+        let h = s.headline_spread().unwrap();
+        assert_eq!(h.n, 4);
+        assert!((h.mean + 0.00125).abs() < 1e-17);
+        assert!((h.percentiles[2].1 - 0.0025).abs() < 1e-17);
+        assert!((h.abs_percentiles[3].1 - 0.0285).abs() < 1e-16);
+        assert_eq!((h.min, h.max), (-0.03, 0.02));
+        // Every error column is reported, the headline first among them.
+        assert_eq!(s.errors[0].0, HEADLINE);
+        assert!(s.errors.iter().all(|(n, _)| COLUMNS
+            .iter()
+            .any(|c| c.name == *n && c.kind == ColumnKind::Error)));
+    }
+}
