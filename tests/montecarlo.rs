@@ -3,7 +3,10 @@
 //! a lot spread only in the drive-gain ratio has the mode-1 error F1/F2 - 1 (the Coriolis
 //! phase of mode 1 scales with F2/F1, the rotating phase does not: THEORY.md eqs. 2-3 and 6),
 //! one spread only in lambda has the error lambda_nominal / lambda - 1 (the calibration
-//! predicts with the nominal lambda), each to the ideal device's own error.
+//! predicts with the nominal lambda), one only in the Q mismatch has Q1/Q2 - 1 (the phasors
+//! of THEORY.md section 3 with damping w0/Q_k per mode give the small-angle Coriolis phase of
+//! mode 1 as 2 lambda Omega Q2 F2 / (F1 w0), while its rotating phase goes as 2 Q1 Omega / w0),
+//! each to the ideal device's own error.
 
 use gyroemu::analysis::montecarlo::{
     device_config, draw_device, run_device, validate_lot, DeviceResult, HEADLINE,
@@ -93,13 +96,14 @@ fn one_spread(set: impl Fn(&mut gyroemu::config::MonteCarloConfig)) -> Config {
 }
 
 #[test]
-fn drive_gain_and_lambda_spreads_give_their_closed_form_errors() {
+fn drive_gain_lambda_and_q_mismatch_spreads_give_their_closed_form_errors() {
     // The ideal device's own error sets the tolerance.
     let ideal = device(&one_spread(|_| {}), 0);
     let floor = ideal.value(HEADLINE).unwrap();
     assert!(floor.abs() < 1e-5, "ideal device: {floor:e}");
     let gain = one_spread(|m| m.drive_gain_sigma_rel = 0.01);
     let lambda = one_spread(|m| m.lambda_sigma_rel = 0.01);
+    let q_mismatch = one_spread(|m| m.q_mismatch_sigma_rel = 0.01);
     for i in 0..4 {
         let d = device(&gain, i);
         let want = 1.0 / d.value("f2_over_f1").unwrap() - 1.0;
@@ -122,5 +126,12 @@ fn drive_gain_and_lambda_spreads_give_their_closed_form_errors() {
         // The board itself is unaffected by the lambda spread: its own error is the floor.
         let board = d.value("board_relative_error_mode1").unwrap();
         assert!((board - floor).abs() < 2e-6, "device {i}: board {board:e}");
+        let d = device(&q_mismatch, i);
+        let want = d.value("q").unwrap() / d.value("q_mode2").unwrap() - 1.0;
+        let got = d.value(HEADLINE).unwrap();
+        assert!(
+            (got - want - floor).abs() < 2e-6,
+            "Q mismatch, device {i}: {got:e} vs Q1/Q2 - 1 = {want:e} (+ {floor:e})"
+        );
     }
 }

@@ -182,7 +182,7 @@ pub struct SelfcalConfig {
 
 /// A production lot (`gyroemu montecarlo`): each device's parameters drawn around the
 /// config's own from the tolerances below, device `i` from `(seed, i)` alone. Every spread is
-/// the standard deviation of its draw, whatever the `distribution`.
+/// a standard deviation: of the uniform draw, or of the normal before its truncation.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MonteCarloConfig {
