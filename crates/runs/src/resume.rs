@@ -79,6 +79,7 @@ pub fn previous_devices(
     let scan = scan_records::<DeviceFile>(out).map_err(RunError::BadInput)?;
     warn_bad::<DeviceFile>(&scan.bad, reporter);
     let mut done = BTreeMap::new();
+    let mut stale: Vec<(&Path, String)> = Vec::new();
     for (i, (path, f)) in scan
         .by_index(&id.hash, n_devices, true)
         .map_err(RunError::BadInput)?
@@ -87,12 +88,20 @@ pub fn previous_devices(
             Ok(d) => {
                 done.insert(i, d);
             }
-            Err(e) => reporter.warn(&format!(
-                "ignoring `{}` (written by another gyroemu version: {e}); device {i} is \
-                 computed again",
-                path.display()
-            )),
+            Err(e) => stale.push((path, e)),
         }
+    }
+    // One line for them all: a new gyroemu version can make every file of a lot stale.
+    if let Some((path, why)) = stale.first() {
+        let more = match stale.len() {
+            1 => String::new(),
+            k => format!(" and {} more device files", k - 1),
+        };
+        reporter.warn(&format!(
+            "ignoring `{}`{more} (written by another gyroemu version: {why}); those devices \
+             are computed again",
+            path.display()
+        ));
     }
     Ok(done)
 }

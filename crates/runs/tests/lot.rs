@@ -320,3 +320,29 @@ fn merge_refuses_shards_run_with_another_spec_or_lot_size() {
     let m = merge(&d, &Quiet).unwrap_err().to_string();
     assert!(m.contains("same --devices"), "{m}");
 }
+
+#[test]
+fn device_files_of_another_version_are_computed_again_with_one_warning() {
+    let cfg = lot();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    run_into(&cfg, &out, 3, None, false, None).outcome.unwrap();
+    let csv = std::fs::read(out.join("devices.csv")).unwrap();
+    // Two files as an older version would have written them: a column fewer.
+    for i in [0, 2] {
+        let p = out.join(format!("devices/device-{i}.json"));
+        let mut v: Value = json(&p);
+        v["values"].as_object_mut().unwrap().remove("q");
+        std::fs::write(&p, serde_json::to_string(&v).unwrap()).unwrap();
+    }
+    let r = run_into(&cfg, &out, 3, None, false, None);
+    assert!(r.outcome.is_ok() && r.computed == 2, "{}", r.notes);
+    assert_eq!(
+        r.notes.matches("another gyroemu version").count(),
+        1,
+        "{}",
+        r.notes
+    );
+    assert!(r.notes.contains("and 1 more device files"), "{}", r.notes);
+    assert_eq!(std::fs::read(out.join("devices.csv")).unwrap(), csv);
+}
