@@ -5,9 +5,11 @@
 //! (no [montecarlo], a bad key, no devices, an impossible drawn device) exits 2 before any
 //! sample is computed.
 
-use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use common::*;
+use std::path::Path;
+use std::process::Output;
 
 const OUTPUTS: [&str; 4] = [
     "devices.csv",
@@ -15,43 +17,6 @@ const OUTPUTS: [&str; 4] = [
     "histogram.png",
     "percentiles.png",
 ];
-
-const SCHED_VARS: [&str; 8] = [
-    "SLURM_ARRAY_TASK_STEP",
-    "SLURM_ARRAY_TASK_ID",
-    "SLURM_ARRAY_TASK_COUNT",
-    "SLURM_ARRAY_TASK_MIN",
-    "SLURM_ARRAY_TASK_MAX",
-    "JOB_COMPLETION_INDEX",
-    "GYROEMU_SHARD_COUNT",
-    "RAYON_NUM_THREADS",
-];
-
-fn command(args: &[&str], env: &[(&str, &str)]) -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_gyroemu"));
-    for v in SCHED_VARS {
-        c.env_remove(v);
-    }
-    c.args(args).envs(env.iter().copied());
-    c
-}
-
-fn gyroemu(args: &[&str], env: &[(&str, &str)]) -> Output {
-    command(args, env).output().expect("binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn ok(o: Output) -> Output {
-    assert!(o.status.success(), "{}", stderr(&o));
-    o
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// The preset's text with `(from, to)` replaced (each must occur).
 fn preset_with(edits: &[(&str, &str)]) -> String {
@@ -77,12 +42,6 @@ fn tiny() -> String {
     ])
 }
 
-fn config(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
 fn lot(cfg: &Path, out: &Path, threads: &str, extra: &[&str], env: &[(&str, &str)]) -> Output {
     let mut args = vec!["--threads", threads, "montecarlo", s(cfg), "--out", s(out)];
     args.extend(extra);
@@ -90,15 +49,7 @@ fn lot(cfg: &Path, out: &Path, threads: &str, extra: &[&str], env: &[(&str, &str
 }
 
 fn assert_same_outputs(a: &Path, b: &Path) {
-    for f in OUTPUTS {
-        let (x, y) = (std::fs::read(a.join(f)), std::fs::read(b.join(f)));
-        assert!(x.is_ok() && y.is_ok(), "{f} missing in {a:?} or {b:?}");
-        assert!(x.unwrap() == y.unwrap(), "{f} differs: {a:?} vs {b:?}");
-    }
-}
-
-fn json(p: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    assert_same_files(a, b, &OUTPUTS);
 }
 
 fn device_files(out: &Path) -> usize {
@@ -197,24 +148,7 @@ fn sigint_keeps_the_finished_devices_and_the_rerun_completes() {
         "--out",
         s(&out),
     ];
-    let mut child = command(&args, &[])
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let t0 = std::time::Instant::now();
-    while device_files(&out) == 0 {
-        assert!(t0.elapsed().as_secs() < 60, "no device file appeared");
-        if child.try_wait().unwrap().is_some() {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(2));
-    }
-    let killed = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(killed.success());
-    let o = child.wait_with_output().unwrap();
+    let o = interrupted(&args, || device_files(&out) > 0);
     assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
     let m = json(&out.join("manifest.json"));
     assert_eq!(m["status"], "interrupted");

@@ -3,45 +3,24 @@
 //! drawn and self-calibrated, devices in parallel, each saved as it finishes; the manifest
 //! says what is done; an interrupt keeps what finished; a whole lot then writes its files.
 
-use crate::abort::LiveManifest;
 use crate::device_file::{lot_hash, DeviceFile, DEVICES_DIR};
 use crate::error::RunError;
-use crate::manifest::{Manifest, RunKind, ShardId, RUN_MANIFEST};
+use crate::ledger::Ledger;
+use crate::manifest::RunKind;
 use crate::points::canonical_toml;
 use crate::records::write_record;
 use crate::resume::previous_devices;
+use crate::run::RunRequest;
 use crate::shard::Shard;
 use gyroemu_analysis::montecarlo::{lot_work, run_device, DeviceResult, LotSummary};
-use gyroemu_config::Config;
 use gyroemu_experiment::work::measured_throughput;
 use gyroemu_experiment::{Reporter, SweepError};
 use gyroemu_report::{write_lot, ReportError};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
-
-/// What to run.
-pub struct LotRequest<'a> {
-    /// The config, validated for the devices this run draws
-    /// ([`gyroemu_analysis::montecarlo::validate_lot`]).
-    pub config: &'a Config,
-    /// Devices in the lot (indices `0..devices`).
-    pub devices: usize,
-    /// The output folder (it must exist and be writable: see [`crate::prepare_out`]).
-    pub out: &'a Path,
-    /// Run only this shard of the devices.
-    pub shard: Option<Shard>,
-    /// Run even above the cap of [`gyroemu_experiment::MAX_POINT_SAMPLES`], and delete results
-    /// of another config or kind found in `out` instead of refusing.
-    pub force: bool,
-    /// Raised (Ctrl-C, SIGTERM): the lot saves the devices that finished and returns
-    /// [`RunError::Interrupted`].
-    pub cancel: Arc<AtomicBool>,
-    /// Called after each saved device with the number of devices this run has saved.
-    pub on_saved: Option<&'a (dyn Fn(usize) + Sync)>,
-}
 
 /// How a lot ended.
 #[derive(Clone, Debug, PartialEq)]
@@ -58,11 +37,15 @@ pub enum LotOutcome {
     },
 }
 
-/// Runs the devices of `req` not yet saved in `req.out`, saving each as it finishes; then (a
-/// whole lot) writes its files. The manifest ends `complete`, `interrupted` or `failed` (with
-/// the cause in `next`).
-pub fn run_lot(req: &LotRequest, reporter: &dyn Reporter) -> Result<LotOutcome, RunError> {
-    let (cfg, out, n) = (req.config, req.out, req.devices);
+/// Runs the devices of the lot of `n` devices of `req` not yet saved in `req.out`, saving
+/// each as it finishes; then (a whole lot) writes its files. The manifest ends `complete`,
+/// `interrupted` or `failed` (with the cause in `next`).
+pub fn run_lot(
+    req: &RunRequest,
+    n: usize,
+    reporter: &dyn Reporter,
+) -> Result<LotOutcome, RunError> {
+    let (cfg, out) = (req.config, req.out);
     if cfg.montecarlo.is_none() {
         return Err(RunError::BadInput(
             "the config has no [montecarlo] section: a lot draws its devices from it".into(),
@@ -75,14 +58,7 @@ pub fn run_lot(req: &LotRequest, reporter: &dyn Reporter) -> Result<LotOutcome, 
     }
     let hash = lot_hash(cfg);
     let config_toml = canonical_toml(cfg);
-    let mine: Vec<usize> = match &req.shard {
-        Some(s) => s.points(n),
-        None => (0..n).collect(),
-    };
-    let manifest_path = match &req.shard {
-        Some(s) => out.join(s.manifest_name()),
-        None => out.join(RUN_MANIFEST),
-    };
+    let mine = Shard::items(req.shard.as_ref(), n);
     let prev = previous_devices(out, cfg, n, req.force, reporter)?;
     let todo: Vec<u64> = mine
         .iter()
@@ -91,16 +67,7 @@ pub fn run_lot(req: &LotRequest, reporter: &dyn Reporter) -> Result<LotOutcome, 
         .collect();
     let (work, input_total) = lot_work(cfg, &todo);
     work.check_cap(req.force).map_err(RunError::BadInput)?;
-    let what = match &req.shard {
-        Some(s) => format!(
-            "shard {}/{} ({}): {} of the {n} devices",
-            s.index,
-            s.count,
-            s.source,
-            mine.len()
-        ),
-        None => format!("{n} devices"),
-    };
+    let what = Shard::describe(req.shard.as_ref(), n, "device");
     let devices_dir = out.join(DEVICES_DIR);
     let reused = mine.len() - todo.len();
     reporter.note(&if todo.is_empty() {
@@ -124,40 +91,16 @@ pub fn run_lot(req: &LotRequest, reporter: &dyn Reporter) -> Result<LotOutcome, 
             work.describe(Some(measured_throughput(cfg)))
         )
     });
-    let shard_id = req.shard.as_ref().map(|s| ShardId {
-        index: s.index,
-        count: s.count,
-    });
-    let manifest = |status: &str, done: &BTreeMap<usize, DeviceResult>| {
-        Manifest::new(
-            RunKind::Montecarlo,
-            status,
-            &hash,
-            &config_toml,
-            shard_id,
-            n,
-            &mine,
-            done,
-        )
-    };
-    manifest("running", &prev).write(&manifest_path)?;
-    let mut aborted = manifest("interrupted", &prev);
-    aborted.next = "stopped at once by a second Ctrl-C or SIGTERM: rerun the same command to \
-                    resume"
-        .into();
-    let live = LiveManifest::new(&manifest_path, aborted);
-    let fail = |e: RunError, done: &BTreeMap<usize, DeviceResult>| {
-        let mut m = manifest("failed", done);
-        m.next = format!("fix the cause ({e}) and rerun the same command");
-        match live.write_final(&manifest_path, &m) {
-            Ok(()) => e,
-            Err(w) => RunError::Unrecorded {
-                cause: Box::new(e),
-                manifest: manifest_path.clone(),
-                why: w.to_string(),
-            },
-        }
-    };
+    let ledger = Ledger::start(
+        RunKind::Montecarlo,
+        &hash,
+        &config_toml,
+        out,
+        req.shard.as_ref(),
+        n,
+        &mine,
+        &prev,
+    )?;
 
     let done = Mutex::new(prev);
     let task = reporter.task("montecarlo");
@@ -188,7 +131,7 @@ pub fn run_lot(req: &LotRequest, reporter: &dyn Reporter) -> Result<LotOutcome, 
                 };
                 write_record(out, &DeviceFile::new(&hash, &d))
                     .map_err(|e| RunError::Sweep(SweepError::Output(e)))?;
-                live.saved(&[i as usize]);
+                ledger.saved(i as usize);
                 let ps = d.point_samples;
                 done.lock()
                     .unwrap_or_else(|e| e.into_inner())
@@ -210,47 +153,22 @@ pub fn run_lot(req: &LotRequest, reporter: &dyn Reporter) -> Result<LotOutcome, 
     for o in outcomes {
         match o {
             Ok(ps) => point_samples += ps,
-            Err(e) => return Err(fail(e, &done)),
+            Err(e) => return Err(ledger.fail(e, &done)),
         }
     }
     task.finish(Some(point_samples));
-    let missing = mine.iter().filter(|i| !done.contains_key(i)).count();
-    if missing > 0 {
-        let mut m = manifest("interrupted", &done);
-        m.next = "rerun the same command to resume".into();
-        let e = RunError::Interrupted(format!(
-            "interrupted: {} of {} devices saved in `{}`, {missing} missing (listed in `{}`); \
-             rerun the same command to resume",
-            mine.len() - missing,
-            mine.len(),
-            devices_dir.display(),
-            manifest_path.display()
-        ));
-        return match live.write_final(&manifest_path, &m) {
-            Ok(()) => Err(e),
-            Err(w) => Err(RunError::Unrecorded {
-                cause: Box::new(e),
-                manifest: manifest_path.clone(),
-                why: w.to_string(),
-            }),
-        };
+    if mine.iter().any(|i| !done.contains_key(i)) {
+        return Err(ledger.interrupted(&done, "device", &devices_dir));
     }
-    let mut m = manifest("complete", &done);
-    if let Some(s) = &req.shard {
-        m.next = format!(
-            "when all {} shards are complete: gyroemu merge {}",
-            s.count,
-            out.display()
-        );
-        live.write_final(&manifest_path, &m)
-            .map_err(|e| fail(e, &done))?;
-        return Ok(LotOutcome::ShardComplete { next: m.next });
+    if req.shard.is_some() {
+        let next = ledger.shard_complete(&done, out)?;
+        return Ok(LotOutcome::ShardComplete { next });
     }
     let devices: Vec<DeviceResult> = done.values().cloned().collect();
-    let (mut files, summary) = write_lot(out, cfg, &devices).map_err(|e| fail(e.into(), &done))?;
-    live.write_final(&manifest_path, &m)
-        .map_err(|e| fail(e, &done))?;
-    files.push(manifest_path);
+    let (mut files, summary) =
+        write_lot(out, cfg, &devices).map_err(|e| ledger.fail(e.into(), &done))?;
+    ledger.complete(&done)?;
+    files.push(ledger.path().to_path_buf());
     warn_devices(&devices, reporter);
     check_unreliable(&out.display().to_string(), &summary, &devices)?;
     Ok(LotOutcome::Complete { files, summary })

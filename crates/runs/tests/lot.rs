@@ -5,18 +5,21 @@
 //! device; a folder holding a sweep refuses a lot and the reverse, naming both kinds, unless
 //! `--force`; merge refuses shards run with another spec.
 
+mod common;
+
+use common::*;
 use gyroemu_config::presets::preset;
 use gyroemu_config::Config;
-use gyroemu_experiment::{Quiet, Reporter, Task};
+use gyroemu_experiment::Quiet;
 use gyroemu_report::LOT_FILES;
 use gyroemu_runs::shard::parse_shard;
 use gyroemu_runs::{
-    merge, prepare_out, run, run_lot, LotOutcome, LotRequest, RunError, RunOutcome, RunRequest,
+    merge, prepare_out, run, run_lot, LotOutcome, RunError, RunOutcome, RunRequest,
 };
 use serde_json::Value;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// The lot preset made small (Q = 200, three rates, 0.2 s averages), noise on.
 fn lot() -> Config {
@@ -27,22 +30,6 @@ fn lot() -> Config {
     c.experiment.settle_s = Some(0.1);
     c.validate().unwrap();
     c
-}
-
-/// Keeps the notes and warnings.
-#[derive(Default)]
-struct Record(Mutex<Vec<String>>);
-
-impl Reporter for Record {
-    fn task(&self, _: &str) -> Box<dyn Task + '_> {
-        Box::new(Quiet)
-    }
-    fn note(&self, text: &str) {
-        self.0.lock().unwrap().push(text.to_string());
-    }
-    fn warn(&self, text: &str) {
-        self.0.lock().unwrap().push(format!("warning: {text}"));
-    }
 }
 
 struct Ran {
@@ -71,9 +58,8 @@ fn run_into(
             flag.store(true, Ordering::SeqCst);
         }
     };
-    let req = LotRequest {
+    let req = RunRequest {
         config: cfg,
-        devices: n,
         out,
         shard: shard.map(|s| parse_shard(s).unwrap()),
         force,
@@ -86,7 +72,7 @@ fn run_into(
         .num_threads(threads)
         .build()
         .unwrap();
-    let outcome = pool.install(|| run_lot(&req, &rec));
+    let outcome = pool.install(|| run_lot(&req, n, &rec));
     Ran {
         outcome,
         computed: computed.load(Ordering::SeqCst),
@@ -102,19 +88,8 @@ fn assert_same_files(a: &Path, b: &Path) {
     }
 }
 
-fn json(p: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
-
 fn device_files(out: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(out.join("devices"))
-        .map(|d| {
-            d.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-                .collect()
-        })
-        .unwrap_or_default();
-    v.sort();
-    v
+    files_in(out, "devices")
 }
 
 #[test]

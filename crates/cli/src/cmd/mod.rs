@@ -5,6 +5,7 @@ pub mod config;
 pub mod inspect;
 pub mod merge;
 pub mod montecarlo;
+pub mod out_args;
 pub mod reproduce;
 pub mod run;
 pub mod selfcal;

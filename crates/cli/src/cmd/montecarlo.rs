@@ -1,14 +1,13 @@
 //! `gyroemu montecarlo CONFIG --devices N [--out DIR] [--shard I/N] [--force]`, and
 //! `--print-device I` (one device's config, for `gyroemu selfcal`).
 
-use crate::input::{command_line, list_written, print_out, read_config, refused, BadInput};
+use crate::cmd::out_args::OutArgs;
+use crate::input::{list_written, print_out, read_config, refused, BadInput};
 use crate::progress::Terminal;
-use crate::signals;
 use anyhow::Result;
 use gyroemu_analysis::montecarlo::{device_config, draw_device, validate_lot, LotSummary};
-use gyroemu_runs::{
-    lock_out, prepare_out, resolve_shard, run_lot, LockScope, LotOutcome, LotRequest,
-};
+use gyroemu_runs::shard::Shard;
+use gyroemu_runs::{run_lot, LotOutcome, RunRequest};
 use std::path::Path;
 
 /// The arguments of `gyroemu montecarlo`.
@@ -17,14 +16,8 @@ pub struct MonteCarloArgs<'a> {
     pub config: &'a Path,
     /// `--devices N`: the lot's size.
     pub devices: Option<usize>,
-    /// The output folder.
-    pub out: &'a Path,
-    /// `--shard I/N`.
-    pub shard: Option<&'a str>,
-    /// `--shard-count N` (with `JOB_COMPLETION_INDEX` or a Slurm array).
-    pub shard_count: Option<usize>,
-    /// `--force`: delete results of another config found in the output folder.
-    pub force: bool,
+    /// `--out`, `--shard`, `--shard-count`, `--force`.
+    pub out: &'a OutArgs,
     /// `--print-device I`: print device I's config instead of running the lot.
     pub print_device: Option<u64>,
 }
@@ -53,38 +46,29 @@ pub fn montecarlo_command(a: &MonteCarloArgs) -> Result<()> {
     if n == 0 {
         return Err(BadInput("--devices = 0: a lot needs at least 1 device".into()).into());
     }
-    let shard = resolve_shard(a.shard, a.shard_count, &|k| std::env::var(k).ok())?;
-    let mine: Vec<u64> = match &shard {
-        Some(s) => s.points(n).into_iter().map(|i| i as u64).collect(),
-        None => (0..n as u64).collect(),
-    };
+    let shard = a.out.shard()?;
+    let mine: Vec<u64> = Shard::items(shard.as_ref(), n)
+        .into_iter()
+        .map(|i| i as u64)
+        .collect();
     // The config, its sweeps and every device this process draws, before any sample.
     let warnings = validate_lot(&cfg, &mine).map_err(|e| refused(a.config, &text, e))?;
     for w in warnings {
         eprintln!("warning: {}: {w}", a.config.display());
     }
-    let cancel = signals::install(true);
-    prepare_out(a.out)?;
-    let scope = shard
-        .as_ref()
-        .map_or(LockScope::Folder, |s| LockScope::Shard {
-            index: s.index,
-            count: s.count,
-        });
-    let _lock = lock_out(a.out, &command_line(), scope, &Terminal)?;
-    let req = LotRequest {
+    let (cancel, _lock) = a.out.open(shard.as_ref())?;
+    let req = RunRequest {
         config: &cfg,
-        devices: n,
-        out: a.out,
+        out: &a.out.out,
         shard,
-        force: a.force,
+        force: a.out.force,
         cancel,
         on_saved: None,
     };
-    match run_lot(&req, &Terminal)? {
+    match run_lot(&req, n, &Terminal)? {
         LotOutcome::Complete { files, summary } => {
             print_out(&summary_text(&summary))?;
-            list_written(a.out, &files);
+            list_written(&a.out.out, &files);
         }
         LotOutcome::ShardComplete { next } => eprintln!("shard complete; {next}"),
     }
