@@ -6,7 +6,8 @@
 //! predicts with the nominal lambda), one only in the Q mismatch has Q1/Q2 - 1 (the phasors
 //! of THEORY.md section 3 with damping w0/Q_k per mode give the small-angle Coriolis phase of
 //! mode 1 as 2 lambda Omega Q2 F2 / (F1 w0), while its rotating phase goes as 2 Q1 Omega / w0),
-//! each to the ideal device's own error.
+//! each to the ideal device's own error; the two-mode (combined) error cancels the drive-gain
+//! ratio and the Q mismatch.
 
 use gyroemu::analysis::montecarlo::{
     device_config, draw_device, run_device, validate_lot, DeviceResult, HEADLINE,
@@ -64,6 +65,15 @@ fn each_device_equals_selfcal_on_its_own_config_bit_for_bit() {
                 - 1.0;
             assert_eq!(v(&format!("relative_error_{sfx}")), nominal.to_bits());
         }
+        let c = &r.combined;
+        assert_eq!(
+            v("board_combined_relative_error"),
+            c.relative_error.to_bits()
+        );
+        let nominal = cfg.device.angular_gain * c.rotating.slope_deg_per_dps
+            / c.coriolis.slope_deg_per_dps
+            - 1.0;
+        assert_eq!(v("combined_relative_error"), nominal.to_bits());
         assert_eq!(v("q"), own.device.q.to_bits());
         assert_eq!(v("angular_gain"), own.device.angular_gain.to_bits());
         assert!(d.problems.is_empty(), "{:?}", d.problems);
@@ -101,6 +111,11 @@ fn drive_gain_lambda_and_q_mismatch_spreads_give_their_closed_form_errors() {
     let ideal = device(&one_spread(|_| {}), 0);
     let floor = ideal.value(HEADLINE).unwrap();
     assert!(floor.abs() < 1e-5, "ideal device: {floor:e}");
+    let combined_floor = ideal.value("combined_relative_error").unwrap();
+    assert!(
+        combined_floor.abs() < 1e-5,
+        "ideal device: {combined_floor:e}"
+    );
     let gain = one_spread(|m| m.drive_gain_sigma_rel = 0.01);
     let lambda = one_spread(|m| m.lambda_sigma_rel = 0.01);
     let q_mismatch = one_spread(|m| m.q_mismatch_sigma_rel = 0.01);
@@ -133,5 +148,13 @@ fn drive_gain_lambda_and_q_mismatch_spreads_give_their_closed_form_errors() {
             (got - want - floor).abs() < 2e-6,
             "Q mismatch, device {i}: {got:e} vs Q1/Q2 - 1 = {want:e} (+ {floor:e})"
         );
+        // The two modes together: the Q mismatch and the drive-gain ratio cancel.
+        for (what, d) in [("Q mismatch", d), ("drive gain", device(&gain, i))] {
+            let c = d.value("combined_relative_error").unwrap();
+            assert!(
+                (c - combined_floor).abs() < 2e-6,
+                "{what}, device {i}: combined {c:e} vs the ideal device's {combined_floor:e}"
+            );
+        }
     }
 }

@@ -6,7 +6,7 @@
 
 mod common;
 
-use gyroemu::analysis::selfcal::{run_selfcal_core, validate_selfcal};
+use gyroemu::analysis::selfcal::{linearised_slope, run_selfcal_core, validate_selfcal};
 use gyroemu::analysis::selfcal_analyses::{drift_analysis, tau_analysis};
 use gyroemu::config::presets::preset;
 use gyroemu::config::{Config, NoiseConfig, SelfcalConfig};
@@ -57,14 +57,42 @@ fn drift_selfcal_tracks_the_scale_factor_and_a_stale_one_misses_by_the_q_over_f0
     let deltas = [-30.0, 40.0];
     let d = drift_analysis(&c, &deltas, nominal, &quiet).unwrap();
     for (p, dt) in d.iter().zip(deltas) {
-        assert!(p.selfcal_relative_error.abs() < 1e-4, "{p:?}");
+        // PLL-tracked: the carrier sits on the drifted resonance.
+        let pll = p.pll.as_ref().expect("the default loop fits this board");
+        assert!((pll.carrier_hz / p.f0_hz - 1.0).abs() < 1e-7, "{p:?}");
+        assert!(pll.selfcal_relative_error.abs() < 1e-4, "{p:?}");
+        assert!(pll.combined_selfcal_relative_error.abs() < 1e-4, "{p:?}");
         // Scale factor 2 Q lambda / w0: the stale calibration is off by (Q/f0)/(Q'/f0') - 1.
         let ratio = (1.0 - 30e-6 * dt) / (1.0 - 3000e-6 * dt);
         assert!(
-            (p.stale_relative_error - (ratio - 1.0)).abs() < 1e-4,
+            (pll.stale_relative_error - (ratio - 1.0)).abs() < 1e-4,
             "{p:?}, expected stale error {}",
             ratio - 1.0
         );
+        // Open loop: the carrier stays at the nominal f0, detuned from the drifted mode by
+        // -30 ppm/K; both sweeps read a detuned drive, as the exact theory of a drive at that
+        // carrier says (its slopes read like the sweeps').
+        let open = gyroemu::analysis::selfcal::drifted(&c, dt);
+        assert_eq!(p.open_loop.carrier_hz, c.device.f0_hz);
+        let dev = open.driven_device();
+        let rates = &c.experiment.rates_dps;
+        let deg = |r: [f64; 2]| r[0].to_degrees();
+        let rot: Vec<f64> = rates
+            .iter()
+            .map(|&r| deg(dev.rotating_psi_rad(r.to_radians())))
+            .collect();
+        let cor: Vec<f64> = rates
+            .iter()
+            .map(|&r| deg(dev.coriolis_phase_rad(r.to_radians())))
+            .collect();
+        let slope = |ph: &[f64]| linearised_slope(rates, ph).slope_deg_per_dps;
+        let want = c.device.angular_gain * slope(&rot) / slope(&cor) - 1.0;
+        assert!(
+            (p.open_loop.selfcal_relative_error - want).abs() < 1e-4,
+            "{p:?}: theory {want}"
+        );
+        // Detuned by 4.8 (at -40 K) half-bandwidths, the open loop's error is far from 0.
+        assert!(p.open_loop.selfcal_relative_error.abs() > 1e-2, "{p:?}");
     }
 }
 
@@ -78,6 +106,7 @@ fn averaging_time_reading_at_the_sweep_time_equals_the_sweep() {
         14.4,
         m.coriolis.slope_deg_per_dps,
         m.theory_coriolis_deg_per_dps,
+        core.combined.coriolis.slope_deg_per_dps,
         &quiet,
     )
     .unwrap();
@@ -86,6 +115,9 @@ fn averaging_time_reading_at_the_sweep_time_equals_the_sweep() {
         .find(|p| p.tau_s == 7.2)
         .expect("7.2 s is on the grid");
     assert!((at.predicted_deg_per_dps / m.predicted_deg_per_dps - 1.0).abs() < 1e-12);
+    let comb = core.combined;
+    assert!((at.combined_predicted_deg_per_dps / comb.predicted_deg_per_dps - 1.0).abs() < 1e-12);
+    assert!((at.combined_relative_error - comb.relative_error).abs() < 1e-12);
     // At 1 s (under half a period of the slowest rate) the window is truncated; its leak of the
     // 2 Omega products is known exactly and removed, so the
     // noiseless reading stays as good as the full one.
@@ -100,6 +132,8 @@ fn noisy_selfcal_errors_scatter_as_their_reported_confidence() {
     // zero and scatter like the standard error each run reports (from its fit residuals).
     let mut errs = Vec::new();
     let mut reported = Vec::new();
+    let mut comb_errs = Vec::new();
+    let mut comb_reported = Vec::new();
     for seed in 0..8 {
         let mut c = fast_cfg(&[100.0, 125.0, 150.0, 175.0], 3.6);
         c.noise = Some(NoiseConfig {
@@ -109,23 +143,32 @@ fn noisy_selfcal_errors_scatter_as_their_reported_confidence() {
             tia_current_noise_a_per_rthz: 3e-11,
             tia_voltage_noise_v_per_rthz: 0.0,
         });
-        let m = run_selfcal_core(&c, &quiet, &quiet).unwrap().modes[0];
+        let core = run_selfcal_core(&c, &quiet, &quiet).unwrap();
+        let comb = core.combined;
+        comb_errs.push(comb.relative_error);
+        comb_reported.push(comb.rotating.rel_std_err.hypot(comb.coriolis.rel_std_err));
+        let m = core.modes[0];
         errs.push(m.relative_error);
         let rel =
             |s: &gyroemu::analysis::selfcal::SlopeFit| s.std_err_deg_per_dps / s.slope_deg_per_dps;
         reported.push(rel(&m.rotating).hypot(rel(&m.coriolis)));
     }
-    let n = errs.len() as f64;
-    let mean = errs.iter().sum::<f64>() / n;
-    let sd = (errs.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
-    let typical = (reported.iter().map(|r| r * r).sum::<f64>() / n).sqrt();
-    assert!(sd > 0.0 && typical > 0.0);
-    assert!(mean.abs() < 4.0 * sd / n.sqrt(), "mean {mean:e}, sd {sd:e}");
-    // Two-point fits per sweep (dof 2) make each reported error rough: a factor 3 either way.
-    assert!(
-        sd / typical > 1.0 / 3.0 && sd / typical < 3.0,
-        "scatter {sd:e}, reported {typical:e}"
-    );
+    // Mode 1 alone, then both modes combined (geometric mean; its reported error counts the
+    // two modes' correlation).
+    for (errs, reported) in [(&errs, &reported), (&comb_errs, &comb_reported)] {
+        let n = errs.len() as f64;
+        let mean = errs.iter().sum::<f64>() / n;
+        let sd = (errs.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        let typical = (reported.iter().map(|r| r * r).sum::<f64>() / n).sqrt();
+        assert!(sd > 0.0 && typical > 0.0);
+        assert!(mean.abs() < 4.0 * sd / n.sqrt(), "mean {mean:e}, sd {sd:e}");
+        // Two-point fits per sweep (dof 2) make each reported error rough: a factor 3 either
+        // way.
+        assert!(
+            sd / typical > 1.0 / 3.0 && sd / typical < 3.0,
+            "scatter {sd:e}, reported {typical:e}"
+        );
+    }
     // Same seed, same bits.
     let mut c = fast_cfg(&[100.0, 125.0, 150.0, 175.0], 3.6);
     c.noise = Some(NoiseConfig {

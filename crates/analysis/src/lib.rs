@@ -6,9 +6,16 @@
 
 pub mod allan;
 pub mod bandwidth;
+pub mod freq_response;
+pub mod matrix_fit;
 pub mod montecarlo;
+pub mod resonance_fit;
 pub mod selfcal;
 pub mod selfcal_analyses;
+pub mod selfcal_combined;
 mod selfcal_run;
+pub mod stepped_sine;
 
+pub use freq_response::{run_frequency_response, FrequencyResponse};
 pub use selfcal_run::{run_selfcal, selfcal_work, SelfcalReport};
+pub use stepped_sine::stepped_sine_work;

@@ -3,6 +3,7 @@
 //! virtual rate table on the same emulated board. Both sweeps run sample by sample through
 //! `run_sweep`; the analyses (averaging time, Allan deviation, drift) are in `selfcal_analyses`.
 
+use crate::selfcal_combined::{combined_selfcal, CombinedSelfcal};
 use gyroemu_config::{Config, ConfigError, ExperimentKind, RateTable};
 use gyroemu_experiment::fit::{fit_line, t95, LineFit};
 use gyroemu_experiment::{run_sweep, Progress, SweepError, SweepResult};
@@ -50,6 +51,9 @@ pub struct ModeSelfcal {
     pub relative_error: f64,
     /// Half-width of the 95 % confidence interval of `relative_error`.
     pub relative_error_ci95: f64,
+    /// The same estimator applied to the exact continuous-time theory of both sweeps at the
+    /// same rates (what the imperfections alone leave, without noise or board effects).
+    pub relative_error_theory: f64,
     /// The same prediction from the paper's single channel, and its error.
     pub predicted_paper_i_deg_per_dps: f64,
     pub relative_error_paper_i: f64,
@@ -58,21 +62,30 @@ pub struct ModeSelfcal {
     pub theory_coriolis_deg_per_dps: f64,
 }
 
+fn rates_of(r: &SweepResult) -> Vec<f64> {
+    r.points.iter().map(|p| p.rate_dps).collect()
+}
+
 /// Combines the rotating and Coriolis sweeps of one mode.
 pub fn mode_selfcal(cfg: &Config, rot: &SweepResult, cor: &SweepResult, k: usize) -> ModeSelfcal {
     let lambda = cfg.device.angular_gain;
-    let rates: Vec<f64> = rot.points.iter().map(|p| p.rate_dps).collect();
+    let rates = rates_of(rot);
     let rot_phase: Vec<f64> = rot.points.iter().map(|p| p.phase_deg[k]).collect();
     let paper: Vec<f64> = rot
         .points
         .iter()
         .map(|p| p.paper_i_deg.map_or(f64::NAN, |v| v[k]))
         .collect();
-    let cor_rates: Vec<f64> = cor.points.iter().map(|p| p.rate_dps).collect();
+    let cor_rates = rates_of(cor);
     let cor_phase: Vec<f64> = cor.points.iter().map(|p| p.phase_deg[k]).collect();
     let rotating = linearised_slope(&rates, &rot_phase);
     let rotating_paper_i = linearised_slope(&rates, &paper);
     let coriolis = linearised_slope(&cor_rates, &cor_phase);
+    let theory = |r: &SweepResult| {
+        let ph: Vec<f64> = r.points.iter().map(|p| p.theory_deg[k]).collect();
+        linearised_slope(&rates_of(r), &ph).slope_deg_per_dps
+    };
+    let relative_error_theory = lambda * theory(rot) / theory(cor) - 1.0;
     let predicted = lambda * rotating.slope_deg_per_dps;
     let measured = coriolis.slope_deg_per_dps;
     let rel = |s: &SlopeFit| s.std_err_deg_per_dps / s.slope_deg_per_dps;
@@ -93,6 +106,7 @@ pub fn mode_selfcal(cfg: &Config, rot: &SweepResult, cor: &SweepResult, k: usize
         predicted_deg_per_dps: predicted,
         relative_error: ratio - 1.0,
         relative_error_ci95: ci.abs(),
+        relative_error_theory,
         predicted_paper_i_deg_per_dps: predicted_paper,
         relative_error_paper_i: predicted_paper / measured - 1.0,
         theory_coriolis_deg_per_dps: 2.0 * d.q * d.angular_gain / w0 * other / own,
@@ -123,8 +137,9 @@ pub fn drifted(cfg: &Config, delta_t_k: f64) -> Config {
     c.device.mode2_f0_offset_hz *= f_scale;
     c.device.q *= q_scale;
     c.device.q_mode2 = c.device.q_mode2.map(|q| q * q_scale);
-    // The carrier follows the resonance (a perfectly tracked drive).
-    c.drive.carrier_hz = c.drive.carrier_hz.map(|f| f * f_scale);
+    // The board does not drift: its carrier stays where it was set (open loop); a PLL can
+    // lock it onto the drifted resonance (`drift_analysis`).
+    c.drive.carrier_hz = Some(cfg.carrier_hz());
     c
 }
 
@@ -183,6 +198,16 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
     add("rotating sweep", rot.validate());
     add("rate-table sweep", cor.validate());
     if let Some(s) = &cfg.selfcal {
+        if !s.drift_delta_t_k.is_empty() && cfg.pll.is_none() {
+            // The PLL-tracked half of the drift scenario locks with the default loop; where
+            // none fits the board, that half is left out (null), and said so.
+            if let Err(e) = crate::selfcal_analyses::drift_pll_design(cfg).validate() {
+                add("drift scenario", Ok(vec![format!(
+                    "selfcal.drift_delta_t_k: the drift scenario's PLL-tracked half is left out (null): the default carrier PLL does not fit this board ({}); add a [pll] section that fits to get it",
+                    e.problems().iter().map(|p| p.to_string()).collect::<Vec<_>>().join("; ")
+                )]));
+            }
+        }
         for &dt in &s.drift_delta_t_k {
             let (r, c) = sweep_configs(&drifted(cfg, dt));
             let what = format!("drift scenario at {dt} K");
@@ -207,6 +232,9 @@ pub struct SelfcalCore {
     pub angular_gain: f64,
     /// Per mode (mode 1 is the headline).
     pub modes: [ModeSelfcal; 2],
+    /// Both modes together (their geometric mean), free of the drive-gain ratio and the Q
+    /// mismatch.
+    pub combined: CombinedSelfcal,
     pub rotating: SweepResult,
     pub coriolis: SweepResult,
 }
@@ -229,6 +257,7 @@ impl SelfcalCore {
         Self {
             angular_gain: cfg.device.angular_gain,
             modes: [0, 1].map(|k| mode_selfcal(cfg, &rotating, &coriolis, k)),
+            combined: combined_selfcal(cfg, &rotating, &coriolis),
             rotating,
             coriolis,
         }

@@ -4,12 +4,13 @@
 
 use crate::allan::{noise_readings, overlapping_adev, AllanPoint, NoiseReadings};
 use crate::selfcal::{drifted, linearised_slope, run_selfcal_core, sweep_configs};
+use crate::selfcal_combined::combined_slope;
 use gyroemu_board::{Board, LaneResult, Point, RunOptions, MAX_LANES};
-use gyroemu_config::Config;
+use gyroemu_config::{Config, PllConfig};
 use gyroemu_core::f64x4;
 use gyroemu_experiment::post_process;
 use gyroemu_experiment::sweep::{add_group_progress, canonical_work};
-use gyroemu_experiment::{Progress, SweepError};
+use gyroemu_experiment::{lock_config_carrier, resolve_lock, Progress, SweepError};
 use gyroemu_lpf::Window;
 use gyroemu_mixer::wrap_pi;
 use rayon::prelude::*;
@@ -130,6 +131,11 @@ pub struct TauPoint {
     /// Predicted over the small-angle theory of an ideal device, minus one (noise and
     /// truncation only, without the rate table's own error).
     pub relative_error_vs_theory: f64,
+    /// Both modes together: lambda times the geometric mean of their rotating slopes.
+    pub combined_predicted_deg_per_dps: f64,
+    /// That over the combined Coriolis slope measured by the sweep, minus one.
+    pub combined_relative_error: f64,
+    pub combined_relative_error_ci95: f64,
 }
 
 /// The averaging times read: 1, 2, 5 per decade up to `tau_max_s`, plus the config's
@@ -150,12 +156,14 @@ pub fn tau_grid(tau_max_s: f64, average_s: f64) -> Vec<f64> {
 
 /// One rotating run of `tau_max_s`, read at every averaging time of [`tau_grid`] (each point
 /// averaged over whole half periods once tau spans one, as the sweep does), compared with
-/// the measured Coriolis slope of mode 1.
+/// the measured Coriolis slope of mode 1, and the two modes' combined prediction with their
+/// combined measured slope (`combined_measured_deg_per_dps`, NaN to leave it out).
 pub fn tau_analysis(
     cfg: &Config,
     tau_max_s: f64,
     measured_deg_per_dps: f64,
     theory_deg_per_dps: f64,
+    combined_measured_deg_per_dps: f64,
     progress: Progress,
 ) -> Result<Vec<TauPoint>, SweepError> {
     let (mut rot, _) = sweep_configs(cfg);
@@ -243,8 +251,13 @@ pub fn tau_analysis(
             c.experiment.average_s = tau;
             let res = post_process(&c, &rates, &windows[ti], &lanes)?;
             let xs: Vec<f64> = res.points.iter().map(|p| p.rate_dps).collect();
-            let ys: Vec<f64> = res.points.iter().map(|p| p.phase_deg[0]).collect();
+            let [ys, ys2]: [Vec<f64>; 2] =
+                [0, 1].map(|k| res.points.iter().map(|p| p.phase_deg[k]).collect());
             let s = linearised_slope(&xs, &ys);
+            let comb = combined_slope(&xs, [&ys, &ys2]);
+            let comb_predicted = lambda * comb.slope_deg_per_dps;
+            let comb_ratio = comb_predicted / combined_measured_deg_per_dps;
+            let comb_ci = gyroemu_experiment::fit::t95(comb.dof) * comb_ratio * comb.rel_std_err;
             let predicted = lambda * s.slope_deg_per_dps;
             let ratio = predicted / measured_deg_per_dps;
             let ci = gyroemu_experiment::fit::t95(s.dof) * ratio * s.std_err_deg_per_dps
@@ -256,17 +269,19 @@ pub fn tau_analysis(
                 relative_error: ratio - 1.0,
                 relative_error_ci95: ci.abs(),
                 relative_error_vs_theory: predicted / theory_deg_per_dps - 1.0,
+                combined_predicted_deg_per_dps: comb_predicted,
+                combined_relative_error: comb_ratio - 1.0,
+                combined_relative_error_ci95: comb_ci.abs(),
             })
         })
         .collect()
 }
 
-/// The self-calibration at one temperature offset.
+/// The self-calibration at one temperature offset with one way of driving the carrier.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct DriftPoint {
-    pub delta_t_k: f64,
-    pub f0_hz: f64,
-    pub q: f64,
+pub struct DriftCase {
+    /// The carrier the sweeps ran at, Hz.
+    pub carrier_hz: f64,
     /// Coriolis slope measured on the rate table at this temperature, deg per deg/s.
     pub measured_deg_per_dps: f64,
     /// Self-calibrated at this temperature.
@@ -275,10 +290,47 @@ pub struct DriftPoint {
     pub selfcal_relative_error: f64,
     /// Error of keeping the nominal-temperature calibration instead.
     pub stale_relative_error: f64,
+    /// Self-calibration error of both modes together at this temperature.
+    pub combined_selfcal_relative_error: f64,
 }
 
-/// Re-runs both sweeps on the drifted device at each temperature offset; `nominal_deg_per_dps`
-/// is the calibration taken at the nominal temperature (what a device without
+/// The self-calibration at one temperature offset: the drive open loop at the nominal
+/// carrier, and the carrier locked onto the drifted resonance by the PLL.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DriftPoint {
+    pub delta_t_k: f64,
+    pub f0_hz: f64,
+    pub q: f64,
+    /// The carrier left where it was at the nominal temperature.
+    pub open_loop: DriftCase,
+    /// The carrier locked by the PLL at this temperature (held for the sweeps); `None` when
+    /// no loop fits the board (validation warns).
+    pub pll: Option<DriftCase>,
+    /// When the PLL's lock indicator came on for good, s.
+    pub pll_lock_time_s: Option<f64>,
+}
+
+/// The config whose `[pll]` designs the drift scenario's loop: the user's, or the default
+/// loop (derived natural frequency and lock time) on the nominal device.
+pub fn drift_pll_design(cfg: &Config) -> Config {
+    let mut d = cfg.clone();
+    if d.pll.is_none() {
+        d.pll = Some(PllConfig {
+            natural_hz: None,
+            damping: core::f64::consts::FRAC_1_SQRT_2,
+            lock_s: None,
+            mode: 1,
+        });
+        d.resolve();
+    }
+    d
+}
+
+/// Re-runs both sweeps on the drifted device at each temperature offset, twice: with the
+/// carrier open loop at the nominal one (`cfg`'s, or where a `[pll]` locked it at the
+/// nominal temperature), and with the carrier locked by the PLL at that temperature (the
+/// loop of [`drift_pll_design`], designed for the nominal device). `nominal_deg_per_dps` is
+/// the calibration taken at the nominal temperature (what a device without
 /// self-calibration keeps using).
 pub fn drift_analysis(
     cfg: &Config,
@@ -286,24 +338,48 @@ pub fn drift_analysis(
     nominal_deg_per_dps: f64,
     progress: Progress,
 ) -> Result<Vec<DriftPoint>, SweepError> {
+    let design = drift_pll_design(cfg);
+    let tracked_too = design.validate().is_ok();
+    let (held, _) = resolve_lock(cfg)?;
     let n = deltas_k.len() as u64;
     let mut out = Vec::new();
     for (i, &dt) in deltas_k.iter().enumerate() {
-        let c = drifted(cfg, dt);
-        // Progress in thousandths: each offset is half rotating, half rate table.
-        let at = |half: u64, d: u64, t: u64| {
-            progress(i as u64 * 1000 + half * 500 + d * 500 / t.max(1), n * 1000)
+        let open = drifted(&held, dt);
+        // Progress in thousandths: each offset is two self-calibrations of two sweeps.
+        let at = |quarter: u64, d: u64, t: u64| {
+            progress(
+                i as u64 * 1000 + quarter * 250 + d * 250 / t.max(1),
+                n * 1000,
+            )
         };
-        let core = run_selfcal_core(&c, &|d, t| at(0, d, t), &|d, t| at(1, d, t))?;
-        let m = core.modes[0];
+        let case = |c: &Config, q0: u64| -> Result<DriftCase, SweepError> {
+            let core = run_selfcal_core(c, &|d, t| at(q0, d, t), &|d, t| at(q0 + 1, d, t))?;
+            let m = core.modes[0];
+            Ok(DriftCase {
+                carrier_hz: c.carrier_hz(),
+                measured_deg_per_dps: m.coriolis.slope_deg_per_dps,
+                selfcal_deg_per_dps: m.predicted_deg_per_dps,
+                selfcal_relative_error: m.relative_error,
+                stale_relative_error: nominal_deg_per_dps / m.coriolis.slope_deg_per_dps - 1.0,
+                combined_selfcal_relative_error: core.combined.relative_error,
+            })
+        };
+        let open_loop = case(&open, 0)?;
+        let (pll, pll_lock_time_s) = if tracked_too {
+            let lock = lock_config_carrier(&open, &design)?.expect("the design has a [pll]");
+            let mut tracked = open.clone();
+            tracked.drive.carrier_hz = Some(lock.carrier_hz);
+            (Some(case(&tracked, 2)?), lock.lock_time_s)
+        } else {
+            (None, None)
+        };
         out.push(DriftPoint {
             delta_t_k: dt,
-            f0_hz: c.device.f0_hz,
-            q: c.device.q,
-            measured_deg_per_dps: m.coriolis.slope_deg_per_dps,
-            selfcal_deg_per_dps: m.predicted_deg_per_dps,
-            selfcal_relative_error: m.relative_error,
-            stale_relative_error: nominal_deg_per_dps / m.coriolis.slope_deg_per_dps - 1.0,
+            f0_hz: open.device.f0_hz,
+            q: open.device.q,
+            open_loop,
+            pll,
+            pll_lock_time_s,
         });
     }
     Ok(out)

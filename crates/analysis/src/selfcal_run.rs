@@ -6,7 +6,9 @@ use crate::selfcal_analyses::{
     allan_analysis, drift_analysis, tau_analysis, AllanResult, DriftPoint, TauPoint,
 };
 use gyroemu_config::Config;
-use gyroemu_experiment::{run_sweep, sweep_work, Reporter, SweepError, Work};
+use gyroemu_experiment::{
+    resolve_lock, run_sweep, sweep_work, CarrierLock, Reporter, SweepError, Work,
+};
 
 /// Everything `selfcal` measured.
 #[derive(Clone, Debug)]
@@ -19,25 +21,32 @@ pub struct SelfcalReport {
     pub taus: Option<Vec<TauPoint>>,
     /// Drift scenario (`selfcal.drift_delta_t_k`).
     pub drift: Option<Vec<DriftPoint>>,
+    /// How the carrier PLL locked, with a `[pll]`.
+    pub lock: Option<CarrierLock>,
 }
 
 /// Runs the rotating sweep and the rate-table sweep of `cfg` (validated, e.g. by
 /// `validate_selfcal`), compares them, then runs each analysis the config asks for.
 pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalReport, SweepError> {
-    let (rot_cfg, cor_cfg) = sweep_configs(cfg);
+    // With a [pll], both sweeps run at the carrier it locks (the drift scenario locks again at
+    // each temperature).
+    let (held, lock) = resolve_lock(cfg)?;
+    let (rot_cfg, cor_cfg) = sweep_configs(&held);
     let p = reporter.task("rotating sweep");
     let rotating = run_sweep(&rot_cfg, &|d, t| p.update(d, t), None)?;
     p.finish(Some(rotating.point_samples));
     let p = reporter.task("rate-table sweep");
     let coriolis = run_sweep(&cor_cfg, &|d, t| p.update(d, t), None)?;
     p.finish(Some(coriolis.point_samples));
-    let core = SelfcalCore::from_sweeps(cfg, rotating, coriolis);
+    let core = SelfcalCore::from_sweeps(&held, rotating, coriolis);
     let m = core.modes[0];
     let sc = cfg.selfcal.clone().unwrap_or_default();
     let allan = match sc.allan_record_s {
         Some(t) => {
             let p = reporter.task("allan record");
-            let a = allan_analysis(cfg, t, m.coriolis.slope_deg_per_dps, &|d, n| p.update(d, n))?;
+            let a = allan_analysis(&held, t, m.coriolis.slope_deg_per_dps, &|d, n| {
+                p.update(d, n)
+            })?;
             p.finish(None);
             Some(a)
         }
@@ -47,10 +56,11 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
         Some(t) => {
             let p = reporter.task("averaging-time run");
             let r = tau_analysis(
-                cfg,
+                &held,
                 t,
                 m.coriolis.slope_deg_per_dps,
                 m.theory_coriolis_deg_per_dps,
+                core.combined.coriolis.slope_deg_per_dps,
                 &|d, n| p.update(d, n),
             )?;
             p.finish(None);
@@ -76,6 +86,7 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
         allan,
         taus,
         drift,
+        lock,
     })
 }
 

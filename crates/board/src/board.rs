@@ -6,6 +6,7 @@ use crate::fault::NonFinite;
 use crate::params::{build_adc, build_dac, build_lowpass, build_tia, BoardParams, Shape};
 use crate::point::{Point, RunOptions, RunOutput};
 use gyroemu_am::{AmModulator, Dac, DrivePattern, Quantizer};
+use gyroemu_core::gauss::NormalBlock;
 use gyroemu_core::noise::{held_white_sigma, stream_seed, NoiseRng};
 use gyroemu_core::{ParamError, Sample};
 use gyroemu_lpf::LowPassBank;
@@ -25,11 +26,12 @@ pub(crate) const CORIOLIS: u8 = 0;
 pub(crate) const RATE_TABLE: u8 = 1;
 pub(crate) const ROTATING: u8 = 2;
 
-/// The seeded noise of one lane group: one stream per lane (per operating point) and the
-/// per-sample standard deviations of the force (per unit mass) and input-current sources.
+/// The seeded noise of one lane group: each lane's (operating point's) normals, drawn ahead,
+/// four a sample (force on both modes, then input current on both modes), and the per-sample
+/// standard deviations of the force (per unit mass) and input-current sources.
 #[derive(Clone, Debug)]
 pub(crate) struct NoiseState<S> {
-    pub(crate) rng: NoiseRng,
+    pub(crate) normals: NormalBlock,
     pub(crate) sigma_force: [S; 2],
     pub(crate) sigma_current: [S; 2],
 }
@@ -217,7 +219,7 @@ impl<S: Sample> Board<S> {
             fs_hz: fs,
             mod_shift,
             noise: NoiseState {
-                rng,
+                normals: NormalBlock::new(rng),
                 sigma_force: sigma_force.map(S::splat),
                 sigma_current: sigma_current.map(S::splat),
             },
@@ -259,10 +261,15 @@ impl<S: Sample> Board<S> {
             .map_err(|k| self.locate_fault(k))
     }
 
-    /// The plant takes its decoupled step (exact zeros across the modes in every lane: no
-    /// rotation and no quadrature coupling; never on a rate table, whose step varies). Public
-    /// so tests can check that a run took the shortcut it is compared through.
+    /// The plant takes its sparse step: at a constant rate the decoupled one (exact zeros
+    /// across the modes in every lane: no rotation and no quadrature coupling), on a rate
+    /// table the one split by mode (`Resonator::rate_split_by_mode`). Both leave out only
+    /// products by exact zeros. Public so tests can check that a run took the shortcut it is
+    /// compared through.
     pub fn plant_decoupled(&self) -> bool {
-        !matches!(self.shape, Shape::RateTable { .. }) && self.plant.decoupled()
+        match self.shape {
+            Shape::RateTable { .. } => self.plant.rate_split_by_mode(),
+            _ => self.plant.decoupled(),
+        }
     }
 }

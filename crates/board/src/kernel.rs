@@ -9,7 +9,7 @@ use crate::params::Shape;
 use crate::point::{LaneResult, Point, RunOptions, RunOutput};
 use crate::probe::Probe;
 use gyroemu_am::AmInput;
-use gyroemu_core::{Complex64, Sample, Stage};
+use gyroemu_core::{f64x4, Complex64, Sample, Stage};
 use gyroemu_lpf::Averager;
 use gyroemu_mixer::{
     table_channel, table_reference, Iq, Stage1Mixer, MAX_TABLE_HARMONIC, TABLE_CHANNELS,
@@ -75,7 +75,8 @@ impl<S: Sample> Board<S> {
     }
 
     /// The sample loop of experiment shape `K`; `NOISY`: the noise sources and the ADC are in
-    /// the chain; `DECOUPLED`: the plant takes its decoupled step.
+    /// the chain; `DECOUPLED`: the plant takes its sparse step (decoupled, or split by mode on
+    /// a rate table: [`Board::plant_decoupled`]).
     ///
     /// Its own function per shape: inlined into the dispatcher beside the other shapes, the
     /// sample loop's registers were allocated worse (measurably slower).
@@ -263,100 +264,128 @@ impl<S: Sample> Board<S> {
     ) -> ([Iq<S>; 2], [S; 2]) {
         let zero = S::splat(0.0);
         let mut out = ([Iq::<S>::default(); 2], [zero; 2]);
-        for j in 0..self.decimation as u64 {
-            let (c_re, c_im) = self.carrier.tick(());
-            // The rotating drive uses only the in-phase carrier.
-            let cq = if K == ROTATING {
-                0.0
+        let m = self.decimation as u64;
+        let noisy = NOISY && self.noise_on;
+        let mut j0 = 0;
+        // In runs that the drawn-ahead normals cover: drawing more is a call, kept out of the
+        // per-sample loop.
+        while j0 < m {
+            let run = if noisy {
+                self.noise.normals.ready(m - j0)
             } else {
-                self.shifter.apply(Complex64::new(c_re, c_im)).re
+                m - j0
             };
-            let (mod_cos, mod_sin) = if K == ROTATING {
-                self.modulation.tick(())
-            } else {
-                (zero, zero)
-            };
-            // The drive's quadrature copy passes the (imperfect) phase shifter:
-            // sin(Omega t - eps); the stage-2 references stay exact.
-            let drive_sin = match self.mod_shift {
-                Some((ce, se)) if K == ROTATING => mod_sin * ce - mod_cos * se,
-                _ => mod_sin,
-            };
-            let drive = self.am.tick(AmInput {
-                carrier_i: S::splat(c_re),
-                carrier_q: S::splat(cq),
-                mod_cos,
-                mod_sin: drive_sin,
-            });
-            let mut u = drive;
-            for md in 0..2 {
-                u[md] = match self.dac[md].quantizer() {
-                    // The same bits as the DAC's tick, with its clipped and zero samples counted.
-                    Some(q) if NOISY => {
-                        let (clip, zeros) = counts.0.split_at_mut(DAC_ZERO);
-                        q.quantize_counting(drive[md], &mut clip[DAC_CLIP + md], &mut zeros[md])
-                    }
-                    _ => self.dac[md].tick(drive[md]),
+            let base = self.noise.normals.pos();
+            for j in j0..j0 + run {
+                let (c_re, c_im) = self.carrier.tick(());
+                // The rotating drive uses only the in-phase carrier.
+                let cq = if K == ROTATING {
+                    0.0
+                } else {
+                    self.shifter.apply(Complex64::new(c_re, c_im)).re
                 };
-            }
-            if NOISY && self.noise_on {
-                // Brownian force on each mode, after the DAC (it acts on the proof mass).
-                let (a, b) = self.noise.rng.normal_pair();
-                u[0] = S::from_x4(a).mul_add(self.noise.sigma_force[0], u[0]);
-                u[1] = S::from_x4(b).mul_add(self.noise.sigma_force[1], u[1]);
-            }
-            let mut p = if K == RATE_TABLE {
-                let (_, sin_t) = self.table_nco.tick(());
-                self.plant.tick_with_rate(u, self.rate * S::splat(sin_t))
-            } else if DECOUPLED {
-                self.plant.tick_decoupled(u)
-            } else {
-                self.plant.tick(u)
-            };
-            if NOISY && self.noise_on {
-                // Amplifier noise, referred to the TIA input.
-                let (a, b) = self.noise.rng.normal_pair();
-                p.current[0] = S::from_x4(a).mul_add(self.noise.sigma_current[0], p.current[0]);
-                p.current[1] = S::from_x4(b).mul_add(self.noise.sigma_current[1], p.current[1]);
-            }
-            let mut y = [
-                self.tia[0].tick(p.current[0]),
-                self.tia[1].tick(p.current[1]),
-            ];
-            if NOISY {
-                let c = &mut counts.0;
+                let (mod_cos, mod_sin) = if K == ROTATING {
+                    self.modulation.tick(())
+                } else {
+                    (zero, zero)
+                };
+                // The drive's quadrature copy passes the (imperfect) phase shifter:
+                // sin(Omega t - eps); the stage-2 references stay exact.
+                let drive_sin = match self.mod_shift {
+                    Some((ce, se)) if K == ROTATING => mod_sin * ce - mod_cos * se,
+                    _ => mod_sin,
+                };
+                let drive = self.am.tick(AmInput {
+                    carrier_i: S::splat(c_re),
+                    carrier_q: S::splat(cq),
+                    mod_cos,
+                    mod_sin: drive_sin,
+                });
+                let mut u = drive;
                 for md in 0..2 {
-                    c[TIA_RAIL + md] += self.tia[md].rail_flags(y[md]);
+                    u[md] = match self.dac[md].quantizer() {
+                        // The same bits as the DAC's tick, with its clipped and zero samples counted.
+                        Some(q) if NOISY => {
+                            let (clip, zeros) = counts.0.split_at_mut(DAC_ZERO);
+                            q.quantize_counting(drive[md], &mut clip[DAC_CLIP + md], &mut zeros[md])
+                        }
+                        _ => self.dac[md].tick(drive[md]),
+                    };
                 }
-                if let Some(adc) = &self.adc {
-                    let (clip, zeros) = c.split_at_mut(ADC_ZERO);
+                // This sample's normals: force on each mode, then input current on each mode.
+                let nz = if noisy {
+                    self.noise.normals.at(base + 4 * (j - j0) as usize)
+                } else {
+                    [f64x4::ZERO; 4]
+                };
+                if noisy {
+                    // Brownian force on each mode, after the DAC (it acts on the proof mass).
+                    u[0] = S::from_x4(nz[0]).mul_add(self.noise.sigma_force[0], u[0]);
+                    u[1] = S::from_x4(nz[1]).mul_add(self.noise.sigma_force[1], u[1]);
+                }
+                let mut p = if K == RATE_TABLE {
+                    let (_, sin_t) = self.table_nco.tick(());
+                    let rate = self.rate * S::splat(sin_t);
+                    if DECOUPLED {
+                        self.plant.tick_with_rate_split(u, rate)
+                    } else {
+                        self.plant.tick_with_rate(u, rate)
+                    }
+                } else if DECOUPLED {
+                    self.plant.tick_decoupled(u)
+                } else {
+                    self.plant.tick(u)
+                };
+                if noisy {
+                    // Amplifier noise, referred to the TIA input.
+                    p.current[0] =
+                        S::from_x4(nz[2]).mul_add(self.noise.sigma_current[0], p.current[0]);
+                    p.current[1] =
+                        S::from_x4(nz[3]).mul_add(self.noise.sigma_current[1], p.current[1]);
+                }
+                let mut y = [
+                    self.tia[0].tick(p.current[0]),
+                    self.tia[1].tick(p.current[1]),
+                ];
+                if NOISY {
+                    let c = &mut counts.0;
                     for md in 0..2 {
-                        y[md] = adc[md].quantize_counting(
-                            y[md],
-                            &mut clip[ADC_CLIP + md],
-                            &mut zeros[md],
-                        );
+                        c[TIA_RAIL + md] += self.tia[md].rail_flags(y[md]);
+                    }
+                    if let Some(adc) = &self.adc {
+                        let (clip, zeros) = c.split_at_mut(ADC_ZERO);
+                        for md in 0..2 {
+                            y[md] = adc[md].quantize_counting(
+                                y[md],
+                                &mut clip[ADC_CLIP + md],
+                                &mut zeros[md],
+                            );
+                        }
                     }
                 }
+                // Both stage-1 mixers see the same carrier: when their reference phases agree
+                // (always, as built) they share one set of carrier factors.
+                let carrier = Complex64::new(c_re, c_im);
+                let f0 = self.mix1[0].factors(carrier);
+                let f1 = if self.mix1_same_ref {
+                    f0
+                } else {
+                    self.mix1[1].factors(carrier)
+                };
+                let z = [Stage1Mixer::mix(y[0], f0), Stage1Mixer::mix(y[1], f1)];
+                if let Some(pr) = probe.as_deref_mut() {
+                    pr.record_full(n0 + j, &u, &p, &y, &z);
+                }
+                let [i1, q1, i2, q2] = self.lp.tick([z[0].i, z[0].q, z[1].i, z[1].q]);
+                out = ([Iq::new(i1, q1), Iq::new(i2, q2)], [mod_cos, mod_sin]);
+                if let Some(pr) = probe.as_deref_mut() {
+                    pr.check_lowpass(n0 + j, &out.0);
+                }
             }
-            // Both stage-1 mixers see the same carrier: when their reference phases agree
-            // (always, as built) they share one set of carrier factors.
-            let carrier = Complex64::new(c_re, c_im);
-            let f0 = self.mix1[0].factors(carrier);
-            let f1 = if self.mix1_same_ref {
-                f0
-            } else {
-                self.mix1[1].factors(carrier)
-            };
-            let z = [Stage1Mixer::mix(y[0], f0), Stage1Mixer::mix(y[1], f1)];
-            if let Some(pr) = probe.as_deref_mut() {
-                pr.record_full(n0 + j, &u, &p, &y, &z);
+            if noisy {
+                self.noise.normals.advance(run);
             }
-            let [i1, q1, i2, q2] = self.lp.tick([z[0].i, z[0].q, z[1].i, z[1].q]);
-            out = ([Iq::new(i1, q1), Iq::new(i2, q2)], [mod_cos, mod_sin]);
-            if let Some(pr) = probe.as_deref_mut() {
-                pr.check_lowpass(n0 + j, &out.0);
-            }
+            j0 += run;
         }
         out
     }

@@ -4,13 +4,15 @@
 //! onto it) and owns the sample loop: [`Board`] runs up to four operating points in `f64x4`
 //! lanes through one fused kernel (`kernel.rs`); [`reference::run_reference`] runs the same
 //! chain plainly, stage by stage, as its test oracle; [`ChainResponse`] answers the read-out's
-//! compensation from the very stages the board runs; [`Probe`] records signal dumps.
+//! compensation from the very stages the board runs; [`Probe`] records signal dumps;
+//! [`lock_carrier`] locks the carrier onto a resonance with the PLL.
 
 mod board;
 mod chain;
 mod fault;
 mod health;
 mod kernel;
+mod lock;
 mod params;
 mod point;
 mod probe;
@@ -20,6 +22,7 @@ pub use board::{Board, MAX_LANES};
 pub use chain::{unleak_sidebands, unleak_table_harmonics, ChainResponse, RotatingTerms};
 pub use fault::NonFinite;
 pub use health::Health;
+pub use lock::{lock_carrier, LockRun, LockSample};
 pub use params::{BoardParams, Converter, NoiseParams, Shape};
 pub use point::{LaneResult, Point, RunOptions, RunOutput};
 pub use probe::{Probe, DUMP_NODES};

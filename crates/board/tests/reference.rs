@@ -85,8 +85,13 @@ fn the_shortcuts_under_test_are_taken() {
     assert!(!Board::<f64x4>::new(&imperfect(rot), &[1.0], &[0])
         .unwrap()
         .plant_decoupled());
+    // A rate table on a device without coupling takes the step split by mode; with the
+    // imperfect device's quadrature coupling, the full time-varying step.
     let table = m2tfg(Shape::RateTable { freq_hz: 2.0 });
-    assert!(!Board::<f64x4>::new(&table, &[0.0], &[0])
+    assert!(Board::<f64x4>::new(&table, &[0.0, 1.0], &[0, 1])
+        .unwrap()
+        .plant_decoupled());
+    assert!(!Board::<f64x4>::new(&imperfect(table), &[1.0], &[0])
         .unwrap()
         .plant_decoupled());
 }

@@ -76,6 +76,19 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Characterise the device as the lab does: a stepped-sine frequency response of each
+    /// mode through the board (Bode plot, CSV) and a resonance fit (f0, Q, mode split)
+    /// checked against the configured device.
+    Sweep {
+        /// The config file (its [sweep] section, or the defaults derived from the device).
+        config: PathBuf,
+        /// Output folder.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Run even when the plan exceeds the cap of 1e11 point-samples.
+        #[arg(long)]
+        force: bool,
+    },
     /// Measure throughput: the whole chain on 1 and on all threads, and each stage.
     Bench {
         /// Preset whose board is measured (the rotating one exercises every stage).
@@ -199,6 +212,7 @@ fn run_cli() -> ExitCode {
         Command::Selfcal { config, out, force } => {
             cmd::selfcal::selfcal_command(&config, &out, force)
         }
+        Command::Sweep { config, out, force } => cmd::sweep::sweep_command(&config, &out, force),
         Command::Config {
             preset,
             list,

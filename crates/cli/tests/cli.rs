@@ -298,8 +298,9 @@ fn inspect_refuses_missing_or_damaged_dumps_with_exit_2() {
     assert_eq!(pngs, 0);
 }
 
-/// `bench` measures the whole chain and every stage on 1 and on all threads (the figures are
-/// timing, so only their presence and sign are checked), and refuses zero repeats.
+/// `bench` measures the whole chain, noiseless and with noise, and every stage on 1 and on all
+/// threads (the figures are timing, so only their presence and sign are checked), and refuses
+/// zero repeats.
 #[test]
 fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
     let o = gyroemu(&[
@@ -315,14 +316,21 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
     let text = String::from_utf8_lossy(&o.stdout);
     for name in [
         "whole chain",
+        "whole chain with noise",
         "resonator (decoupled step)",
-        "low-pass bank",
+        "low-pass bank (I1, Q1, I2, Q2)",
         "tia",
     ] {
         for threads in ["1", "2"] {
             let row = text
                 .lines()
-                .find(|l| l.starts_with(name) && l.split_whitespace().rev().nth(2) == Some(threads))
+                .find(|l| {
+                    // The label is the text left of the three figures.
+                    let words: Vec<&str> = l.split_whitespace().collect();
+                    words.len() > 3
+                        && words[..words.len() - 3].join(" ") == name
+                        && words[words.len() - 3] == threads
+                })
                 .unwrap_or_else(|| panic!("no `{name}` row on {threads} threads:\n{text}"));
             let v: Vec<f64> = row
                 .split_whitespace()

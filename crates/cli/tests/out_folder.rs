@@ -157,9 +157,10 @@ fn every_writing_command_refuses_a_folder_in_use_naming_the_holder() {
     let mut holder = Command::new("sleep").arg("60").spawn().unwrap();
     plant_lock(&out, holder.id());
     let lock_before = std::fs::read(out.join(LOCK)).unwrap();
-    let commands: [Vec<&str>; 4] = [
+    let commands: [Vec<&str>; 5] = [
         vec!["run", s(&cfg), "--out", s(&out)],
         vec!["selfcal", s(&cfg), "--out", s(&out)],
+        vec!["sweep", s(&cfg), "--out", s(&out)],
         vec!["merge", s(&out)],
         vec!["reproduce", "--quick", "--out", s(&out)],
     ];

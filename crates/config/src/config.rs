@@ -21,9 +21,40 @@ pub struct Config {
     /// The analyses of `gyroemu selfcal` (absent: only the two sweeps and their comparison).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub selfcal: Option<SelfcalConfig>,
+    /// The stepped-sine frequency response of `gyroemu sweep` (absent: every key at its
+    /// default, derived from the device; read it with [`Config::sweep_resolved`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sweep: Option<SweepConfig>,
+    /// A carrier PLL that locks the drive onto the resonance before the sweep (absent: the
+    /// carrier is `drive.carrier_hz`, open loop).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pll: Option<PllConfig>,
     /// The production lot of `gyroemu montecarlo` (absent: that command refuses the config).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub montecarlo: Option<MonteCarloConfig>,
+}
+
+/// The carrier PLL (`crates/pll`): at zero rate the board drives the device and the PLL steers
+/// the carrier onto the resonance of one mode from its demodulated output; the sweep then runs
+/// with the carrier held where the lock ended.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PllConfig {
+    /// The loop's natural frequency, Hz; default the geometric mean of the slowest loop a PI
+    /// on the frequency can make (2 zeta w_n tau >= 1) and the fastest the low-pass allows
+    /// (read it with [`Config::pll_natural_hz`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub natural_hz: Option<f64>,
+    /// The loop's damping ratio.
+    #[serde(default = "default_damping")]
+    pub damping: f64,
+    /// Length of the lock run, s; default 16 mechanical time constants plus 10 loop time
+    /// constants 1/(zeta w_n) (read it with [`Config::pll_lock_s`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lock_s: Option<f64>,
+    /// The mode whose output the PLL locks on: 1 or 2.
+    #[serde(default = "default_pll_mode")]
+    pub mode: usize,
 }
 
 /// The resonator (THEORY.md section 2).
@@ -180,6 +211,60 @@ pub struct SelfcalConfig {
     pub q_tc_ppm_per_k: f64,
 }
 
+/// How the stepped-sine frequencies are spaced between `start_hz` and `stop_hz`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Spacing {
+    /// Evenly in the sum of the two modes' resonance phases `atan((f - f0_k) / b_k)`
+    /// (`b_k = f0_k / (2 Q_k)`): dense near each resonance, sparse on the skirts.
+    Resonance,
+    /// Evenly in frequency.
+    Linear,
+    /// Evenly in log frequency.
+    Log,
+}
+
+/// The stepped-sine frequency response of `gyroemu sweep`: each mode driven alone at each
+/// frequency, at zero rate, settled, then averaged. Every key has a default derived from the
+/// device (see `Config::sweep_resolved`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepConfig {
+    /// Lowest frequency, Hz; default 10 half-bandwidths f0/(2Q) below the lower mode.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_hz: Option<f64>,
+    /// Highest frequency, Hz; default 10 half-bandwidths above the upper mode.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stop_hz: Option<f64>,
+    /// Number of frequencies (start and stop included).
+    #[serde(default = "default_sweep_points")]
+    pub points: usize,
+    /// How the frequencies are spaced.
+    #[serde(default = "default_spacing")]
+    pub spacing: Spacing,
+    /// Time discarded at each frequency before averaging, s; default 16 mechanical time
+    /// constants Q/(pi f0) of the slower mode plus the low-pass settling.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settle_s: Option<f64>,
+    /// Averaging time at each frequency, s; default 2 mechanical time constants.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub average_s: Option<f64>,
+}
+
+impl Default for SweepConfig {
+    /// Every key at the default it has when left out of a `[sweep]` table.
+    fn default() -> Self {
+        Self {
+            start_hz: None,
+            stop_hz: None,
+            points: default_sweep_points(),
+            spacing: default_spacing(),
+            settle_s: None,
+            average_s: None,
+        }
+    }
+}
+
 /// A production lot (`gyroemu montecarlo`): each device's parameters drawn around the
 /// config's own from the tolerances below, device `i` from `(seed, i)` alone. Every spread is
 /// a standard deviation: of the uniform draw, or of the normal before its truncation.
@@ -304,6 +389,21 @@ pub struct DumpConfig {
     pub nodes: Option<Vec<String>>,
 }
 
+fn default_damping() -> f64 {
+    core::f64::consts::FRAC_1_SQRT_2
+}
+fn default_pll_mode() -> usize {
+    1
+}
+/// Frequencies of a `[sweep]` by default.
+pub const DEFAULT_SWEEP_POINTS: usize = 61;
+
+fn default_sweep_points() -> usize {
+    DEFAULT_SWEEP_POINTS
+}
+fn default_spacing() -> Spacing {
+    Spacing::Resonance
+}
 fn default_transduction() -> f64 {
     1e-6
 }

@@ -17,13 +17,17 @@ mod validate;
 mod validate_montecarlo;
 mod validate_noise;
 mod validate_regime;
+mod validate_sweep;
 
 pub use config::{
     BoardConfig, Config, DeviceConfig, Distribution, DriveConfig, DumpConfig, ExperimentConfig,
-    ExperimentKind, MonteCarloConfig, NoiseConfig, RateTable, SelfcalConfig, WindowKind,
+    ExperimentKind, MonteCarloConfig, NoiseConfig, PllConfig, RateTable, SelfcalConfig, Spacing,
+    SweepConfig, WindowKind, DEFAULT_SWEEP_POINTS,
 };
 pub use error::ConfigError;
 pub use parse::{parse_config, parse_config_explained, plain_words};
-pub use resolve::Derived;
+pub use plan::sweep_grid;
+pub use resolve::{Derived, SWEEP_AVERAGE_TAUS, SWEEP_SETTLE_TAUS, SWEEP_SPAN_HALF_BANDWIDTHS};
 pub use validate::MAX_RUN_SAMPLES;
 pub use validate_regime::{MAX_HOLD_ERROR_MDEG, NODE_RANGE, WARN_HOLD_ERROR_MDEG};
+pub use validate_sweep::{MAX_SWEEP_POINTS, MIN_POINTS_NEAR_RESONANCE, MIN_SWEEP_POINTS};

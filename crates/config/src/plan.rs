@@ -1,7 +1,7 @@
 //! What a config implies before anything runs: its experiment shape, the board it describes,
 //! the operating points it emulates and their settling and averaging windows.
 
-use crate::config::{Config, ExperimentKind, RateTable, WindowKind};
+use crate::config::{Config, ExperimentKind, RateTable, Spacing, WindowKind};
 use gyroemu_board::{BoardParams, Converter, NoiseParams, Point, Shape};
 use gyroemu_lpf::{LowPassDesign, Window};
 use gyroemu_mixer::MAX_TABLE_HARMONIC;
@@ -209,4 +209,84 @@ impl Config {
             },
         }
     }
+
+    /// The stepped-sine frequencies of the resolved `[sweep]`, Hz: ascending, `start_hz`
+    /// and `stop_hz` included (see [`sweep_grid`]).
+    pub fn sweep_frequencies_hz(&self) -> Vec<f64> {
+        let s = self.sweep_resolved();
+        sweep_grid(
+            s.start_hz.unwrap_or(f64::NAN),
+            s.stop_hz.unwrap_or(f64::NAN),
+            s.points,
+            s.spacing,
+            &self.mode_resonances_hz(),
+        )
+    }
+
+    /// One swept frequency's run in decimated samples: the settling (whole output periods
+    /// covering `sweep.settle_s`) and the boxcar averaging window (the whole output periods in
+    /// `sweep.average_s`, at least one).
+    pub fn sweep_point(&self) -> (u64, Point) {
+        let s = self.sweep_resolved();
+        let fs_out = self.fs_out_hz();
+        let settle = (s.settle_s.unwrap_or(0.0) * fs_out).ceil() as u64;
+        let n = (s.average_s.unwrap_or(0.0) * fs_out).floor().max(1.0) as u64;
+        (
+            settle,
+            Point {
+                rate_rad_s: 0.0,
+                window: Window::Boxcar { n, frac: 0.0 },
+            },
+        )
+    }
+}
+
+/// `points` frequencies from `start_hz` to `stop_hz` (both included, ascending), spaced
+/// evenly in frequency, in log frequency, or in `g(f) = sum_k atan((f - f0_k) / b_k)` over the
+/// modes `(f0_k, b_k)` (resonance and half-bandwidth): the phase of each resonance moves by
+/// the same step between neighbours, so the points crowd where the response changes.
+pub fn sweep_grid(
+    start_hz: f64,
+    stop_hz: f64,
+    points: usize,
+    spacing: Spacing,
+    modes: &[(f64, f64)],
+) -> Vec<f64> {
+    if points < 2 {
+        return vec![start_hz; points];
+    }
+    let last = (points - 1) as f64;
+    let at = |i: usize, lo: f64, hi: f64| lo + (hi - lo) * (i as f64 / last);
+    let mut f: Vec<f64> = match spacing {
+        Spacing::Linear => (0..points).map(|i| at(i, start_hz, stop_hz)).collect(),
+        Spacing::Log => (0..points)
+            .map(|i| at(i, start_hz.ln(), stop_hz.ln()).exp())
+            .collect(),
+        Spacing::Resonance => {
+            let g = |f: f64| -> f64 { modes.iter().map(|&(f0, b)| ((f - f0) / b).atan()).sum() };
+            let (g0, g1) = (g(start_hz), g(stop_hz));
+            (0..points)
+                .map(|i| {
+                    // g rises monotonically: bisection to the last bit.
+                    let target = at(i, g0, g1);
+                    let (mut lo, mut hi) = (start_hz, stop_hz);
+                    for _ in 0..200 {
+                        let mid = 0.5 * (lo + hi);
+                        if mid <= lo || mid >= hi {
+                            break;
+                        }
+                        if g(mid) < target {
+                            lo = mid;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    0.5 * (lo + hi)
+                })
+                .collect()
+        }
+    };
+    f[0] = start_hz;
+    f[points - 1] = stop_hz;
+    f
 }

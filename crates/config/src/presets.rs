@@ -6,7 +6,7 @@ use crate::error::ConfigError;
 use crate::parse::parse_config;
 
 /// (name, what it reproduces, TOML text).
-pub const PRESETS: [(&str, &str, &str); 7] = [
+pub const PRESETS: [(&str, &str, &str); 9] = [
     (
         "m2tfg-coriolis",
         "Fig. 8: Coriolis run on an M^2-TFG-like gyroscope (default)",
@@ -36,6 +36,16 @@ pub const PRESETS: [(&str, &str, &str); 7] = [
         "m2tfg-selfcal",
         "`gyroemu selfcal` example: imperfect, noisy device, Allan deviation, drift",
         include_str!("../presets/m2tfg-selfcal.toml"),
+    ),
+    (
+        "m2tfg-pll",
+        "Carrier PLL: a drive started 10 Hz off the resonance, locked before the sweep",
+        include_str!("../presets/m2tfg-pll.toml"),
+    ),
+    (
+        "m2tfg-sweep",
+        "`gyroemu sweep` example: stepped-sine response, 0.5 Hz mode split, Q mismatch, quadrature coupling",
+        include_str!("../presets/m2tfg-sweep.toml"),
     ),
     (
         "m2tfg-montecarlo",

@@ -3,7 +3,7 @@
 //! `parse_config` fills them in, so a config is always complete once parsed; `gyroemu config
 //! --resolved FILE` prints the result with the rule behind each derived value.
 
-use crate::config::{Config, DumpConfig};
+use crate::config::{Config, DumpConfig, SweepConfig};
 use gyroemu_board::{Shape, DUMP_NODES};
 
 /// Samples per carrier period of the default sample rate (the DAC's hold then moves the
@@ -20,6 +20,16 @@ pub const F0_OVER_MAX_CUTOFF: f64 = 10.0;
 pub const OUTPUT_SAMPLES_PER_CUTOFF: f64 = 20.0;
 /// A default dump holds at most this many full-rate frames (small files).
 pub const DEFAULT_DUMP_FRAMES: f64 = 50_000.0;
+
+/// The default frequency sweep reaches this many half-bandwidths f0/(2Q) beyond each mode's
+/// resonance (the response there is 1/20 of its peak, the phase within 6 degrees of +-90).
+pub const SWEEP_SPAN_HALF_BANDWIDTHS: f64 = 10.0;
+/// The default settling at each swept frequency, in mechanical time constants of the slower
+/// mode (what is left of the start-up transient, e^-16 = 1e-7 of the response, is far below
+/// the fit's resolution), plus the low-pass settling of the rate sweeps.
+pub const SWEEP_SETTLE_TAUS: f64 = 16.0;
+/// The default averaging at each swept frequency, in mechanical time constants.
+pub const SWEEP_AVERAGE_TAUS: f64 = 2.0;
 
 /// A key the config left out, filled with a derived value.
 #[derive(Clone, Debug, PartialEq)]
@@ -151,6 +161,43 @@ impl Config {
         })
     }
 
+    /// Each mode's resonance and half-bandwidth f0/(2Q), Hz, as configured (uncoupled).
+    pub fn mode_resonances_hz(&self) -> [(f64, f64); 2] {
+        let d = &self.device;
+        let q2 = d.q_mode2.unwrap_or(d.q);
+        let f2 = self.f0_mode2_hz();
+        [(d.f0_hz, d.f0_hz / (2.0 * d.q)), (f2, f2 / (2.0 * q2))]
+    }
+
+    /// The longer mechanical time constant Q/(pi f0) of the two modes, s.
+    pub fn slowest_tau_s(&self) -> f64 {
+        let d = &self.device;
+        let q2 = d.q_mode2.unwrap_or(d.q);
+        gyroemu_theory::mechanical_tau_s(d.f0_hz, d.q)
+            .max(gyroemu_theory::mechanical_tau_s(self.f0_mode2_hz(), q2))
+    }
+
+    /// The `[sweep]` section with every key filled in (the section's defaults when it is
+    /// absent): `start_hz`/`stop_hz` 10 half-bandwidths beyond the lower/upper resonance,
+    /// `settle_s` 16 mechanical time constants of the slower mode plus 40 low-pass time
+    /// constants, `average_s` 2 mechanical time constants.
+    pub fn sweep_resolved(&self) -> SweepConfig {
+        let given = self.sweep.clone().unwrap_or_default();
+        let [(f1, b1), (f2, b2)] = self.mode_resonances_hz();
+        let n = SWEEP_SPAN_HALF_BANDWIDTHS;
+        let tau = self.slowest_tau_s();
+        SweepConfig {
+            start_hz: Some(given.start_hz.unwrap_or((f1 - n * b1).min(f2 - n * b2))),
+            stop_hz: Some(given.stop_hz.unwrap_or((f1 + n * b1).max(f2 + n * b2))),
+            settle_s: Some(given.settle_s.unwrap_or_else(|| {
+                SWEEP_SETTLE_TAUS * tau
+                    + 40.0 / (2.0 * core::f64::consts::PI * self.lpf_cutoff_hz())
+            })),
+            average_s: Some(given.average_s.unwrap_or(SWEEP_AVERAGE_TAUS * tau)),
+            ..given
+        }
+    }
+
     /// Fills every key left out with its derived value (idempotent) and says what it derived.
     pub fn resolve(&mut self) -> Vec<Derived> {
         let mut out = Vec::new();
@@ -208,6 +255,35 @@ impl Config {
                 ),
             });
         }
+        if let Some(pll) = self.pll.clone() {
+            if pll.natural_hz.is_none() {
+                let f = self.pll_natural_hz().unwrap_or(f64::NAN);
+                let (lo, hi) = pll_bounds_hz(self, pll.damping, pll.mode);
+                if let Some(p) = self.pll.as_mut() {
+                    p.natural_hz = Some(f);
+                }
+                out.push(Derived {
+                    key: "pll.natural_hz",
+                    value: fmt(f),
+                    rule: format!(
+                        "geometric mean of the slowest loop a PI on the frequency can make ({}) and the fastest the low-pass allows ({})",
+                        fmt(lo),
+                        fmt(hi)
+                    ),
+                });
+            }
+            if pll.lock_s.is_none() {
+                let t = self.pll_lock_s().unwrap_or(f64::NAN);
+                if let Some(p) = self.pll.as_mut() {
+                    p.lock_s = Some(t);
+                }
+                out.push(Derived {
+                    key: "pll.lock_s",
+                    value: fmt(t),
+                    rule: "16 mechanical time constants plus 10 loop time constants 1/(damping x 2 pi natural_hz)".into(),
+                });
+            }
+        }
         if let (Some(given), Some(full)) = (self.dump.clone(), self.dump_resolved()) {
             let pairs = [
                 ("dump.rate_dps", given.rate_dps.is_none(), "the largest listed rate"),
@@ -236,6 +312,45 @@ impl Config {
             }
             self.dump = Some(full);
         }
+        if let Some(given) = self.sweep.clone() {
+            let full = self.sweep_resolved();
+            let rules = [
+                (
+                    "sweep.start_hz",
+                    given.start_hz.is_none(),
+                    full.start_hz,
+                    format!("{SWEEP_SPAN_HALF_BANDWIDTHS} half-bandwidths f0/(2Q) below the lower resonance"),
+                ),
+                (
+                    "sweep.stop_hz",
+                    given.stop_hz.is_none(),
+                    full.stop_hz,
+                    format!("{SWEEP_SPAN_HALF_BANDWIDTHS} half-bandwidths f0/(2Q) above the upper resonance"),
+                ),
+                (
+                    "sweep.settle_s",
+                    given.settle_s.is_none(),
+                    full.settle_s,
+                    format!("{SWEEP_SETTLE_TAUS} mechanical time constants Q/(pi f0) of the slower mode plus 40 low-pass time constants"),
+                ),
+                (
+                    "sweep.average_s",
+                    given.average_s.is_none(),
+                    full.average_s,
+                    format!("{SWEEP_AVERAGE_TAUS} mechanical time constants Q/(pi f0) of the slower mode"),
+                ),
+            ];
+            for (key, derived, value, rule) in rules {
+                if derived {
+                    out.push(Derived {
+                        key,
+                        value: fmt(value.unwrap_or(f64::NAN)),
+                        rule,
+                    });
+                }
+            }
+            self.sweep = Some(full);
+        }
         out
     }
 }
@@ -243,4 +358,51 @@ impl Config {
 /// A number as TOML writes it.
 fn fmt(x: f64) -> String {
     toml::Value::Float(x).to_string()
+}
+
+/// The loop bounds of the carrier PLL a config allows, Hz: `(lowest, highest)` natural
+/// frequency. A PI on the frequency cannot make a loop slower than the envelope damps it
+/// (2 zeta w_n tau >= 1, tau = Q/(pi f0) of the locked mode), and the loop must stay within a
+/// tenth of the update rate and lag the demodulation low-pass's group delay d by at most
+/// `w_n d = 0.05` rad (`gyroemu_pll::MAX_NATURAL_PER_UPDATE`, `MAX_LOWPASS_LAG_RAD`).
+pub fn pll_bounds_hz(cfg: &Config, damping: f64, mode: usize) -> (f64, f64) {
+    let (f0, q) = if mode == 2 {
+        (
+            cfg.f0_mode2_hz(),
+            cfg.device.q_mode2.unwrap_or(cfg.device.q),
+        )
+    } else {
+        (cfg.device.f0_hz, cfg.device.q)
+    };
+    let tau = q / (core::f64::consts::PI * f0);
+    let lowest = 1.0 / (2.0 * damping * tau * core::f64::consts::TAU);
+    let delay_s = gyroemu_lpf::LowPass::<f64>::new(cfg.lowpass_design(), cfg.fs_hz())
+        .map(|lp| gyroemu_core::Stage::latency_samples(&lp) / cfg.fs_hz())
+        .unwrap_or(f64::NAN);
+    let highest = (0.1 * cfg.fs_out_hz()).min(0.05 / (core::f64::consts::TAU * delay_s));
+    (lowest, highest)
+}
+
+impl Config {
+    /// The carrier PLL's natural frequency, Hz (set, or the geometric mean of the bounds of
+    /// [`pll_bounds_hz`]); `None` without a `[pll]` section.
+    pub fn pll_natural_hz(&self) -> Option<f64> {
+        let p = self.pll.as_ref()?;
+        Some(p.natural_hz.unwrap_or_else(|| {
+            let (lo, hi) = pll_bounds_hz(self, p.damping, p.mode);
+            (lo * hi).sqrt()
+        }))
+    }
+
+    /// The lock run's length, s (set, or 16 mechanical time constants of the locked mode plus
+    /// 10 loop time constants 1/(zeta w_n)); `None` without a `[pll]` section.
+    pub fn pll_lock_s(&self) -> Option<f64> {
+        let p = self.pll.as_ref()?;
+        let natural = self.pll_natural_hz()?;
+        Some(p.lock_s.unwrap_or_else(|| {
+            let q = self.device.q.max(self.device.q_mode2.unwrap_or(0.0));
+            16.0 * q / (core::f64::consts::PI * self.device.f0_hz)
+                + 10.0 / (p.damping * core::f64::consts::TAU * natural)
+        }))
+    }
 }

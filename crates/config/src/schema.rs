@@ -156,6 +156,28 @@ pub(crate) const SECTIONS: &[Section] = &[
         ],
     },
     Section {
+        name: "sweep",
+        required: false,
+        fields: &[
+            opt("start_hz", Number),
+            opt("stop_hz", Number),
+            opt("points", COUNT),
+            opt("spacing", Choice(&["resonance", "linear", "log"])),
+            opt("settle_s", Number),
+            opt("average_s", Number),
+        ],
+    },
+    Section {
+        name: "pll",
+        required: false,
+        fields: &[
+            opt("natural_hz", Number),
+            opt("damping", Number),
+            opt("lock_s", Number),
+            opt("mode", COUNT),
+        ],
+    },
+    Section {
         name: "montecarlo",
         required: false,
         fields: &[

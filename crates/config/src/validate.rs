@@ -18,9 +18,19 @@ fn same(a: f64, b: f64) -> bool {
 }
 
 impl Config {
-    /// Checks every rule that does not need the stages built; returns the warnings, or every
-    /// broken rule in one error.
+    /// Checks every rule that does not need the stages built (the `[sweep]` rules when the
+    /// section is present); returns the warnings, or every broken rule in one error.
     pub fn validate(&self) -> Result<Vec<String>, ConfigError> {
+        self.validate_with(self.sweep.is_some())
+    }
+
+    /// [`Config::validate`] plus the rules of the `[sweep]` that `gyroemu sweep` runs, its
+    /// defaults included when the section is absent.
+    pub fn validate_sweep(&self) -> Result<Vec<String>, ConfigError> {
+        self.validate_with(true)
+    }
+
+    fn validate_with(&self, sweep: bool) -> Result<Vec<String>, ConfigError> {
         let mut p = Rules::default();
         let mut warnings = Vec::new();
         self.link_derived(&mut p);
@@ -37,6 +47,9 @@ impl Config {
             self.validate_regime(&mut p, &mut warnings);
         }
         self.validate_dump(&mut p);
+        if sweep {
+            self.validate_sweep_rules(&mut p, &mut warnings);
+        }
         p.finish().map(|()| warnings)
     }
 

@@ -7,8 +7,8 @@
 use crate::config::{Config, Distribution, MonteCarloConfig};
 use crate::rules::Rules;
 
-/// The widest `truncate_sigma` accepted: Box-Muller draws from 53-bit uniforms never exceed
-/// sqrt(-2 ln 2^-53) = 8.57 standard deviations, so 8 is already all but untruncated.
+/// The widest `truncate_sigma` accepted: a normal exceeds 8 standard deviations with
+/// probability 1.2e-15, so 8 is all but untruncated.
 pub const MAX_TRUNCATE_SIGMA: f64 = 8.0;
 
 impl MonteCarloConfig {

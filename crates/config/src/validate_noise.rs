@@ -41,6 +41,9 @@ impl Config {
                 );
             }
         }
+        if let Some(pll) = &self.pll {
+            self.validate_pll(pll, p);
+        }
         if let Some(s) = &self.selfcal {
             // The record lengths are bounded by the sample rates.
             let rates_ok = p.clean(&["board.fs_hz", "board.decimation"]);
@@ -97,6 +100,53 @@ impl Config {
                     "the temperature coefficients must keep Q and f0 > 0 at this offset",
                 );
             }
+        }
+    }
+}
+
+impl Config {
+    /// The `[pll]` rules: a damping > 0, mode 1 or 2, a natural frequency inside the bounds
+    /// the loop can be built in, a lock run long enough to settle.
+    fn validate_pll(&self, pll: &crate::config::PllConfig, p: &mut Rules) {
+        p.check(
+            pll.mode == 1 || pll.mode == 2,
+            "pll.mode",
+            pll.mode,
+            "must be 1 or 2 (the mode whose output the PLL locks on)",
+        );
+        if !p.positive("pll.damping", pll.damping)
+            || !p.clean(&["pll.mode"])
+            || !p.section_clean("device")
+            || !p.section_clean("board")
+        {
+            return;
+        }
+        let (lo, hi) = crate::resolve::pll_bounds_hz(self, pll.damping, pll.mode);
+        let natural = self.pll_natural_hz().unwrap_or(f64::NAN);
+        let fits = p.check(
+            lo < hi,
+            "pll.natural_hz",
+            natural,
+            format!(
+                "no loop fits: a PI on the frequency needs at least {lo:.4} Hz (2 damping w_n tau >= 1) but the low-pass's group delay and the update rate allow at most {hi:.4} Hz; raise board.lpf_cutoff_hz or pll.damping"
+            ),
+        );
+        if fits {
+            p.check(
+            natural.is_finite() && natural >= lo && natural <= hi,
+            "pll.natural_hz",
+            natural,
+            format!("must be within {lo:.4} .. {hi:.4} Hz (2 damping w_n tau >= 1, and at most a tenth of the update rate and 0.05 rad of low-pass lag)"),
+        );
+        }
+        if let Some(t) = self.pll_lock_s() {
+            let min = 5.0 / (pll.damping * core::f64::consts::TAU * natural);
+            p.check(
+                t.is_finite() && t >= min,
+                "pll.lock_s",
+                t,
+                format!("must cover at least 5 loop time constants 1/(damping 2 pi natural_hz) = {min:.4} s"),
+            );
         }
     }
 }

@@ -11,6 +11,7 @@ const C: &str = "m2tfg-coriolis";
 const R: &str = "m2tfg-rotating";
 const T: &str = "m2tfg-ratetable";
 const M: &str = "m2tfg-montecarlo";
+const S: &str = "m2tfg-sweep";
 
 /// How the edited config must fail.
 #[derive(Debug)]
@@ -188,6 +189,7 @@ fn cases() -> Vec<Case> {
     );
     let dumped = with(c.clone(), DUMP);
     let m = base(M);
+    let sw = base(S);
     vec![
         // Unknown or misspelt keys, in every section.
         parse_case(
@@ -1025,6 +1027,82 @@ fn cases() -> Vec<Case> {
                 "mode-2 resonance > 0",
             ],
         ),
+        // Frequency-sweep keys (the sweep preset has a [sweep] section, so every command
+        // judges it).
+        parse_case(
+            "misspelt sweep key",
+            set(&sw, "sweep", "point", "61"),
+            &["sweep.point", "unknown key", "did you mean `points`?"],
+        ),
+        parse_case(
+            "unknown sweep spacing",
+            set(&sw, "sweep", "spacing", "\"cubic\""),
+            &[
+                "sweep.spacing",
+                "= \"cubic\"",
+                "expected one of \"resonance\", \"linear\", \"log\"",
+            ],
+        ),
+        invalid(
+            "too few sweep points",
+            set(&sw, "sweep", "points", "3"),
+            &["sweep.points", "= 3", "from 5"],
+        ),
+        invalid(
+            "sweep stop below its start",
+            set(&sw, "sweep", "stop_hz", "14990.0"),
+            &["sweep.stop_hz", "14990", "above sweep.start_hz"],
+        ),
+        invalid(
+            "sweep start below the low-pass cutoff",
+            set(&sw, "sweep", "start_hz", "100.0"),
+            &["sweep.start_hz", "= 100", "board.lpf_cutoff_hz = 200 Hz"],
+        ),
+        invalid(
+            "sweep stop above Nyquist",
+            set(&sw, "sweep", "stop_hz", "130000.0"),
+            &["sweep.stop_hz", "130000", "Nyquist"],
+        ),
+        invalid(
+            "sweep settling negative",
+            set(&sw, "sweep", "settle_s", "-1.0"),
+            &["sweep.settle_s", "-1", ">= 0"],
+        ),
+        invalid(
+            "sweep averaging zero",
+            set(&sw, "sweep", "average_s", "0.0"),
+            &["sweep.average_s", "= 0", "> 0"],
+        ),
+        case(
+            "short sweep settling warns",
+            set(&sw, "sweep", "settle_s", "1.0").0,
+            Warning,
+            &["sweep.settle_s", "10.6 mechanical time constants"],
+        ),
+        case(
+            "a sweep span missing a resonance warns",
+            set(
+                &set(&sw, "sweep", "start_hz", "15000.4").0,
+                "sweep",
+                "stop_hz",
+                "15002.0",
+            )
+            .0,
+            Warning,
+            &["mode 1's resonance", "outside"],
+        ),
+        case(
+            "a sparse sweep warns",
+            set(
+                &set(&sw, "sweep", "points", "5").0,
+                "sweep",
+                "spacing",
+                "\"linear\"",
+            )
+            .0,
+            Warning,
+            &["within a half-bandwidth", "raise sweep.points"],
+        ),
         // Dumps.
         invalid(
             "dump longer than the run",
@@ -1203,7 +1281,7 @@ fn validation_errors_have_the_key_value_rule_form() {
 
 #[test]
 fn the_unedited_presets_and_the_edit_helpers_are_sound() {
-    for name in [C, R, T] {
+    for name in [C, R, T, S] {
         let c = parse_config(&base(name)).unwrap();
         assert!(c.validate().is_ok(), "{name}");
         // Setting a key to its own value changes nothing.

@@ -85,6 +85,7 @@ fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
     let w0 = std::f64::consts::TAU * f0;
     c.device.quadrature_coupling_rad2_s2 = k12 * w0 * w0;
     c.drive.f1 = f1;
+    c.drive.carrier_hz = Some(f0); // the drawn f0 (the preset resolved its own)
     c.drive.f2 = Some(f2);
 
     let (fs_mult, dec, cut, order, pole, gain, inverting, dac, adc, shift) = b;

@@ -7,6 +7,10 @@ pub mod check;
 pub mod detmath;
 pub mod error;
 pub mod flicker;
+pub mod gauss;
+#[cfg(target_arch = "x86_64")]
+mod gauss_avx512;
+mod gauss_tables;
 pub mod noise;
 pub mod sample;
 pub mod stage;

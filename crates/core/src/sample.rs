@@ -138,16 +138,14 @@ impl Sample for f64x4 {
     #[inline(always)]
     fn round_away(self) -> Self {
         // f64x4::round rounds half to even; match f64::round (half away from zero) without a
-        // libm call per lane, on the magnitude: with t = trunc(|x|) and d = |x| - t (exact,
-        // d < 1), trunc(2 d) is 1 exactly when d >= 1/2; then x's sign bit goes back on (so
-        // -0.3 gives -0.0 as f64::round does). From 2^52 up every f64 is an integer (and inf
-        // stays inf), so those pass through.
-        let a = self.abs();
-        let t = a.trunc();
-        let mag = t + ((a - t) * f64x4::splat(2.0)).trunc();
-        let r = mag | (self & f64x4::splat(-0.0));
-        a.simd_ge(f64x4::splat(4_503_599_627_370_496.0))
-            .bitselect(self, r)
+        // libm call per lane: trunc(x + copysign(1/2 - 2^-54, x)). The addend just below 1/2
+        // makes the sum reach the next integer exactly when |x| has a fraction of 1/2 or more
+        // (a sum that lands within half an ulp of it rounds there), never below (so
+        // 0.49999999999999994 stays 0). From 2^52 up every f64 is an integer and the addend is
+        // below half an ulp, so those pass through, as do inf and NaN; the sign survives (-0.3
+        // gives -0.0 as f64::round does). LLVM lowers f64::round itself this way.
+        let half = f64x4::splat(0.499_999_999_999_999_94) | (self & f64x4::splat(-0.0));
+        (self + half).trunc()
     }
     #[inline(always)]
     fn all_finite(self) -> bool {

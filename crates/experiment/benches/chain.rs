@@ -8,7 +8,7 @@ use divan::counter::ItemsCount;
 use divan::{black_box, Bencher};
 use gyroemu_board::{Board, Point, RunOptions};
 use gyroemu_config::presets::preset;
-use gyroemu_config::{Config, NoiseConfig};
+use gyroemu_config::Config;
 use gyroemu_core::f64x4;
 use gyroemu_lpf::Window;
 
@@ -21,21 +21,12 @@ fn main() {
 }
 
 fn rotating(noise: bool) -> Config {
-    let mut c = preset("m2tfg-rotating").expect("embedded preset");
+    let c = preset("m2tfg-rotating").expect("embedded preset");
     if noise {
-        c.noise = Some(NoiseConfig {
-            seed: 1,
-            temperature_k: 300.0,
-            effective_mass_kg: Some(1e-9),
-            tia_current_noise_a_per_rthz: 5e-14,
-            tia_voltage_noise_v_per_rthz: 2e-8,
-        });
-        c.board.dac_bits = Some(16);
-        c.board.dac_full_scale = 1.5;
-        c.board.adc_bits = Some(16);
-        c.board.adc_full_scale_v = 0.05;
+        gyroemu_experiment::bench::with_noise(&c)
+    } else {
+        c
     }
-    c
 }
 
 /// Runs `groups` lane groups of N_IN samples each, one per rayon worker.

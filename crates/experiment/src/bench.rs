@@ -43,6 +43,25 @@ fn lane_rates(cfg: &Config) -> Vec<f64> {
         .collect()
 }
 
+/// `cfg` with every noise source on (seed 1, 300 K, a 1e-9 kg modal mass, a TIA of 5e-14
+/// A/sqrt(Hz) and 2e-8 V/sqrt(Hz)) and a 16-bit DAC and ADC: the chain a self-calibration
+/// study with noise runs, measured beside the noiseless one.
+pub fn with_noise(cfg: &Config) -> Config {
+    let mut c = cfg.clone();
+    c.noise = Some(gyroemu_config::NoiseConfig {
+        seed: 1,
+        temperature_k: 300.0,
+        effective_mass_kg: Some(1e-9),
+        tia_current_noise_a_per_rthz: 5e-14,
+        tia_voltage_noise_v_per_rthz: 2e-8,
+    });
+    c.board.dac_bits = Some(16);
+    c.board.dac_full_scale = 1.5;
+    c.board.adc_bits = Some(16);
+    c.board.adc_full_scale_v = 0.05;
+    c
+}
+
 /// Runs `groups` lane groups of `n_in` input samples each, spread over the rayon pool;
 /// returns point-samples per second.
 pub fn chain(cfg: &Config, n_in: u64, groups: usize) -> f64 {
@@ -116,7 +135,8 @@ impl Stage for DecoupledPlant {
     }
 }
 
-/// Every figure, each the best and the median of `repeats` runs: the chain, then each stage,
+/// Every figure, each the best and the median of `repeats` runs: the chain, noiseless and
+/// with noise, then each stage,
 /// on 1 thread and on all threads.
 pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     use gyroemu_am::{AmInput, AmModulator, DrivePattern};
@@ -139,6 +159,13 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     push_n("whole chain", 1, &mut || chain(cfg, n_in, 1));
     if threads > 1 {
         push_n("whole chain", threads, &mut || chain(cfg, n_in, threads));
+    }
+    let noisy = with_noise(cfg);
+    push_n("whole chain with noise", 1, &mut || chain(&noisy, n_in, 1));
+    if threads > 1 {
+        push_n("whole chain with noise", threads, &mut || {
+            chain(&noisy, n_in, threads)
+        });
     }
     let x = |i: u64| f64x4::splat((i & 1023) as f64 * 1e-3);
     let fs = cfg.fs_hz();

@@ -6,12 +6,14 @@
 pub mod bench;
 pub mod dump;
 pub mod fit;
+pub mod lock;
 pub mod progress;
 pub mod readout;
 pub mod sweep;
 pub mod work;
 
 pub use dump::{dump_extra, DumpPlan};
+pub use lock::{lock_config_carrier, pll_params, resolve_lock, CarrierLock};
 pub use progress::{Progress, Quiet, Reporter, Task, Written};
 pub use readout::{post_process, theory_deg, Compensation, PointResult, SweepResult};
 pub use sweep::{

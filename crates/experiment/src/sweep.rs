@@ -33,6 +33,9 @@ pub enum SweepError {
     /// Points without a result (indices in `emulated_rates_dps`).
     #[error("the sweep is missing the results of points {0:?}")]
     Missing(Vec<usize>),
+    /// The carrier PLL did not lock (the sweep would run at a carrier still moving).
+    #[error("{0}")]
+    NotLocked(String),
 }
 
 /// The file stem of a sweep's signal dump in its output folder (see [`Probe::write`]).
@@ -145,8 +148,10 @@ pub fn add_group_progress(
 }
 
 /// Runs the points of a sweep that `opts` assigns and that are not done yet, four per lane
-/// group in index order, groups in parallel. Each point draws the noise stream of its index,
-/// and lanes do not interact, so any subset or grouping gives every point the same bits.
+/// group, groups in parallel. A group runs as long as its longest window, so the points are
+/// packed by window length (longest first, index order among equals) and a short window does
+/// not idle a lane beside a long one. Each point draws the noise stream of its index, and
+/// lanes do not interact, so any subset or grouping gives every point the same bits.
 pub fn run_sweep_with(
     cfg: &Config,
     progress: Progress,
@@ -167,6 +172,8 @@ pub fn run_sweep_with(
     .filter(|i| !opts.done.contains_key(i))
     .collect();
     let plan = |i: usize| cfg.plan_point(rates[i]);
+    let mut todo = todo;
+    todo.sort_by_key(|&i| core::cmp::Reverse(plan(i).window.samples()));
     let n_settle = cfg.n_settle_out();
     let groups: Vec<&[usize]> = todo.chunks(MAX_LANES).collect();
     let samples_of =

@@ -5,7 +5,9 @@ use crate::dump_figures::write_dump_figures;
 use crate::dump_set::read_dump_set;
 use crate::error::{check_problems, create_dir, ReportError};
 use crate::sweep_report::{sweep_figure, theory_series, write_run};
-use gyroemu_analysis::bandwidth::{bandwidth, BANDWIDTH_AMPLITUDE_DPS, BANDWIDTH_FREQS_HZ};
+use gyroemu_analysis::bandwidth::{
+    bandwidth, BandwidthPoint, BANDWIDTH_AMPLITUDE_DPS, BANDWIDTH_FREQS_HZ,
+};
 use gyroemu_config::presets::preset;
 use gyroemu_config::{Config, DumpConfig};
 use gyroemu_experiment::{
@@ -17,6 +19,7 @@ use gyroemu_theory::rate_table_gain;
 use rayon::prelude::*;
 use serde_json::json;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Averaging of Fig. 9 with `--quick`, s (the paper: 500 s).
 const QUICK_AVERAGE_S: f64 = 15.0;
@@ -123,51 +126,98 @@ pub fn plan_reproduce(quick: bool) -> Result<ReproducePlan, ReportError> {
 
 /// Runs every figure's experiment of `plan` and writes the figures and summaries into `out`
 /// (which must exist); returns the files written.
+///
+/// Every experiment's lane groups and the bandwidth sweep run in one parallel pool (one
+/// experiment alone often has fewer lane groups than the machine has cores), reported as one
+/// task; then each experiment's files and every figure are written in parallel. The files and
+/// their order are those of a sequential run.
 pub fn reproduce(
     plan: &ReproducePlan,
     out: &Path,
     reporter: &dyn Reporter,
 ) -> Result<Vec<PathBuf>, ReportError> {
     let (jobs, quick) = (&plan.jobs, plan.quick);
-    let mut files = Vec::new();
-    let mut results = Vec::new();
-    // Where each experiment's dump figures go in the list, and its folder.
-    let mut dump_dirs = Vec::new();
     for job in jobs {
-        let progress = reporter.task(job.preset);
-        let dir = out.join(job.preset);
-        create_dir(&dir)?;
-        // The dump only records: the results are those of a run without it.
-        let opts = SweepOptions {
-            dump: Some(reproduce_dump(&job.cfg)),
-            ..Default::default()
-        };
-        let run = run_sweep_with(&job.cfg, &|d, t| progress.update(d, t), Some(&dir), opts)?;
-        let r = finish_sweep(&job.cfg, &run.lanes)?;
-        progress.finish_writing(Some(r.point_samples), run.written());
-        files.extend(write_run(&dir, &job.cfg, &r, job.title)?);
-        files.extend(run.dump_files.iter().cloned());
-        dump_dirs.push((files.len(), dir));
+        create_dir(&out.join(job.preset))?;
+    }
+    let task = reporter.task("reproduce");
+    // Each experiment's (done, total) input samples; the task sees their sums.
+    let slots: Vec<[AtomicU64; 2]> = jobs.iter().map(|_| Default::default()).collect();
+    let report = |i: usize, d: u64, t: u64| {
+        slots[i][0].store(d, Ordering::Relaxed);
+        slots[i][1].store(t, Ordering::Relaxed);
+        let sum = |k: usize| slots.iter().map(|s| s[k].load(Ordering::Relaxed)).sum();
+        task.update(sum(0), sum(1));
+    };
+    let rt_cfg = &jobs[job_index(jobs, "m2tfg-ratetable")].cfg;
+    let (swept, bandwidth_runs) = rayon::join(
+        || {
+            jobs.par_iter()
+                .enumerate()
+                .map(|(i, job)| {
+                    // The dump only records: the results are those of a run without it.
+                    let opts = SweepOptions {
+                        dump: Some(reproduce_dump(&job.cfg)),
+                        ..Default::default()
+                    };
+                    let dir = out.join(job.preset);
+                    let progress = |d: u64, t: u64| report(i, d, t);
+                    let run = run_sweep_with(&job.cfg, &progress, Some(&dir), opts)?;
+                    let r = finish_sweep(&job.cfg, &run.lanes)?;
+                    Ok((run, r))
+                })
+                .collect::<Vec<Result<_, ReportError>>>()
+        },
+        || bandwidth(rt_cfg),
+    );
+    let mut runs = Vec::with_capacity(jobs.len());
+    for s in swept {
+        runs.push(s?);
+    }
+    let bandwidth_runs = bandwidth_runs?;
+    let point_samples: u64 = runs.iter().map(|(_, r)| r.point_samples).sum();
+    let written = runs.iter().map(|(run, _)| run.written()).fold(
+        Default::default(),
+        |a: gyroemu_experiment::Written, w| gyroemu_experiment::Written {
+            files: a.files + w.files,
+            bytes: a.bytes + w.bytes,
+            seconds: a.seconds + w.seconds,
+        },
+    );
+    task.finish_writing(Some(point_samples), written);
+    for (job, (_, r)) in jobs.iter().zip(&runs) {
         for w in &r.warnings {
             reporter.warn(&format!("{}: {w}", job.preset));
         }
         check_problems(job.preset, &r.problems)?;
-        results.push(r);
     }
-    // The dumps' figures, read back from the files, drawn in parallel once every sweep is
-    // done (so they do not compete with the emulation for the cores).
-    let figures: Vec<Result<Vec<PathBuf>, ReportError>> = dump_dirs
+    // Each experiment's results and plot, and its dump's figures (read back from the
+    // files), in parallel.
+    let per_job: Vec<Result<Vec<PathBuf>, ReportError>> = jobs
         .par_iter()
-        .map(|(_, dir)| write_dump_figures(&read_dump_set(&dir.join("dump"))?, dir))
+        .zip(runs.par_iter())
+        .map(|(job, (run, r))| {
+            let dir = out.join(job.preset);
+            let mut files = write_run(&dir, &job.cfg, r, job.title)?;
+            files.extend(run.dump_files.iter().cloned());
+            files.extend(write_dump_figures(
+                &read_dump_set(&dir.join("dump"))?,
+                &dir,
+            )?);
+            Ok(files)
+        })
         .collect();
-    for ((at, _), figs) in dump_dirs.iter().zip(figures).rev() {
-        let figs = figs?;
-        files.splice(at..at, figs);
+    let mut files = Vec::new();
+    for f in per_job {
+        files.extend(f?);
     }
+    let results: Vec<SweepResult> = runs.into_iter().map(|(_, r)| r).collect();
     let get = |name: &str| {
-        let i = jobs.iter().position(|j| j.preset == name).unwrap_or(0);
+        let i = job_index(jobs, name);
         (&jobs[i].cfg, &results[i], jobs[i].title)
     };
+    // Every figure built, then rendered in parallel.
+    let mut figures: Vec<(String, Figure)> = Vec::new();
     for (fig, name) in [
         ("fig8", "m2tfg-coriolis"),
         ("fig9", "m2tfg-rotating"),
@@ -180,22 +230,29 @@ pub fn reproduce(
         if let Some(paper) = paper_i_series(r) {
             f = f.with(paper);
         }
-        let path = out.join(format!("{fig}.png"));
-        render_png(&f, &path)?;
-        files.push(path);
+        figures.push((format!("{fig}.png"), f));
     }
-    let (rt_cfg, _, _) = get("m2tfg-ratetable");
-    let task = reporter.task("bandwidth");
-    let (figure, csv) = bandwidth_outputs(rt_cfg, out)?;
-    task.finish(None);
-    let path = out.join("fig_bandwidth.png");
-    render_png(&figure, &path)?;
-    files.extend([csv, path]);
+    let (figure, csv) = bandwidth_outputs(rt_cfg, &bandwidth_runs, out)?;
+    figures.push(("fig_bandwidth.png".into(), figure));
     let (cc, cr, _) = get("baw-coriolis");
     let (_, rr, _) = get("baw-rotating");
-    let path = out.join("fig6.png");
-    render_png(&fig6(cc, cr, rr), &path)?;
-    files.push(path);
+    figures.push(("fig6.png".into(), fig6(cc, cr, rr)));
+    let rendered: Vec<Result<PathBuf, ReportError>> = figures
+        .par_iter()
+        .map(|(name, f)| {
+            let path = out.join(name);
+            render_png(f, &path)?;
+            Ok(path)
+        })
+        .collect();
+    for r in rendered {
+        let path = r?;
+        // The bandwidth sweep's table goes before its figure.
+        if path.ends_with("fig_bandwidth.png") {
+            files.push(csv.clone());
+        }
+        files.push(path);
+    }
     let pair = |c: &str, rname: &str| {
         let (cfg, rc, _) = get(c);
         let (_, rrot, _) = get(rname);
@@ -228,12 +285,15 @@ pub fn reproduce(
     Ok(files)
 }
 
-/// The bandwidth sweep of the rate-table preset: writes `m2tfg-ratetable/bandwidth.csv` and
-/// returns its figure (the emulated gains against the first-order low-pass of THEORY.md
+/// The outputs of the rate-table preset's bandwidth sweep: writes `m2tfg-ratetable/bandwidth.csv`
+/// and returns its figure (the emulated gains against the first-order low-pass of THEORY.md
 /// section 3) and the CSV's path.
-fn bandwidth_outputs(base: &Config, out: &Path) -> Result<(Figure, PathBuf), ReportError> {
+fn bandwidth_outputs(
+    base: &Config,
+    runs: &[BandwidthPoint],
+    out: &Path,
+) -> Result<(Figure, PathBuf), ReportError> {
     let d = &base.device;
-    let runs = bandwidth(base)?;
     let rows = runs
         .iter()
         .map(|p| {
@@ -320,6 +380,11 @@ fn paper_i_series(r: &SweepResult) -> Option<Series> {
         xs: r.points.iter().map(|p| p.rate_dps).collect(),
         ys: ys?,
     })
+}
+
+/// The index of a preset's job (every plan has the five).
+fn job_index(jobs: &[Job], name: &str) -> usize {
+    jobs.iter().position(|j| j.preset == name).unwrap_or(0)
 }
 
 /// Fig. 6: the Coriolis phase against the rotation rate, and the rotating-excitation phase

@@ -149,3 +149,43 @@ fn decoupled_step_equals_full_step_and_is_only_offered_without_coupling() {
     let mixed = [plain.clone(), plain.clone(), coupled, plain];
     assert!(!Resonator::<f64x4>::from_lanes(&mixed).decoupled());
 }
+
+/// On a rate table about zero rate with no quadrature coupling, the rate expansion splits by
+/// mode (E0 and E2 within a mode, E1 across, with exact zeros elsewhere), and the split step
+/// (nine products per row) equals the full time-varying step bit for bit, mode mismatch and
+/// Q mismatch included; a coupling, a design rate, or one such lane refuses the shortcut.
+#[test]
+fn rate_split_step_equals_the_full_time_varying_step() {
+    let mut p = lane_params(2).0;
+    p.quadrature_coupling_rad2_s2 = 0.0;
+    let mut full = Resonator::<f64x4>::new(&p, 0.0).unwrap();
+    assert!(full.rate_split_by_mode());
+    full.set_state([1e-6, -2e-7, 3e-4, 1e-5].map(f64x4::splat));
+    let mut split = full.clone();
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    for n in 0..20_000 {
+        let force: [f64x4; 2] =
+            core::array::from_fn(|_| f64x4::from_fn(|_| rng.random_range(-1.0..1.0)));
+        let rate = f64x4::from_fn(|_| rng.random_range(-30.0..30.0));
+        let (a, b) = (
+            full.tick_with_rate(force, rate),
+            split.tick_with_rate_split(force, rate),
+        );
+        for k in 0..2 {
+            let (u, v) = (a.v[k].to_array(), b.v[k].to_array());
+            assert_eq!(u.map(f64::to_bits), v.map(f64::to_bits), "sample {n}");
+            let (u, v) = (a.q[k].to_array(), b.q[k].to_array());
+            assert_eq!(u.map(f64::to_bits), v.map(f64::to_bits), "sample {n}");
+        }
+    }
+    let mut pk = p;
+    pk.quadrature_coupling_rad2_s2 = 1e-3;
+    assert!(!Resonator::<f64>::new(&pk, 0.0)
+        .unwrap()
+        .rate_split_by_mode());
+    assert!(!Resonator::<f64>::new(&p, 0.5).unwrap().rate_split_by_mode());
+    let plain = Resonator::<f64>::new(&p, 0.0).unwrap();
+    let coupled = Resonator::<f64>::new(&pk, 0.0).unwrap();
+    let mixed = [plain.clone(), coupled, plain.clone(), plain];
+    assert!(!Resonator::<f64x4>::from_lanes(&mixed).rate_split_by_mode());
+}

@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 /// `key: old -> new` (`(unset)` on the side that lacks the key).
 pub fn config_diff(old: &str, new: &Config) -> Result<Vec<String>, String> {
     let mut old: toml::Table = toml::from_str(old).map_err(|e| e.to_string())?;
-    for ignored in ["dump", "selfcal", "montecarlo"] {
+    for ignored in ["dump", "selfcal", "sweep", "montecarlo"] {
         old.remove(ignored);
     }
     let new = toml::Table::try_from(result_config(new)).map_err(|e| e.to_string())?;

@@ -9,7 +9,7 @@ use crate::manifest::{read_manifest, shard_manifest_paths, Manifest, RunKind, RU
 use crate::points::{config_hash, scan_points, PointFile};
 use crate::records::{scan_records, RecordFile};
 use gyroemu_config::parse_config;
-use gyroemu_experiment::{finish_sweep, Reporter};
+use gyroemu_experiment::{finish_sweep, resolve_lock, Reporter};
 use gyroemu_report::{check_problems, run_title, write_run};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -328,8 +328,13 @@ fn merge_run(dir: &Path, split: Split, reporter: &dyn Reporter) -> Result<Vec<Pa
     let lanes = scan_points(dir)
         .and_then(|s| s.lanes(&split.hash, n))
         .map_err(bad)?;
-    let r = finish_sweep(&cfg, &lanes)?;
-    let written = write_run(dir, &cfg, &r, &run_title(&cfg)).map_err(RunError::from);
+    // The shards swept at the carrier a [pll] locked: lock again (the same bits) to read out.
+    let (held, lock) = resolve_lock(&cfg)?;
+    if let Some(l) = &lock {
+        reporter.note(&crate::run::lock_note(l));
+    }
+    let r = finish_sweep(&held, &lanes)?;
+    let written = write_run(dir, &held, &r, &run_title(&cfg)).map_err(RunError::from);
     let (mut files, path) = split.finish(dir, n, written)?;
     files.push(path);
     reporter.note(&format!("merged {} shards ({n} points)", split.count));

@@ -27,12 +27,14 @@ pub fn canonical_toml(cfg: &Config) -> String {
 }
 
 /// The part of a config that decides a sweep's results: all but `[dump]` (what is recorded
-/// on the way), `[selfcal]` (what `selfcal` adds) and `[montecarlo]` (what a lot draws), so a
-/// config differing only there reuses the saved points.
+/// on the way), `[selfcal]` (what `selfcal` adds), `[sweep]` (what `sweep` measures) and
+/// `[montecarlo]` (what a lot draws), so a config differing only there reuses the saved
+/// points.
 pub fn result_config(cfg: &Config) -> Config {
     Config {
         dump: None,
         selfcal: None,
+        sweep: None,
         montecarlo: None,
         ..cfg.clone()
     }

@@ -14,7 +14,8 @@ use gyroemu_board::LaneResult;
 use gyroemu_config::Config;
 use gyroemu_experiment::work::measured_throughput;
 use gyroemu_experiment::{
-    dump_point, finish_sweep, run_sweep_with, sweep_work, Reporter, SweepOptions, Work,
+    dump_point, finish_sweep, resolve_lock, run_sweep_with, sweep_work, CarrierLock, Reporter,
+    SweepOptions, Work,
 };
 use gyroemu_report::{check_problems, run_title, write_run};
 use std::path::{Path, PathBuf};
@@ -132,6 +133,12 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         &prev,
     )?;
 
+    // With a [pll], the carrier is locked on the emulated board first and held for the sweep
+    // (deterministic: a resume, a shard and a merge lock to the same bits).
+    let (held, lock) = resolve_lock(cfg).map_err(|e| ledger.fail(e.into(), &prev))?;
+    if let Some(l) = &lock {
+        reporter.note(&lock_note(l));
+    }
     let saved = AtomicUsize::new(0);
     let on_group = |pts: &[(usize, LaneResult)]| -> Result<(), String> {
         for (i, lane) in pts {
@@ -152,7 +159,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         on_group: Some(&on_group),
         dump: None,
     };
-    let swept = match run_sweep_with(cfg, &|d, t| task.update(d, t), Some(out), opts) {
+    let swept = match run_sweep_with(&held, &|d, t| task.update(d, t), Some(out), opts) {
         Ok(s) => s,
         Err(e) => {
             // What finished is saved; the manifest says the rest is missing.
@@ -172,9 +179,9 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         let next = ledger.shard_complete(&swept.lanes, out)?;
         return Ok(RunOutcome::ShardComplete { next });
     }
-    let written = finish_sweep(cfg, &swept.lanes)
+    let written = finish_sweep(&held, &swept.lanes)
         .map_err(RunError::from)
-        .and_then(|r| Ok((write_run(out, cfg, &r, &run_title(cfg))?, r)));
+        .and_then(|r| Ok((write_run(out, &held, &r, &run_title(cfg))?, r)));
     let (mut files, r) = written.map_err(|e| ledger.fail(e, &swept.lanes))?;
     ledger.complete(&swept.lanes)?;
     files.push(ledger.path().to_path_buf());
@@ -184,4 +191,16 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     }
     check_problems(&out.display().to_string(), &r.problems)?;
     Ok(RunOutcome::Complete(files))
+}
+
+/// What a lock did, for the run's log.
+pub fn lock_note(l: &CarrierLock) -> String {
+    format!(
+        "pll: locked the carrier at {} Hz after {} (started at {} Hz; the locked mode resonates at {} Hz as configured); the sweep runs at that carrier",
+        l.carrier_hz,
+        l.lock_time_s
+            .map_or("the lock run".to_string(), |t| format!("{t:.3} s")),
+        l.nominal_hz,
+        l.resonance_hz
+    )
 }

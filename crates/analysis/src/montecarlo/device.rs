@@ -1,12 +1,12 @@
 //! One device of a lot: its draw applied to the nominal config, self-calibrated on the emulated
 //! board (the rotating sweep and the virtual rate table, sample by sample), and what the lot
-//! records of it: a table of named values, each read by a column function, so a new column
-//! (e.g. a combined-mode error) is one line of [`COLUMNS`].
+//! records of it: a table of named values, each read by a column function, so a new column is
+//! one line of [`COLUMNS`].
 
 use super::draw::{device_config, draw_device};
 use crate::selfcal::{sweep_configs, SelfcalCore};
 use gyroemu_config::Config;
-use gyroemu_experiment::{finish_sweep, run_sweep_with, SweepError, SweepOptions};
+use gyroemu_experiment::{finish_sweep, resolve_lock, run_sweep_with, SweepError, SweepOptions};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 
@@ -53,10 +53,21 @@ fn nominal_error(d: &DeviceInputs, k: usize) -> f64 {
     d.nominal_angular_gain * m.rotating.slope_deg_per_dps / m.coriolis.slope_deg_per_dps - 1.0
 }
 
+/// The lambda ratio a half-width of `selfcal` is scaled by: nominal over the device's own.
+fn lambda_ratio(d: &DeviceInputs) -> f64 {
+    (d.nominal_angular_gain / d.config.device.angular_gain).abs()
+}
+
 /// Its 95 % half-width: `selfcal`'s, scaled as the ratio is by the two lambdas.
 fn nominal_ci95(d: &DeviceInputs, k: usize) -> f64 {
-    let ratio = d.nominal_angular_gain / d.config.device.angular_gain;
-    d.core.modes[k].relative_error_ci95 * ratio.abs()
+    d.core.modes[k].relative_error_ci95 * lambda_ratio(d)
+}
+
+/// The two-mode error (geometric means of the two modes' slopes, free of the drive-gain ratio
+/// and the Q mismatch) predicted with the nominal lambda.
+fn nominal_combined(d: &DeviceInputs) -> f64 {
+    let c = &d.core.combined;
+    d.nominal_angular_gain * c.rotating.slope_deg_per_dps / c.coriolis.slope_deg_per_dps - 1.0
 }
 
 use ColumnKind::{Error, Measured, Parameter};
@@ -85,11 +96,18 @@ pub const COLUMNS: &[Column] = &[
     col("relative_error_ci95_mode2", Measured, |d| {
         nominal_ci95(d, 1)
     }),
+    col("combined_relative_error", Error, nominal_combined),
+    col("combined_relative_error_ci95", Measured, |d| {
+        d.core.combined.relative_error_ci95 * lambda_ratio(d)
+    }),
     col("board_relative_error_mode1", Error, |d| {
         d.core.modes[0].relative_error
     }),
     col("board_relative_error_mode2", Error, |d| {
         d.core.modes[1].relative_error
+    }),
+    col("board_combined_relative_error", Error, |d| {
+        d.core.combined.relative_error
     }),
     col("rotating_slope_mode1_deg_per_dps", Measured, |d| {
         d.core.modes[0].rotating.slope_deg_per_dps
@@ -149,9 +167,9 @@ impl DeviceResult {
     }
 }
 
-/// Draws device `index` of the lot of `base` and self-calibrates it: both sweeps of
-/// [`sweep_configs`] on its config, through the same calls as `selfcal` (so a direct `selfcal`
-/// of [`device_config`] gives the same bits). `on_samples` receives each increase of the input
+/// Draws device `index` of the lot of `base` and self-calibrates it: with a `[pll]` the carrier
+/// locked first, then both sweeps of [`sweep_configs`] on its config, through the same calls
+/// as `selfcal` (so a direct `selfcal` of [`device_config`] gives the same bits). `on_samples` receives each increase of the input
 /// samples emulated. `None`: the `cancel` flag stopped it before both sweeps finished.
 pub fn run_device(
     base: &Config,
@@ -164,7 +182,8 @@ pub fn run_device(
             "the config has no [montecarlo] section",
         )));
     };
-    let cfg = device_config(base, &draw_device(mc, index));
+    // With a [pll], both sweeps run at the carrier it locks, as in `selfcal`.
+    let (cfg, _lock) = resolve_lock(&device_config(base, &draw_device(mc, index)))?;
     let (rot_cfg, cor_cfg) = sweep_configs(&cfg);
     let mut runs = Vec::with_capacity(2);
     for c in [&rot_cfg, &cor_cfg] {

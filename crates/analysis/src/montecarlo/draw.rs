@@ -30,10 +30,10 @@ pub struct DeviceDraw {
     pub z: [f64; 6],
 }
 
-/// Draws device `index` of the lot `mc`: four xoshiro256++ streams (one per SIMD lane of
-/// [`NoiseRng`]) seeded from `stream_seed(stream_seed(seed, index), DRAW_STREAM_BASE + lane)`;
-/// tolerance `k` takes lane `k % 4` of Box-Muller pair member `k / 4` (normal) or of uniform
-/// draw `k / 4` (uniform). A normal draw with any score beyond `truncate_sigma` is drawn
+/// Draws device `index` of the lot `mc`: the streams of a [`NoiseRng`] whose four lanes are
+/// seeded from `stream_seed(stream_seed(seed, index), DRAW_STREAM_BASE + lane)`; tolerance `k`
+/// takes lane `k % 4` of the normal pair's member `k / 4` (exact normals, the ziggurat of
+/// `gyroemu_core::gauss`) or of uniform draw `k / 4` (uniform). A normal draw with any score beyond `truncate_sigma` is drawn
 /// again whole, which leaves the scores independent, each a normal truncated to the box.
 pub fn draw_device(mc: &MonteCarloConfig, index: u64) -> DeviceDraw {
     let dev = stream_seed(mc.seed, index);

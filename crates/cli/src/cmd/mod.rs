@@ -9,3 +9,4 @@ pub mod out_args;
 pub mod reproduce;
 pub mod run;
 pub mod selfcal;
+pub mod sweep;

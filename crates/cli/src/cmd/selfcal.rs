@@ -62,6 +62,16 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
         m.relative_error_ci95,
         cfg.experiment.average_s
     );
+    let c = report.core.combined;
+    println!(
+        "self-calibration (both modes, geometric mean): predicted Coriolis {:.9}; rate table measured {:.9}; \
+         relative error {:+.3e} +- {:.2e} (95 %), mode 2 alone {:+.3e}",
+        c.predicted_deg_per_dps,
+        c.coriolis.slope_deg_per_dps,
+        c.relative_error,
+        c.relative_error_ci95,
+        report.core.modes[1].relative_error
+    );
     list_written(out, &files.written);
     let problems: Vec<String> = [&report.core.rotating, &report.core.coriolis]
         .iter()

@@ -1,0 +1,179 @@
+//! `gyroemu sweep` as one call: the stepped-sine measurement (`stepped_sine`), a resonance fit
+//! of each mode's driven response (`resonance_fit`), and what each fit is checked against:
+//! the configured device; the natural frequencies and Q of the coupled plant (the eigenvalues
+//! of its state matrix: quadrature coupling moves the modes apart); and the same fit applied
+//! to the plant's exact held-drive steady state at the same frequencies, which is what a
+//! perfect emulation of this board measures (hold images and coupling included). Beside the
+//! one-mode fits, the whole 2 x 2 response identifies the plant's matrices (`matrix_fit`):
+//! each mode's own f0 and Q and the quadrature coupling, comparable with `[device]` as set.
+
+use crate::matrix_fit::{fit_matrix, MatrixFit};
+use crate::resonance_fit::{fit_resonance, ResonanceFit};
+use crate::stepped_sine::{run_stepped_sine, SteppedSine};
+use gyroemu_config::Config;
+use gyroemu_core::Complex64;
+use gyroemu_experiment::{Reporter, SweepError};
+use gyroemu_resonator::{hold_response, Resonator, ResonatorParams};
+use nalgebra::Matrix4;
+use serde::Serialize;
+
+/// One mode's fit and what it is checked against.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ModeCheck {
+    /// 1 or 2.
+    pub mode: usize,
+    /// The fit of the measured driven response (`None`: no resonance found).
+    pub fit: Option<ResonanceFit>,
+    /// The configured resonance, Hz.
+    pub configured_f0_hz: f64,
+    /// The configured Q.
+    pub configured_q: f64,
+    /// The coupled plant's natural frequency of this mode, Hz (its state matrix's eigenvalue
+    /// s: |s| / 2 pi; the configured one without quadrature coupling).
+    pub coupled_f0_hz: f64,
+    /// The coupled plant's Q of this mode, |s| / (2 Re(-s)).
+    pub coupled_q: f64,
+    /// The fit of the exact held-drive steady state at the swept frequencies: what the
+    /// measurement gives when the emulation is exact.
+    pub expected: Option<ResonanceFit>,
+}
+
+impl ModeCheck {
+    /// Fitted f0 minus the configured one, Hz (NaN without a fit).
+    pub fn f0_error_hz(&self) -> f64 {
+        self.fit
+            .map_or(f64::NAN, |f| f.f0_hz - self.configured_f0_hz)
+    }
+
+    /// Fitted Q over the configured one, minus 1 (NaN without a fit).
+    pub fn q_rel_error(&self) -> f64 {
+        self.fit.map_or(f64::NAN, |f| f.q / self.configured_q - 1.0)
+    }
+
+    /// The configured half-bandwidth f0/(2Q), Hz.
+    pub fn configured_half_bandwidth_hz(&self) -> f64 {
+        self.configured_f0_hz / (2.0 * self.configured_q)
+    }
+}
+
+/// The whole frequency response: the measurement and both modes' fits.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrequencyResponse {
+    /// The measured responses.
+    pub measured: SteppedSine,
+    /// Mode 1 and mode 2.
+    pub modes: [ModeCheck; 2],
+    /// The plant's matrices identified from the whole 2 x 2 response (`None`: too few
+    /// usable frequencies).
+    pub matrix: Option<MatrixFit>,
+}
+
+impl FrequencyResponse {
+    /// Fitted f0 of mode 2 minus that of mode 1, and its standard error, Hz.
+    pub fn mode_split_hz(&self) -> (f64, f64) {
+        match (self.modes[0].fit, self.modes[1].fit) {
+            (Some(a), Some(b)) => (b.f0_hz - a.f0_hz, a.f0_sigma_hz.hypot(b.f0_sigma_hz)),
+            _ => (f64::NAN, f64::NAN),
+        }
+    }
+}
+
+/// The natural frequency (Hz) and Q of each mode of the plant `p` at rest, from the eigenvalues
+/// `s` of its state matrix (`f0 = |s| / 2 pi`, `Q = |s| / (2 Re(-s))`). With quadrature
+/// coupling the two eigenmodes mix the configured modes; each is named for the mode that
+/// dominates it: the lower eigenvalue is mode 1's when `f0_1 <= f0_2`. NaN if the matrix has
+/// no two oscillatory eigenvalue pairs.
+pub fn coupled_modes(p: &ResonatorParams) -> [(f64, f64); 2] {
+    let tau = core::f64::consts::TAU;
+    let (w1, w2) = (tau * p.mode1.f0_hz, tau * p.mode2.f0_hz);
+    // In units of a reference frequency (time scaled by it, displacement by it too), every
+    // entry is near 1 or small, and the eigenvalues keep their relative precision.
+    let wr = 0.5 * (w1 + w2);
+    let (r1, r2) = (w1 / wr, w2 / wr);
+    let k = p.quadrature_coupling_rad2_s2 / (wr * wr);
+    let (g1, g2) = (r1 / p.mode1.q, r2 / p.mode2.q);
+    #[rustfmt::skip]
+    let a = Matrix4::new(
+        0.0, 0.0, 1.0, 0.0,
+        0.0, 0.0, 0.0, 1.0,
+        -r1 * r1, -k, -g1, 0.0,
+        -k, -r2 * r2, 0.0, -g2,
+    );
+    let mut upper: Vec<Complex64> = a
+        .complex_eigenvalues()
+        .iter()
+        .filter(|s| s.im > 0.0)
+        .copied()
+        .collect();
+    if upper.len() != 2 {
+        return [(f64::NAN, f64::NAN); 2];
+    }
+    upper.sort_by(|x, y| x.norm().total_cmp(&y.norm()));
+    let modes: [(f64, f64); 2] = core::array::from_fn(|i| {
+        (
+            upper[i].norm() * wr / tau,
+            upper[i].norm() / (-2.0 * upper[i].re),
+        )
+    });
+    if w1 <= w2 {
+        modes
+    } else {
+        [modes[1], modes[0]]
+    }
+}
+
+/// The velocity of both modes per unit force on mode `m` at `f_hz` under the held drive,
+/// over the hold's response at `f_hz`: what `stepped_sine` measures when the emulation is
+/// exact (from `plant`'s exact held steady state).
+pub fn held_response(plant: &Resonator<f64>, f_hz: f64, m: usize) -> [Complex64; 2] {
+    let mut force = [Complex64::new(0.0, 0.0); 2];
+    force[m] = Complex64::new(1.0, 0.0);
+    let x = plant.held_steady_state(f_hz, force);
+    let hold = hold_response(f_hz, plant.params().fs_hz);
+    [x[2] / hold, x[3] / hold]
+}
+
+/// Fits both modes of a measured response and sets the checks beside them.
+pub fn frequency_response_from(cfg: &Config, measured: SteppedSine) -> FrequencyResponse {
+    let params = cfg.resonator_params();
+    let coupled = coupled_modes(&params);
+    let freqs: Vec<f64> = measured.points.iter().map(|p| p.freq_hz).collect();
+    let plant = Resonator::<f64>::new(&params, 0.0).ok();
+    let configured = cfg.mode_resonances_hz();
+    let modes = core::array::from_fn(|m| {
+        let h: Vec<Complex64> = measured.points.iter().map(|p| p.response[m][m]).collect();
+        let expected = plant.as_ref().and_then(|pl| {
+            let h: Vec<Complex64> = freqs.iter().map(|&f| held_response(pl, f, m)[m]).collect();
+            fit_resonance(&freqs, &h)
+        });
+        let (f0, b) = configured[m];
+        ModeCheck {
+            mode: m + 1,
+            fit: fit_resonance(&freqs, &h),
+            configured_f0_hz: f0,
+            configured_q: f0 / (2.0 * b),
+            coupled_f0_hz: coupled[m].0,
+            coupled_q: coupled[m].1,
+            expected,
+        }
+    });
+    let responses: Vec<_> = measured.points.iter().map(|p| p.response).collect();
+    let matrix = fit_matrix(&freqs, &responses);
+    FrequencyResponse {
+        measured,
+        modes,
+        matrix,
+    }
+}
+
+/// Runs `gyroemu sweep` on `cfg` (validated with `validate_sweep`): the measurement as one
+/// reported task, then the fits.
+pub fn run_frequency_response(
+    cfg: &Config,
+    reporter: &dyn Reporter,
+) -> Result<FrequencyResponse, SweepError> {
+    let task = reporter.task("stepped-sine sweep");
+    let measured = run_stepped_sine(cfg, &|d, t| task.update(d, t))?;
+    task.finish(Some(measured.point_samples));
+    Ok(frequency_response_from(cfg, measured))
+}

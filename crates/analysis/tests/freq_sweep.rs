@@ -1,0 +1,259 @@
+//! `gyroemu sweep`'s measurement and fits, on small emulated boards (Q = 2000 at 15 kHz,
+//! fs = 16 f0): the emulated response is the plant's exact held-drive steady state, the fits
+//! give back the configured device (its hold bias stated), quadrature coupling moves the
+//! fitted modes as the coupled plant's eigenvalues say, and the results do not depend on the
+//! thread count.
+
+use gyroemu_analysis::freq_response::{
+    coupled_modes, frequency_response_from, held_response, FrequencyResponse,
+};
+use gyroemu_analysis::stepped_sine::{run_stepped_sine, SteppedSine};
+use gyroemu_config::presets::preset_text;
+use gyroemu_config::{parse_config, Config};
+use gyroemu_resonator::Resonator;
+use std::f64::consts::PI;
+
+/// The Coriolis preset's board with this device and `[sweep] points`.
+fn config(offset_hz: f64, q2: f64, k12: f64, points: usize, extra: &str) -> Config {
+    let text = preset_text("m2tfg-coriolis")
+        .unwrap()
+        .replace(
+            "mode2_f0_offset_hz = 0.0",
+            &format!("mode2_f0_offset_hz = {offset_hz:?}\nq_mode2 = {q2:?}"),
+        )
+        .replace(
+            "quadrature_coupling_rad2_s2 = 0.0",
+            &format!("quadrature_coupling_rad2_s2 = {k12:?}"),
+        )
+        + &format!("\n[sweep]\npoints = {points}\n{extra}");
+    let c = parse_config(&text).unwrap();
+    c.validate_sweep().unwrap();
+    c
+}
+
+fn measure(c: &Config) -> SteppedSine {
+    let m = run_stepped_sine(c, &|_, _| {}).unwrap();
+    assert!(m.problems.is_empty() && m.warnings.is_empty(), "{m:?}");
+    m
+}
+
+/// The peak velocity per force of mode 1, Q / w0.
+fn peak(c: &Config) -> f64 {
+    c.device.q / (2.0 * PI * c.device.f0_hz)
+}
+
+#[test]
+fn the_emulated_response_is_the_exact_held_steady_state() {
+    let c = config(2.0, 1500.0, 2e5, 21, "");
+    let m = measure(&c);
+    // An independently built plant's exact steady state under the held drive, over the hold.
+    let plant = Resonator::<f64>::new(&c.resonator_params(), 0.0).unwrap();
+    let p = peak(&c);
+    let (mut worst, mut cross_max, mut recip) = (0.0f64, 0.0f64, 0.0f64);
+    for pt in &m.points {
+        for drive in 0..2 {
+            let want = held_response(&plant, pt.freq_hz, drive);
+            for (got, want) in pt.response[drive].iter().zip(want) {
+                worst = worst.max((got - want).norm() / p);
+            }
+        }
+        cross_max = cross_max.max(pt.response[0][1].norm());
+        // Reciprocity: a symmetric stiffness and damping give a symmetric response matrix.
+        recip = recip.max((pt.response[0][1] - pt.response[1][0]).norm());
+    }
+    // What is left of the start-up transient after 16 time constants is e^-16 = 1e-7 of the
+    // response; the low-pass leaves less than 1e-9 of the 2 f product.
+    assert!(worst < 1e-6, "{worst:e}");
+    assert!(cross_max > 1e-2 * p, "the coupling shows: {cross_max:e}");
+    assert!(recip < 1e-6 * cross_max, "{recip:e} of {cross_max:e}");
+}
+
+#[test]
+fn the_fits_give_back_the_configured_device() {
+    let c = config(2.0, 1500.0, 0.0, 41, "");
+    let r = frequency_response_from(&c, measure(&c));
+    for (k, (f0, q)) in [(15000.0, 2000.0), (15002.0, 1500.0)]
+        .into_iter()
+        .enumerate()
+    {
+        let mode = r.modes[k];
+        let fit = mode.fit.unwrap();
+        let hb = f0 / (2.0 * q);
+        assert_eq!((mode.configured_f0_hz, mode.configured_q), (f0, q));
+        // Without coupling the coupled plant's modes are the configured ones.
+        assert!(
+            (mode.coupled_f0_hz - f0).abs() < 1e-9 * hb && (mode.coupled_q / q - 1.0).abs() < 1e-9
+        );
+        // The hold's images add a nearly constant -0.0105 j / w0 to the velocity per force at
+        // 16 samples per period (5e-6 of the peak at Q = 2000): the fit reads f0 about 1e-5
+        // half-bandwidths high and Q 1e-6 low. Bounded ten times above.
+        assert!((fit.f0_hz - f0).abs() < 1e-4 * hb, "mode {k}: {fit:?}");
+        assert!((fit.q / q - 1.0).abs() < 1e-5, "mode {k}: {fit:?}");
+        assert!(
+            (fit.gain_re - 1.0).abs() < 1e-4 && fit.gain_im.abs() < 1e-4,
+            "{fit:?}"
+        );
+        assert!(fit.f0_sigma_hz < 1e-4 * hb, "{fit:?}");
+        // The emulation against the exact expectation (the same fit of the held steady state).
+        let exp = mode.expected.unwrap();
+        assert!((fit.f0_hz - exp.f0_hz).abs() < 1e-7 * hb, "{fit:?} {exp:?}");
+        assert!((fit.q / exp.q - 1.0).abs() < 1e-7, "{fit:?} {exp:?}");
+    }
+    let (split, sigma) = r.mode_split_hz();
+    assert!(
+        (split - 2.0).abs() < 1e-4 * 3.75 && sigma < 1e-3,
+        "{split} {sigma}"
+    );
+    // The matrix identification: the same modes, no coupling.
+    let mx = r.matrix.unwrap();
+    assert!(
+        (mx.f0_hz[0] - 15000.0).abs() < 1e-4 && (mx.f0_hz[1] - 15002.0).abs() < 1e-4,
+        "{mx:?}"
+    );
+    assert!(
+        (mx.q[0] / 2000.0 - 1.0).abs() < 1e-5 && (mx.q[1] / 1500.0 - 1.0).abs() < 1e-5,
+        "{mx:?}"
+    );
+    assert!(
+        mx.coupling_rad2_s2 == 0.0 && mx.damping_coupling_rad_s == 0.0,
+        "{mx:?}"
+    );
+}
+
+/// The coupled modes of `c` from the stiffness matrix `[[w1^2, k], [k, w2^2]]` alone (its
+/// eigenvalues in closed form), Hz: the damping moves them by O(1/Q^2).
+fn stiffness_modes_hz(c: &Config) -> [f64; 2] {
+    let p = c.resonator_params();
+    let (w1, w2) = (2.0 * PI * p.mode1.f0_hz, 2.0 * PI * p.mode2.f0_hz);
+    let k = p.quadrature_coupling_rad2_s2;
+    let mean = 0.5 * (w1 * w1 + w2 * w2);
+    let half = (0.25 * (w2 * w2 - w1 * w1).powi(2) + k * k).sqrt();
+    [
+        (mean - half).sqrt() / (2.0 * PI),
+        (mean + half).sqrt() / (2.0 * PI),
+    ]
+}
+
+fn coupled(c: &Config) -> FrequencyResponse {
+    frequency_response_from(c, measure(c))
+}
+
+#[test]
+fn quadrature_coupling_moves_the_fitted_modes_as_the_coupled_plant_says() {
+    // Modes 40 Hz (about 10 half-bandwidths) apart, coupled by k12 = 2 w0 x 2 pi x 5 Hz: the
+    // stiffness matrix's eigenvalues move each mode by about 0.6 Hz (0.17 half-bandwidth),
+    // outward. The other mode's residue in a driven response is (5/40)^2 = 1.6 %.
+    let w0 = 2.0 * PI * 15e3;
+    let k12 = 2.0 * w0 * 2.0 * PI * 5.0;
+    let c = config(40.0, 2000.0, k12, 61, "");
+    let r = coupled(&c);
+    let eig = stiffness_modes_hz(&c);
+    let shift = [eig[0] - 15000.0, eig[1] - 15040.0];
+    assert!(shift[0] < -0.5 && shift[1] > 0.5, "{shift:?}");
+    for k in 0..2 {
+        let m = r.modes[k];
+        // The damped eigenvalues against the stiffness matrix's: O(1/Q^2) of f0.
+        assert!((m.coupled_f0_hz - eig[k]).abs() < 1e-5, "{m:?} {eig:?}");
+        // A one-mode fit sees the coupled mode: its f0 moved by the eigenvalue's shift, to
+        // within what the neighbour's residue adds (4 % of the shift here).
+        let fit = m.fit.unwrap();
+        let moved = fit.f0_hz - m.configured_f0_hz;
+        assert!(
+            (moved / shift[k] - 1.0).abs() < 0.1,
+            "mode {k}: moved {moved}, eigen {}",
+            shift[k]
+        );
+        // ... and what it sees is exactly what the held steady state gives.
+        let exp = m.expected.unwrap();
+        assert!((fit.f0_hz - exp.f0_hz).abs() < 1e-6 && (fit.q / exp.q - 1.0).abs() < 1e-6);
+    }
+    // The 2 x 2 identification takes the coupling apart: the configured modes and k12.
+    let mx = r.matrix.unwrap();
+    let hb = 3.75;
+    assert!((mx.f0_hz[0] - 15000.0).abs() < 1e-4 * hb, "{mx:?}");
+    assert!((mx.f0_hz[1] - 15040.0).abs() < 1e-4 * hb, "{mx:?}");
+    assert!(
+        (mx.q[0] / 2000.0 - 1.0).abs() < 1e-5 && (mx.q[1] / 2000.0 - 1.0).abs() < 1e-5,
+        "{mx:?}"
+    );
+    assert!(
+        (mx.coupling_rad2_s2 / k12 - 1.0).abs() < 1e-5,
+        "{mx:?} {k12}"
+    );
+}
+
+#[test]
+fn the_coupled_modes_are_the_stiffness_eigenvalues_for_uniform_damping() {
+    // With the same w/Q on both modes the damping matrix is c I and commutes with K: the
+    // damped eigenvalues are exactly s^2 + c s + lambda = 0, |s| = sqrt(lambda), Q = |s| / c.
+    let (f1, q1) = (15e3, 2000.0); // the preset's mode 1
+    let f2 = 15012.0;
+    let q2 = q1 * f2 / f1;
+    let k12 = 3e6;
+    let c = config(12.0, q2, k12, 11, "");
+    let eig = stiffness_modes_hz(&c);
+    let damping = 2.0 * PI * f1 / q1;
+    let modes = coupled_modes(&c.resonator_params());
+    for k in 0..2 {
+        assert!(
+            (modes[k].0 / eig[k] - 1.0).abs() < 1e-13,
+            "{modes:?} {eig:?}"
+        );
+        let q = 2.0 * PI * eig[k] / damping;
+        assert!((modes[k].1 / q - 1.0).abs() < 1e-9, "{modes:?} {q}");
+    }
+    // Mode 2 below mode 1: the names follow the modes, not the order.
+    let c = config(-12.0, q1 * (f1 - 12.0) / f1, k12, 11, "");
+    let modes = coupled_modes(&c.resonator_params());
+    assert!(
+        modes[1].0 < modes[0].0 && (modes[1].0 - 14988.0).abs() < 1.0,
+        "{modes:?}"
+    );
+}
+
+#[test]
+fn the_results_do_not_depend_on_the_thread_count() {
+    // Noise on, so every run's own stream is exercised.
+    let noise = "\n[noise]\nseed = 7\ntia_current_noise_a_per_rthz = 1e-11\n";
+    let c = config(2.0, 1500.0, 2e5, 7, noise);
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| measure(&c))
+    };
+    let (one, three) = (run(1), run(3));
+    assert_eq!(one, three);
+    // The noise is there (the test is not comparing two noiseless runs).
+    let quiet = config(2.0, 1500.0, 2e5, 7, "");
+    let q = measure(&quiet);
+    assert!(one.points.iter().zip(&q.points).all(|(a, b)| a.z != b.z));
+}
+
+#[test]
+fn a_cross_coupling_below_the_adc_resolution_is_nan_with_a_warning_not_zero() {
+    // 8-bit ADC at 0.05 V full scale: the driven TIA output (21 mV at resonance) is resolved,
+    // a cross-coupling of about 1e-4 of it is below half an LSB (0.2 mV): the ADC of the mode
+    // read puts out only zeros, which must not pass for "no coupling".
+    let mut c = config(2.0, 1500.0, 1e3, 7, "");
+    c.board.adc_bits = Some(8);
+    c.board.adc_full_scale_v = 0.05;
+    c.validate_sweep().unwrap();
+    let m = run_stepped_sine(&c, &|_, _| {}).unwrap();
+    assert!(m.problems.is_empty(), "{:?}", m.problems);
+    assert!(
+        m.warnings
+            .iter()
+            .any(|w| w.contains("below the ADC's resolution")),
+        "{:?}",
+        m.warnings
+    );
+    for p in &m.points {
+        assert!(
+            p.response[0][1].re.is_nan() && p.response[1][0].re.is_nan(),
+            "{p:?}"
+        );
+        assert!(p.response[0][0].norm() > 0.0 && p.response[1][1].norm() > 0.0);
+    }
+}

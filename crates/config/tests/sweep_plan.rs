@@ -1,0 +1,96 @@
+//! The `[sweep]` section: its defaults follow the device as documented (10 half-bandwidths
+//! beyond each resonance, 16 + 2 mechanical time constants), its frequency grids are what their
+//! names say, and its rules apply to `gyroemu sweep` (`validate_sweep`) whether or not the
+//! section is written, without follow-on errors from a bad device key.
+
+use gyroemu_config::presets::preset_text;
+use gyroemu_config::{parse_config, sweep_grid, Config, Spacing};
+use std::f64::consts::PI;
+
+fn sweep_preset() -> Config {
+    parse_config(preset_text("m2tfg-sweep").unwrap()).unwrap()
+}
+
+#[test]
+fn the_defaults_follow_the_device() {
+    let c = sweep_preset();
+    let s = c.sweep_resolved();
+    // f0 15 kHz, Q 36 000 (b = 0.2083 Hz); mode 2 at 15 000.5 Hz, Q 30 000 (b = 0.25 Hz).
+    let (b1, b2) = (15000.0 / 72000.0, 15000.5 / 60000.0);
+    assert!((s.start_hz.unwrap() - (15000.0 - 10.0 * b1)).abs() < 1e-9);
+    assert!((s.stop_hz.unwrap() - (15000.5 + 10.0 * b2)).abs() < 1e-9);
+    // tau = Q / (pi f0) of the slower mode (mode 1: 0.7639 s), the low-pass 200 Hz.
+    let tau = 36000.0 / (PI * 15000.0);
+    let lp = 40.0 / (2.0 * PI * 200.0);
+    assert!((s.settle_s.unwrap() - (16.0 * tau + lp)).abs() < 1e-12);
+    assert!((s.average_s.unwrap() - 2.0 * tau).abs() < 1e-12);
+    // Settling and averaging in whole output periods (fs_out = 2400 Hz).
+    let (settle, point) = c.sweep_point();
+    assert_eq!(settle, (s.settle_s.unwrap() * 2400.0).ceil() as u64);
+    assert_eq!(
+        point.window.samples() - 1,
+        (s.average_s.unwrap() * 2400.0).floor() as u64
+    );
+    assert!(c.validate_sweep().unwrap().is_empty());
+}
+
+#[test]
+fn the_grids_are_even_in_what_their_names_say() {
+    let modes = [(1000.0, 2.0), (1010.0, 5.0)];
+    let (a, b, n) = (950.0, 1060.0, 41);
+    for spacing in [Spacing::Linear, Spacing::Log, Spacing::Resonance] {
+        let f = sweep_grid(a, b, n, spacing, &modes);
+        assert_eq!(f.len(), n);
+        assert_eq!((f[0], f[n - 1]), (a, b));
+        assert!(f.windows(2).all(|w| w[1] > w[0]), "{spacing:?}");
+        // The quantity the spacing is even in.
+        let g = |x: f64| match spacing {
+            Spacing::Linear => x,
+            Spacing::Log => x.ln(),
+            Spacing::Resonance => modes.iter().map(|&(f0, hb)| ((x - f0) / hb).atan()).sum(),
+        };
+        let step = (g(b) - g(a)) / (n - 1) as f64;
+        for w in f.windows(2) {
+            assert!(
+                ((g(w[1]) - g(w[0])) / step - 1.0).abs() < 1e-9,
+                "{spacing:?}"
+            );
+        }
+    }
+    // The resonance spacing puts more points within a half-bandwidth of each mode.
+    let near = |f: &[f64]| {
+        modes
+            .iter()
+            .map(|&(f0, hb)| f.iter().filter(|x| (*x - f0).abs() <= hb).count())
+            .collect::<Vec<_>>()
+    };
+    let lin = near(&sweep_grid(a, b, n, Spacing::Linear, &modes));
+    let res = near(&sweep_grid(a, b, n, Spacing::Resonance, &modes));
+    assert!(
+        res[0] > 2 * lin[0] && res[1] > 2 * lin[1],
+        "{res:?} {lin:?}"
+    );
+}
+
+#[test]
+fn sweep_rules_apply_to_the_sweep_command_even_without_the_section() {
+    // Q = 5: the default span reaches down to 0 Hz, which only a sweep cares about.
+    let text = preset_text("m2tfg-coriolis")
+        .unwrap()
+        .replace("q = 2000.0 ", "q = 5.0 ");
+    let c = parse_config(&text).unwrap();
+    assert!(c.sweep.is_none());
+    assert!(c.validate().is_ok());
+    let e = c.validate_sweep().unwrap_err();
+    assert_eq!(e.key.as_deref(), Some("sweep.start_hz"), "{e}");
+}
+
+#[test]
+fn a_bad_device_key_is_reported_once_not_again_through_the_derived_sweep() {
+    let text = preset_text("m2tfg-sweep")
+        .unwrap()
+        .replace("q = 36000.0 ", "q = -1.0 ");
+    let e = parse_config(&text).unwrap().validate_sweep().unwrap_err();
+    let keys: Vec<String> = e.problems().into_iter().filter_map(|p| p.key).collect();
+    assert_eq!(keys, ["device.q"], "{e}");
+}

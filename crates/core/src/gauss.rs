@@ -1,0 +1,288 @@
+//! Exact standard normals in the lanes: the ziggurat of Marsaglia and Tsang (2000), with 2048
+//! layers, and the layer, the sign and the uniform taken from separate bits of one 64-bit draw
+//! (Doornik 2005), on each lane's own xoshiro256++ streams (`noise`).
+//!
+//! The density's 2048 pieces of equal area (`gauss_tables`, computed at 80 digits by
+//! `scripts/gauss_tables.py`) are the base (the rectangle under f(r) plus the tail beyond r)
+//! and 2047 rectangles stacked on it. A draw picks a piece and a uniform point across it; in
+//! 99.77 % of draws the point lies in the piece's core, under the curve by construction, and
+//! is returned: that path runs four lanes at once (eight with AVX-512, `gauss_avx512`) with
+//! no branch per lane. The rest (a point in a wedge between a rectangle's core and the curve,
+//! or in the base beyond r) goes lane by lane through the exact test, drawing further values
+//! from that lane's stream only. So each stream's sequence is the scalar ziggurat on it,
+//! whatever the neighbouring lanes do: a point's noise is the same in every lane, group,
+//! shard and thread count, and in a scalar run.
+//!
+//! Pure IEEE arithmetic with one rounding per operation throughout (the rare wedge `exp` and
+//! tail `ln` are `wide`'s polynomials), so the same bits on every run.
+
+use crate::gauss_tables::{F, FAST, N, R, WEDGE};
+use crate::noise::{step, NoiseRng};
+use wide::bytemuck::cast;
+use wide::{f64x4, u64x4};
+
+/// The exponent bits of 1.0: `ONE_BITS | m` for a 52-bit `m` is `1 + m / 2^52`, in [1, 2).
+pub(crate) const ONE_BITS: u64 = 0x3FF0_0000_0000_0000;
+/// The bit of a draw that gives the sign (the bits below it pick the piece).
+pub(crate) const SIGN_BIT: u64 = N as u64;
+/// How far the sign bit moves to become an f64's sign.
+pub(crate) const SIGN_SHIFT: u32 = 63 - N.trailing_zeros();
+const _: () = assert!(
+    N.is_power_of_two() && N <= 1 << 11,
+    "piece and sign fit below bit 12"
+);
+
+/// The piece (bits 0-10), the sign (bit 11, moved to bit 63) and the uniform
+/// `b = 1 + m / 2^52` in [1, 2) (bits 12-63) of a draw.
+#[inline(always)]
+fn split(w: u64) -> (usize, u64, f64) {
+    (
+        w as usize & (N - 1),
+        (w & SIGN_BIT) << SIGN_SHIFT,
+        f64::from_bits((w >> 12) | ONE_BITS),
+    )
+}
+
+/// `e^x`, the same bits on every run (`wide`'s polynomial).
+#[inline]
+fn exp(x: f64) -> f64 {
+    f64x4::splat(x).exp().to_array()[0]
+}
+
+/// `ln x`, the same bits on every run (`wide`'s polynomial).
+#[inline]
+fn ln(x: f64) -> f64 {
+    f64x4::splat(x).ln().to_array()[0]
+}
+
+/// Uniform in (0, 1] from a draw's top 53 bits (so `ln` never sees 0).
+#[inline]
+fn open0(w: u64) -> f64 {
+    ((w >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// Uniform in [0, 1) from a draw's top 53 bits.
+#[inline]
+fn closed0(w: u64) -> f64 {
+    (w >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// The fast path of four draws: each lane's candidate normal, and the bit mask of the lanes
+/// whose point lay in its piece's core (those candidates are final).
+#[inline(always)]
+fn candidates(w: u64x4) -> (f64x4, u32) {
+    let piece = w.to_array().map(|w| &FAST.0[w as usize & (N - 1)]);
+    let width = f64x4::new(piece.map(|p| p[0]));
+    let bound = f64x4::new(piece.map(|p| p[1]));
+    let b: f64x4 = cast((w >> 12u32) | u64x4::splat(ONE_BITS));
+    let sign: f64x4 = cast((w & u64x4::splat(SIGN_BIT)) << SIGN_SHIFT);
+    // (b - 1) is exact; x >= 0, so or-ing the sign bit in negates it.
+    let x = ((b - f64x4::ONE) * width) | sign;
+    (x, b.simd_lt(bound).to_bitmask())
+}
+
+/// The next normal of every lane from the four lanes' stream states `s`.
+#[inline(always)]
+fn next_normal(s: &mut [u64x4; 4]) -> f64x4 {
+    let w = step(s);
+    let (x, core) = candidates(w);
+    if core == 0xF {
+        x
+    } else {
+        let (st, x) = rare(*s, w, x, core);
+        *s = st;
+        x
+    }
+}
+
+/// The lanes whose draw `w` missed its piece's core (bit `l` of `core` clear) finish one by
+/// one, each on its own stream (so their order does not matter). The state goes in and out
+/// by value: the caller's copy stays in registers on the common path.
+#[cold]
+#[inline(never)]
+pub(crate) fn rare(mut st: [u64x4; 4], w: u64x4, x: f64x4, core: u32) -> ([u64x4; 4], f64x4) {
+    let w = w.to_array();
+    let mut out = x.to_array();
+    let mut pending = !core & 0xF;
+    while pending != 0 {
+        let l = pending.trailing_zeros() as usize;
+        pending &= pending - 1;
+        out[l] = lane_normal(&mut st, l, w[l]);
+    }
+    (st, f64x4::new(out))
+}
+
+/// The next draw of lane `lane` alone: all four lanes step, only that lane keeps its step.
+#[inline(always)]
+fn lane_draw(s: &mut [u64x4; 4], lane: usize) -> u64 {
+    let mut t = *s;
+    let w = step(&mut t);
+    let keep = u64x4::new(core::array::from_fn(
+        |l| if l == lane { u64::MAX } else { 0 },
+    ));
+    for (si, ti) in s.iter_mut().zip(t) {
+        *si = keep.select(ti, *si);
+    }
+    w.as_array()[lane]
+}
+
+/// The scalar ziggurat on lane `lane`, starting from draw `w` (already taken from that lane's
+/// stream); further draws come from the same stream.
+#[inline(always)]
+fn lane_normal(s: &mut [u64x4; 4], lane: usize, mut w: u64) -> f64 {
+    loop {
+        let (i, sign, b) = split(w);
+        let [width, bound] = FAST.0[i];
+        let x = (b - 1.0) * width;
+        let x = if b < bound {
+            Some(x)
+        } else if i == 0 {
+            Some(tail(s, lane))
+        } else {
+            // A uniform height across layer i's wedge, from f(X[i]) at its right edge up to
+            // f(X[i+1]); the point is kept where it lies under the curve. The chord between
+            // the wedge's corners, with the tabled bounds on f minus it, decides all but a
+            // thin band around the curve without exp.
+            let y = F[i] + closed0(lane_draw(s, lane)) * (F[i + 1] - F[i]);
+            let [slope, lo, hi] = WEDGE[i];
+            let c = F[i] + (width - x) * slope;
+            let under = if y < c + lo {
+                true
+            } else if y >= c + hi {
+                false
+            } else {
+                y < exp(-0.5 * x * x)
+            };
+            under.then_some(x)
+        };
+        if let Some(x) = x {
+            return f64::from_bits(x.to_bits() | sign);
+        }
+        w = lane_draw(s, lane);
+    }
+}
+
+/// A normal conditioned on x > r (Marsaglia 1964): x = r + a with a exponential of rate r,
+/// kept with probability exp(-a^2 / 2).
+#[inline(never)]
+fn tail(s: &mut [u64x4; 4], lane: usize) -> f64 {
+    loop {
+        let a = -ln(open0(lane_draw(s, lane))) / R;
+        let c = -ln(open0(lane_draw(s, lane)));
+        if c + c > a * a {
+            return R + a;
+        }
+    }
+}
+
+/// [`NoiseRng::fill_pairs`] without AVX-512: stream a, then stream b, four lanes at a time.
+pub(crate) fn fill_pairs_portable(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
+    let [mut a, mut b] = *s;
+    for pair in out.chunks_exact_mut(2) {
+        pair[0] = next_normal(&mut a);
+        pair[1] = next_normal(&mut b);
+    }
+    *s = [a, b];
+}
+
+impl NoiseRng {
+    /// The next standard normal of each lane's stream a and of its stream b.
+    #[inline]
+    pub fn normal_pair(&mut self) -> (f64x4, f64x4) {
+        let mut out = [f64x4::ZERO; 2];
+        self.fill_pairs(&mut out);
+        (out[0], out[1])
+    }
+
+    /// Fills `out` (of even length) with the next pairs: `out[2k]` and `out[2k + 1]` are what
+    /// the k-th call of [`NoiseRng::normal_pair`] gives (the same bits).
+    pub fn fill_pairs(&mut self, out: &mut [f64x4]) {
+        assert!(out.len().is_multiple_of(2), "normals come in pairs");
+        #[cfg(target_arch = "x86_64")]
+        if crate::gauss_avx512::available() {
+            // SAFETY: the CPU has AVX-512F (checked just above).
+            unsafe { crate::gauss_avx512::fill_pairs(&mut self.s, out) };
+            return;
+        }
+        fill_pairs_portable(&mut self.s, out);
+    }
+}
+
+/// Normals drawn ahead in blocks, for a loop that takes four per sample: the sequence of
+/// [`NoiseRng::normal_pair`] calls, with the generator's state in registers while it fills.
+#[derive(Clone, Debug)]
+pub struct NormalBlock {
+    rng: NoiseRng,
+    buf: Box<[f64x4; NormalBlock::LEN]>,
+    /// The next unread entry (`LEN`: all read).
+    pos: usize,
+}
+
+impl NormalBlock {
+    /// Normals per lane drawn at a time (64 samples of four; a power of two).
+    pub const LEN: usize = 256;
+
+    /// Normals from `rng`'s streams, from their current state on.
+    pub fn new(rng: NoiseRng) -> Self {
+        Self {
+            rng,
+            buf: Box::new([f64x4::ZERO; Self::LEN]),
+            pos: Self::LEN,
+        }
+    }
+
+    /// The next two pairs of every lane, in order: a, b, a, b.
+    #[inline(always)]
+    pub fn next4(&mut self) -> [f64x4; 4] {
+        self.ready(1);
+        let n = self.at(self.pos);
+        self.pos += 4;
+        n
+    }
+
+    /// Makes the normals of up to `samples` samples (four each) ready, drawing more if none
+    /// are left, and returns how many samples they cover (at least one): a loop can then read
+    /// them with [`NormalBlock::at`] from [`NormalBlock::pos`] on, without a call per sample,
+    /// and [`NormalBlock::advance`] past them.
+    #[inline(always)]
+    pub fn ready(&mut self, samples: u64) -> u64 {
+        if self.pos == Self::LEN {
+            self.refill();
+        }
+        samples.min(((Self::LEN - self.pos) / 4) as u64)
+    }
+
+    /// The index of the next unread normal.
+    #[inline(always)]
+    pub fn pos(&self) -> usize {
+        self.pos
+    }
+
+    /// The four normals from index `i` (a multiple of four, below `LEN`).
+    #[inline(always)]
+    pub fn at(&self, i: usize) -> [f64x4; 4] {
+        let i = i & (Self::LEN - 4);
+        [
+            self.buf[i],
+            self.buf[i + 1],
+            self.buf[i + 2],
+            self.buf[i + 3],
+        ]
+    }
+
+    /// Marks `samples` samples' normals (four each) as read.
+    #[inline(always)]
+    pub fn advance(&mut self, samples: u64) {
+        self.pos += 4 * samples as usize;
+    }
+
+    #[inline(never)]
+    fn refill(&mut self) {
+        self.rng.fill_pairs(&mut self.buf[..]);
+        self.pos = 0;
+    }
+}
+
+#[cfg(test)]
+#[path = "gauss_tests.rs"]
+mod tests;

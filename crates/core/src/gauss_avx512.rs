@@ -1,0 +1,111 @@
+//! The fast path of `gauss` with AVX-512F, chosen at run time (the build targets x86-64-v3):
+//! one 512-bit register holds stream a and stream b of the four lanes, so each step, table
+//! look-up and test serves eight normals. The operations are the portable path's (integer
+//! steps, the same table entries, one exact subtraction and one rounded product per normal,
+//! exact comparisons), and draws that miss their piece's core finish in the portable code, so
+//! the bits are the same on either path (tested).
+
+use crate::gauss::{rare, ONE_BITS, SIGN_BIT, SIGN_SHIFT};
+use crate::gauss_tables::{FAST, N};
+use core::arch::x86_64::*;
+use wide::{f64x4, u64x4};
+
+/// The CPU runs AVX-512F (the answer is cached by `std`).
+#[inline]
+pub(crate) fn available() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f")
+}
+
+/// Stream a of the four lanes in the low half, stream b in the high half.
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn join(a: u64x4, b: u64x4) -> __m512i {
+    let a: __m256i = wide::bytemuck::cast(a);
+    let b: __m256i = wide::bytemuck::cast(b);
+    _mm512_inserti64x4::<1>(_mm512_castsi256_si512(a), b)
+}
+
+/// The two halves of [`join`].
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn halves(v: __m512i) -> [u64x4; 2] {
+    [
+        wide::bytemuck::cast(_mm512_castsi512_si256(v)),
+        wide::bytemuck::cast(_mm512_extracti64x4_epi64::<1>(v)),
+    ]
+}
+
+/// [`crate::NoiseRng::fill_pairs`] with AVX-512F.
+///
+/// # Safety
+/// The CPU must have AVX-512F.
+#[target_feature(enable = "avx512f")]
+pub(crate) unsafe fn fill_pairs(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
+    let mut st: [__m512i; 4] = core::array::from_fn(|w| join(s[0][w], s[1][w]));
+    let index = _mm512_set1_epi64(N as i64 - 1);
+    let one = _mm512_set1_epi64(ONE_BITS as i64);
+    let sign_bit = _mm512_set1_epi64(SIGN_BIT as i64);
+    let base = FAST.0.as_ptr() as *const u8;
+    for pair in out.chunks_exact_mut(2) {
+        let [s0, s1, s2, s3] = &mut st;
+        // xoshiro256++ of all eight streams.
+        let w = _mm512_add_epi64(_mm512_rol_epi64::<23>(_mm512_add_epi64(*s0, *s3)), *s0);
+        let t = _mm512_slli_epi64::<17>(*s1);
+        *s2 = _mm512_xor_si512(*s2, *s0);
+        *s3 = _mm512_xor_si512(*s3, *s1);
+        *s1 = _mm512_xor_si512(*s1, *s2);
+        *s0 = _mm512_xor_si512(*s0, *s3);
+        *s2 = _mm512_xor_si512(*s2, t);
+        *s3 = _mm512_rol_epi64::<45>(*s3);
+        // Each stream's piece: [width, bound] pairs, 16 bytes apart.
+        let mut off = [0u64; 8];
+        _mm512_storeu_si512(
+            off.as_mut_ptr().cast(),
+            _mm512_slli_epi64::<4>(_mm512_and_si512(w, index)),
+        );
+        // SAFETY: every offset is below 16 N, inside the table of N pairs.
+        let p = |k: usize| unsafe { _mm_loadu_pd(base.add(off[k] as usize).cast()) };
+        let lo = |k: usize, j: usize| _mm256_insertf128_pd::<1>(_mm256_castpd128_pd256(p(k)), p(j));
+        // Pieces of streams 0, 2, 4, 6 and of 1, 3, 5, 7, then width and bound of all eight.
+        let even = _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(lo(0, 2)), lo(4, 6));
+        let odd = _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(lo(1, 3)), lo(5, 7));
+        let width = _mm512_unpacklo_pd(even, odd);
+        let bound = _mm512_unpackhi_pd(even, odd);
+        let b = _mm512_castsi512_pd(_mm512_or_si512(_mm512_srli_epi64::<12>(w), one));
+        let sign = _mm512_sll_epi64(
+            _mm512_and_si512(w, sign_bit),
+            _mm_cvtsi32_si128(SIGN_SHIFT as i32),
+        );
+        let x = _mm512_mul_pd(_mm512_sub_pd(b, _mm512_set1_pd(1.0)), width);
+        let x = _mm512_castsi512_pd(_mm512_or_si512(_mm512_castpd_si512(x), sign));
+        let core = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(b, bound);
+        // SAFETY: `pair` is two adjacent f64x4, 64 bytes.
+        unsafe { _mm512_storeu_pd(pair.as_mut_ptr().cast(), x) };
+        if core != 0xFF {
+            st = finish(st, w, pair, core as u32);
+        }
+    }
+    for (w, v) in st.iter().enumerate() {
+        [s[0][w], s[1][w]] = halves(*v);
+    }
+}
+
+/// The streams whose draw missed its piece's core, finished by the portable code on their
+/// own state. The state goes in and out by value, so the caller keeps its copy in registers.
+#[cold]
+#[inline(never)]
+#[target_feature(enable = "avx512f")]
+fn finish(st: [__m512i; 4], w: __m512i, pair: &mut [f64x4], core: u32) -> [__m512i; 4] {
+    let mut ab: [[u64x4; 4]; 2] = [[u64x4::ZERO; 4]; 2];
+    for (k, v) in st.iter().enumerate() {
+        [ab[0][k], ab[1][k]] = halves(*v);
+    }
+    let w = halves(w);
+    for h in 0..2 {
+        let core_h = (core >> (4 * h)) & 0xF;
+        if core_h != 0xF {
+            (ab[h], pair[h]) = rare(ab[h], w[h], pair[h], core_h);
+        }
+    }
+    core::array::from_fn(|k| join(ab[0][k], ab[1][k]))
+}

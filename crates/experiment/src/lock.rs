@@ -1,0 +1,112 @@
+//! The carrier PLL of a config (`[pll]`, issue 14 point 1): a lock run emulated on the board at
+//! zero rate, the PLL steering the carrier onto the resonance of one mode, and the config the
+//! sweep then runs: the carrier held where the lock ended.
+
+use crate::sweep::SweepError;
+use gyroemu_board::{lock_carrier as board_lock, ChainResponse, LockSample};
+use gyroemu_config::Config;
+use gyroemu_core::{ParamResult, Stage};
+use gyroemu_lpf::LowPass;
+use gyroemu_pll::{Pll, PllParams};
+
+/// How a config's carrier was locked.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CarrierLock {
+    /// The carrier the lock started from (`drive.carrier_hz`), Hz.
+    pub nominal_hz: f64,
+    /// The carrier where the lock ended (what the sweep runs at), Hz.
+    pub carrier_hz: f64,
+    /// The resonance of the locked mode as configured, Hz (for comparison only: the PLL
+    /// does not know it).
+    pub resonance_hz: f64,
+    /// When the lock indicator came on for good, s.
+    pub lock_time_s: Option<f64>,
+    /// The lock run, one entry per decimated output.
+    pub trace: Vec<LockSample>,
+}
+
+/// The PLL that `design` (the config whose `[pll]`, device and board define the loop) puts on
+/// the board of `cfg`: its nominal carrier `cfg`'s, its update rate the decimated rate, its
+/// gains from the locked mode's nominal tau, its phase offset the chain's phase at the carrier
+/// (the DAC hold and the TIA: the velocity is in phase with the force at resonance), limits
+/// of a fifth of the carrier either side. `None` without a `[pll]`.
+pub fn pll_params(cfg: &Config, design: &Config) -> ParamResult<Option<PllParams>> {
+    let Some(pll) = &design.pll else {
+        return Ok(None);
+    };
+    let (f0, q) = if pll.mode == 2 {
+        (
+            design.f0_mode2_hz(),
+            design.device.q_mode2.unwrap_or(design.device.q),
+        )
+    } else {
+        (design.device.f0_hz, design.device.q)
+    };
+    let fc = cfg.carrier_hz();
+    let chain = ChainResponse::new(&cfg.board_params())?;
+    let lowpass = LowPass::<f64>::new(cfg.lowpass_design(), cfg.fs_hz())?;
+    let mut p = PllParams::new(
+        fc,
+        cfg.fs_out_hz(),
+        design.pll_natural_hz().unwrap_or(f64::NAN),
+        pll.damping,
+        PllParams::tau_s_of(f0, q),
+    );
+    p.phase_offset_rad = (chain.dac_hold(fc) * chain.tia(fc)).arg();
+    p.lowpass_delay_s = lowpass.latency_samples() / cfg.fs_hz();
+    p.min_hz = Some(0.8 * fc);
+    p.max_hz = Some((1.2 * fc).min(0.49 * cfg.fs_hz()));
+    Ok(Some(p))
+}
+
+/// Locks `cfg`'s carrier with the PLL `design` defines (see [`pll_params`]); `None` without a
+/// `[pll]`. A lock that does not hold at the end of `pll.lock_s` is an error: a sweep at a
+/// carrier still moving would be read as if it sat on the resonance.
+pub fn lock_config_carrier(
+    cfg: &Config,
+    design: &Config,
+) -> Result<Option<CarrierLock>, SweepError> {
+    let Some(params) = pll_params(cfg, design)? else {
+        return Ok(None);
+    };
+    let pll_cfg = design.pll.as_ref().expect("pll_params found a [pll]");
+    let mut pll = Pll::new(&params)?;
+    let lock_s = design.pll_lock_s().unwrap_or(f64::NAN);
+    let blocks = (lock_s * cfg.fs_out_hz()).ceil() as u64;
+    let mode = pll_cfg.mode - 1;
+    let run = board_lock(&cfg.board_params(), &mut pll, mode, blocks)??;
+    if !run.locked {
+        return Err(SweepError::NotLocked(format!(
+            "the carrier PLL did not lock within pll.lock_s = {lock_s} s: it ended at {} Hz with a phase error of {:.3e} rad (started at {} Hz, mode {} resonates at {} Hz as configured); raise pll.lock_s, or start drive.carrier_hz nearer the resonance",
+            run.carrier_hz,
+            pll.phase_error_rad(),
+            params.carrier_hz,
+            pll_cfg.mode,
+            if mode == 1 { cfg.f0_mode2_hz() } else { cfg.device.f0_hz },
+        )));
+    }
+    Ok(Some(CarrierLock {
+        nominal_hz: params.carrier_hz,
+        carrier_hz: run.carrier_hz,
+        resonance_hz: if mode == 1 {
+            cfg.f0_mode2_hz()
+        } else {
+            cfg.device.f0_hz
+        },
+        lock_time_s: run.lock_time_s,
+        trace: run.trace,
+    }))
+}
+
+/// The config a sweep of `cfg` runs: with a `[pll]`, its carrier locked first (the lock is
+/// deterministic, so every rerun, shard and merge gets the same bits) and held, the `[pll]`
+/// section then spent; otherwise `cfg` itself.
+pub fn resolve_lock(cfg: &Config) -> Result<(Config, Option<CarrierLock>), SweepError> {
+    let Some(lock) = lock_config_carrier(cfg, cfg)? else {
+        return Ok((cfg.clone(), None));
+    };
+    let mut held = cfg.clone();
+    held.drive.carrier_hz = Some(lock.carrier_hz);
+    held.pll = None;
+    Ok((held, Some(lock)))
+}

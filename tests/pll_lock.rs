@@ -1,0 +1,153 @@
+//! Issue 14 point 1, closed loop: the carrier PLL locks the board's carrier onto the
+//! resonance. The truth is where the chain's own phase at the carrier equals the PLL's
+//! offset: the plant's exact held-drive steady state (resonator::held_steady_state) times the
+//! TIA's response, solved for by bisection here, independently of the loop. A swept run with
+//! `[pll]` then reads its phases at the locked carrier as a tuned board does.
+#![allow(clippy::needless_range_loop)]
+
+mod common;
+use common::*;
+use gyroemu::config::Config;
+use gyroemu::experiment::{lock_config_carrier, pll_params, resolve_lock};
+use gyroemu::resonator::Resonator;
+use gyroemu::tia::Tia;
+use gyroemu::{Complex64, Response};
+
+fn with_pll(mut c: Config, start_offset_hz: f64) -> Config {
+    c.drive.carrier_hz = Some(c.device.f0_hz + start_offset_hz);
+    c.pll = Some(gyroemu::config::PllConfig {
+        natural_hz: None,
+        damping: core::f64::consts::FRAC_1_SQRT_2,
+        lock_s: None,
+        mode: 1,
+    });
+    // The derived loop values, as parse_config fills them in.
+    c.resolve();
+    c.validate().unwrap();
+    c
+}
+
+/// The carrier at which mode 1's demodulated phase equals `offset` (bisection on the exact
+/// held-drive steady state, mode 1 driven alone: at zero rate the modes are independent).
+fn true_lock_hz(c: &Config, offset: f64, lo: f64, hi: f64) -> f64 {
+    let plant = Resonator::<f64>::new(&c.resonator_params(), 0.0).unwrap();
+    let tia = Tia::<f64>::new(&c.board_params().tia).unwrap();
+    let err = |f: f64| {
+        let v = plant.held_steady_state(f, [Complex64::new(1.0, 0.0), Complex64::new(0.0, 0.0)])[2];
+        gyroemu::mixer::wrap_pi((v * tia.response(f)).arg() - offset)
+    };
+    let (mut a, mut b) = (lo, hi);
+    assert!(err(a) * err(b) < 0.0);
+    for _ in 0..100 {
+        let m = 0.5 * (a + b);
+        if err(a) * err(m) <= 0.0 {
+            b = m;
+        } else {
+            a = m;
+        }
+    }
+    0.5 * (a + b)
+}
+
+#[test]
+fn the_pll_locks_the_carrier_where_the_chain_phase_says_resonance() {
+    let base = config(
+        "coriolis",
+        15e3,
+        2000.0,
+        1.0,
+        1.0,
+        &[25.0, 100.0, 175.0],
+        1.0,
+    );
+    let half_bw = 15e3 / (2.0 * 2000.0);
+    for start in [-3.0, 5.0] {
+        let c = with_pll(base.clone(), start * half_bw);
+        let p = pll_params(&c, &c).unwrap().unwrap();
+        let lock = lock_config_carrier(&c, &c).unwrap().unwrap();
+        let want = true_lock_hz(&c, p.phase_offset_rad, 15e3 - 10.0, 15e3 + 10.0);
+        // The image of 2 f_c through the low-pass and the lock tolerance: 1e-4 half-bandwidths.
+        assert!(
+            (lock.carrier_hz - want).abs() < 1e-4 * half_bw,
+            "start {start}: locked {} Hz, truth {want} Hz",
+            lock.carrier_hz
+        );
+        // The offset is taken at the starting carrier, where the hold and the TIA pole turn
+        // a little differently from the resonance: the truth sits within 1e-3 half-bandwidths
+        // of f0.
+        assert!((want - 15e3).abs() < 1e-3 * half_bw, "{want}");
+        let t = lock.lock_time_s.expect("locked");
+        assert!(t > 0.0 && t < c.pll_lock_s().unwrap(), "{t}");
+    }
+}
+
+#[test]
+fn a_sweep_with_a_pll_reads_like_a_tuned_board() {
+    // Started 4 half-bandwidths off, open loop would read a fifth of the tuned slope (see
+    // detuned_carrier.rs); locked, the phases are the tuned board's to 1e-3 of their size.
+    let base = config(
+        "coriolis",
+        15e3,
+        2000.0,
+        1.0,
+        1.0,
+        &[25.0, 100.0, 175.0],
+        1.0,
+    );
+    let c = with_pll(base.clone(), 4.0 * 3.75);
+    let (held, lock) = resolve_lock(&c).unwrap();
+    assert!(lock.is_some() && held.pll.is_none());
+    let tuned = run(&base);
+    let locked = run(&held);
+    for (a, b) in tuned.points.iter().zip(&locked.points) {
+        for k in 0..2 {
+            assert!(
+                (a.phase_deg[k] - b.phase_deg[k]).abs() < 1e-3 * a.phase_deg[k],
+                "{a:?} vs {b:?}"
+            );
+        }
+    }
+    let mut open = c.clone();
+    open.pll = None;
+    let open = run(&open);
+    assert!(open.points[2].phase_deg[0] < 0.2 * tuned.points[2].phase_deg[0]);
+}
+
+#[test]
+fn a_lock_run_too_short_is_an_error_not_a_carrier() {
+    let base = config("coriolis", 15e3, 2000.0, 1.0, 1.0, &[25.0], 1.0);
+    let mut c = with_pll(base, 20.0 * 3.75);
+    let natural = c.pll_natural_hz().unwrap();
+    // Just over the 5 loop time constants validation asks for: far too short from 20
+    // half-bandwidths away.
+    c.pll.as_mut().unwrap().lock_s =
+        Some(5.5 / (core::f64::consts::FRAC_1_SQRT_2 * core::f64::consts::TAU * natural));
+    c.validate().unwrap();
+    let e = lock_config_carrier(&c, &c).unwrap_err();
+    assert!(
+        e.to_string().contains("did not lock within pll.lock_s"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_loop_that_cannot_be_built_is_refused_before_any_sample() {
+    // A 20 Hz low-pass (group delay ~ 13 ms) allows at most 0.6 Hz; a Q of 200 needs at
+    // least 26 Hz for a PI on the frequency.
+    let mut c = config("coriolis", 15e3, 200.0, 1.0, 1.0, &[25.0], 1.0);
+    c.board.lpf_cutoff_hz = Some(20.0);
+    let c = with_pll_unchecked(c);
+    let e = c.validate().unwrap_err();
+    assert_eq!(e.key.as_deref(), Some("pll.natural_hz"), "{e}");
+    assert!(e.to_string().contains("no loop fits"), "{e}");
+}
+
+fn with_pll_unchecked(mut c: Config) -> Config {
+    c.pll = Some(gyroemu::config::PllConfig {
+        natural_hz: None,
+        damping: core::f64::consts::FRAC_1_SQRT_2,
+        lock_s: None,
+        mode: 1,
+    });
+    c
+}
