@@ -40,25 +40,26 @@ enum Command {
     Run {
         /// The config file (see `gyroemu config`).
         config: PathBuf,
-        /// Output folder. Points already computed there for the same config are reused, so
-        /// rerunning an interrupted command resumes it.
-        #[arg(long, default_value = "out")]
-        out: PathBuf,
-        /// Run only shard I of N (0-based) of the operating points: point p belongs to shard
-        /// p % N; then `gyroemu merge OUT`. Default: from SLURM_ARRAY_TASK_ID or
-        /// JOB_COMPLETION_INDEX when set (see docs/cluster.md).
-        #[arg(long, value_name = "I/N")]
-        shard: Option<String>,
-        /// The shard count N beside JOB_COMPLETION_INDEX (or GYROEMU_SHARD_COUNT).
-        #[arg(long, value_name = "N")]
-        shard_count: Option<usize>,
-        /// Run even when the plan exceeds the cap of 1e11 point-samples, and delete results
-        /// of another config found in the output folder instead of refusing.
-        #[arg(long)]
-        force: bool,
+        #[command(flatten)]
+        out: cmd::out_args::OutArgs,
     },
-    /// Check the shards in DIR (all present, one config, every point once) and write the
-    /// results a one-machine run would have written.
+    /// A production lot: devices drawn from the tolerances of the config's [montecarlo]
+    /// section, each self-calibrated on the emulated board; writes the distribution of the
+    /// self-calibration error and the yield within the spec.
+    Montecarlo {
+        /// The config file (the nominal device, board and sweeps, plus [montecarlo]).
+        config: PathBuf,
+        /// Devices in the lot (device i is the same in a lot of any size).
+        #[arg(long, value_name = "N", required_unless_present = "print_device")]
+        devices: Option<usize>,
+        #[command(flatten)]
+        out: cmd::out_args::OutArgs,
+        /// Print the config of device I (for `gyroemu selfcal`) instead of running the lot.
+        #[arg(long, value_name = "I", conflicts_with_all = ["shard", "shard_count", "force"])]
+        print_device: Option<u64>,
+    },
+    /// Check the shards in DIR (all present, one config, every point or device once) and
+    /// write the results a one-machine run would have written.
     Merge {
         /// The output folder the shards wrote into.
         dir: PathBuf,
@@ -195,18 +196,17 @@ fn run_cli() -> ExitCode {
     }
     let result = match cli.command {
         Command::Reproduce { out, quick } => cmd::reproduce::reproduce_command(&out, quick),
-        Command::Run {
+        Command::Run { config, out } => cmd::run::run_command(&config, &out),
+        Command::Montecarlo {
             config,
+            devices,
             out,
-            shard,
-            shard_count,
-            force,
-        } => cmd::run::run_command(&cmd::run::RunArgs {
+            print_device,
+        } => cmd::montecarlo::montecarlo_command(&cmd::montecarlo::MonteCarloArgs {
             config: &config,
+            devices,
             out: &out,
-            shard: shard.as_deref(),
-            shard_count,
-            force,
+            print_device,
         }),
         Command::Merge { dir } => cmd::merge::merge_command(&dir),
         Command::Selfcal { config, out, force } => {

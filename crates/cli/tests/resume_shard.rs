@@ -6,9 +6,12 @@
 //! duplicated point, a missing point file, an unfinished shard and a shard of another config;
 //! a run refuses an output folder holding another config's results unless `--force`.
 
+mod common;
+
+use common::*;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
 /// A Coriolis sweep with every noise source (so each point's random stream matters): nine
 /// listed rates plus the implicit zero, three lane groups.
@@ -61,46 +64,6 @@ settle_s = 0.05
 
 const OUTPUTS: [&str; 3] = ["results.csv", "summary.json", "plot.png"];
 
-/// Scheduler variables that must not leak into the children from the test's environment.
-const SCHED_VARS: [&str; 8] = [
-    "SLURM_ARRAY_TASK_STEP",
-    "SLURM_ARRAY_TASK_ID",
-    "SLURM_ARRAY_TASK_COUNT",
-    "SLURM_ARRAY_TASK_MIN",
-    "SLURM_ARRAY_TASK_MAX",
-    "JOB_COMPLETION_INDEX",
-    "GYROEMU_SHARD_COUNT",
-    "RAYON_NUM_THREADS",
-];
-
-fn command(args: &[&str], env: &[(&str, &str)]) -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_gyroemu"));
-    for v in SCHED_VARS {
-        c.env_remove(v);
-    }
-    c.args(args).envs(env.iter().copied());
-    c
-}
-
-fn gyroemu(args: &[&str], env: &[(&str, &str)]) -> Output {
-    command(args, env).output().expect("binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Writes the config into `dir` and returns its path.
-fn config(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
 /// `gyroemu [--threads t] run CFG --out OUT EXTRA...` with `env`.
 fn run(cfg: &Path, out: &Path, threads: &str, extra: &[&str], env: &[(&str, &str)]) -> Output {
     let mut args = vec!["--threads", threads, "run", s(cfg), "--out", s(out)];
@@ -108,21 +71,8 @@ fn run(cfg: &Path, out: &Path, threads: &str, extra: &[&str], env: &[(&str, &str
     gyroemu(&args, env)
 }
 
-fn ok(o: Output) -> Output {
-    assert!(o.status.success(), "{}", stderr(&o));
-    o
-}
-
 fn assert_same_outputs(a: &Path, b: &Path) {
-    for f in OUTPUTS {
-        let (x, y) = (std::fs::read(a.join(f)), std::fs::read(b.join(f)));
-        assert!(x.is_ok() && y.is_ok(), "{f} missing in {a:?} or {b:?}");
-        assert!(x.unwrap() == y.unwrap(), "{f} differs: {a:?} vs {b:?}");
-    }
-}
-
-fn json(p: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    assert_same_files(a, b, &OUTPUTS);
 }
 
 fn indices(v: &Value) -> Vec<u64> {
@@ -167,24 +117,8 @@ fn sigint_saves_finished_points_and_the_rerun_completes() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = config(dir.path(), "c.toml", &text);
     let out = dir.path().join("out");
-    let mut child = command(&["--threads", "1", "run", s(&cfg), "--out", s(&out)], &[])
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let t0 = std::time::Instant::now();
-    while point_files(&out) == 0 {
-        assert!(t0.elapsed().as_secs() < 60, "no point file appeared");
-        if child.try_wait().unwrap().is_some() {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(2));
-    }
-    let killed = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(killed.success());
-    let o = child.wait_with_output().unwrap();
+    let args = ["--threads", "1", "run", s(&cfg), "--out", s(&out)];
+    let o = interrupted(&args, || point_files(&out) > 0);
     assert_interrupted(&o, &out, 10);
     ok(run(&cfg, &out, "2", &[], &[]));
     let reference = dir.path().join("ref");

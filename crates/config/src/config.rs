@@ -29,6 +29,9 @@ pub struct Config {
     /// carrier is `drive.carrier_hz`, open loop).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pll: Option<PllConfig>,
+    /// The production lot of `gyroemu montecarlo` (absent: that command refuses the config).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub montecarlo: Option<MonteCarloConfig>,
 }
 
 /// The carrier PLL (`crates/pll`): at zero rate the board drives the device and the PLL steers
@@ -298,6 +301,54 @@ impl Default for SweepConfig {
     }
 }
 
+/// A production lot (`gyroemu montecarlo`): each device's parameters drawn around the
+/// config's own from the tolerances below, device `i` from `(seed, i)` alone. Every spread is
+/// a standard deviation: of the uniform draw, or of the normal before its truncation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MonteCarloConfig {
+    /// Seed of the device draws (the noise streams keep `noise.seed`, per device).
+    #[serde(default)]
+    pub seed: u64,
+    /// Shape of every draw: `normal` (truncated at `truncate_sigma`) or `uniform`.
+    #[serde(default = "default_distribution")]
+    pub distribution: Distribution,
+    /// Normal draws beyond this many standard deviations are drawn again.
+    #[serde(default = "default_truncate_sigma")]
+    pub truncate_sigma: f64,
+    /// Spread of the mode split `device.mode2_f0_offset_hz` (added to it), Hz.
+    #[serde(default)]
+    pub mode_split_sigma_hz: f64,
+    /// Relative spread of Q (both modes scaled together).
+    #[serde(default)]
+    pub q_sigma_rel: f64,
+    /// Relative spread of the Q mismatch (mode 2's Q scaled alone).
+    #[serde(default)]
+    pub q_mismatch_sigma_rel: f64,
+    /// Relative spread of the drive-gain ratio F2/F1 (F2 scaled).
+    #[serde(default)]
+    pub drive_gain_sigma_rel: f64,
+    /// Spread of the phase-shifter error `board.phase_shifter_error_deg` (added to it), deg.
+    #[serde(default)]
+    pub phase_shifter_sigma_deg: f64,
+    /// Relative spread of the angular gain lambda; the self-calibration keeps predicting with
+    /// the config's (nominal) lambda.
+    #[serde(default)]
+    pub lambda_sigma_rel: f64,
+    /// A device passes when its |self-calibration error| (mode 1) is at most this.
+    pub spec_abs_relative_error: f64,
+}
+
+/// Shape of a Monte Carlo draw (of unit standard deviation before scaling).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Distribution {
+    /// Gaussian, truncated at `truncate_sigma` standard deviations.
+    Normal,
+    /// Flat over +-sqrt(3) standard deviations.
+    Uniform,
+}
+
 /// Which excitation the sweep uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -420,6 +471,12 @@ fn default_adc_full_scale() -> f64 {
 }
 fn default_temperature() -> f64 {
     300.0
+}
+fn default_distribution() -> Distribution {
+    Distribution::Normal
+}
+fn default_truncate_sigma() -> f64 {
+    4.0
 }
 fn default_f0_tc() -> f64 {
     -30.0

@@ -428,6 +428,8 @@ mod tests {
             "\"hann\"",
             "\"constant\"",
             "\"sinusoid\"",
+            "\"normal\"",
+            "\"uniform\"",
             "[]",
             "[1, 2.5]",
             "[1, \"x\"]",

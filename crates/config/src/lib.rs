@@ -14,14 +14,15 @@ mod resolve;
 mod rules;
 mod schema;
 mod validate;
+mod validate_montecarlo;
 mod validate_noise;
 mod validate_regime;
 mod validate_sweep;
 
 pub use config::{
-    BoardConfig, Config, DeviceConfig, DriveConfig, DumpConfig, ExperimentConfig, ExperimentKind,
-    NoiseConfig, PllConfig, RateTable, SelfcalConfig, Spacing, SweepConfig, WindowKind,
-    DEFAULT_SWEEP_POINTS,
+    BoardConfig, Config, DeviceConfig, Distribution, DriveConfig, DumpConfig, ExperimentConfig,
+    ExperimentKind, MonteCarloConfig, NoiseConfig, PllConfig, RateTable, SelfcalConfig, Spacing,
+    SweepConfig, WindowKind, DEFAULT_SWEEP_POINTS,
 };
 pub use error::ConfigError;
 pub use parse::{parse_config, parse_config_explained, plain_words};

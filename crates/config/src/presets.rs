@@ -6,7 +6,7 @@ use crate::error::ConfigError;
 use crate::parse::parse_config;
 
 /// (name, what it reproduces, TOML text).
-pub const PRESETS: [(&str, &str, &str); 8] = [
+pub const PRESETS: [(&str, &str, &str); 9] = [
     (
         "m2tfg-coriolis",
         "Fig. 8: Coriolis run on an M^2-TFG-like gyroscope (default)",
@@ -46,6 +46,11 @@ pub const PRESETS: [(&str, &str, &str); 8] = [
         "m2tfg-sweep",
         "`gyroemu sweep` example: stepped-sine response, 0.5 Hz mode split, Q mismatch, quadrature coupling",
         include_str!("../presets/m2tfg-sweep.toml"),
+    ),
+    (
+        "m2tfg-montecarlo",
+        "`gyroemu montecarlo` example: a lot drawn from tolerances, yield within 2 %",
+        include_str!("../presets/m2tfg-montecarlo.toml"),
     ),
 ];
 

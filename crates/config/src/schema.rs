@@ -182,6 +182,22 @@ pub(crate) const SECTIONS: &[Section] = &[
             opt("mode", COUNT),
         ],
     },
+    Section {
+        name: "montecarlo",
+        required: false,
+        fields: &[
+            opt("seed", SEED),
+            opt("distribution", Choice(&["normal", "uniform"])),
+            opt("truncate_sigma", Number),
+            opt("mode_split_sigma_hz", Number),
+            opt("q_sigma_rel", Number),
+            opt("q_mismatch_sigma_rel", Number),
+            opt("drive_gain_sigma_rel", Number),
+            opt("phase_shifter_sigma_deg", Number),
+            opt("lambda_sigma_rel", Number),
+            req("spec_abs_relative_error", Number),
+        ],
+    },
 ];
 
 /// `` `a` ``, `` `a` or `b` ``, `` one of `a`, `b`, `c` `` (what follows "expected").

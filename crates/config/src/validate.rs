@@ -37,6 +37,7 @@ impl Config {
         self.validate_device_board(&mut p);
         self.validate_experiment(&mut p, &mut warnings);
         self.validate_noise_adc_selfcal(&mut p, &mut warnings);
+        self.validate_montecarlo(&mut p);
         // The regime rules weigh the whole chain: only once its keys are each valid.
         if ["device", "drive", "board"]
             .iter()

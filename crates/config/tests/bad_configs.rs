@@ -10,6 +10,7 @@ use gyroemu_config::{parse_config, ConfigError};
 const C: &str = "m2tfg-coriolis";
 const R: &str = "m2tfg-rotating";
 const T: &str = "m2tfg-ratetable";
+const M: &str = "m2tfg-montecarlo";
 const S: &str = "m2tfg-sweep";
 
 /// How the edited config must fail.
@@ -187,6 +188,7 @@ fn cases() -> Vec<Case> {
         "\n[selfcal]\ntau_max_s = 10.0\ndrift_delta_t_k = [10.0]\n",
     );
     let dumped = with(c.clone(), DUMP);
+    let m = base(M);
     let sw = base(S);
     vec![
         // Unknown or misspelt keys, in every section.
@@ -932,6 +934,98 @@ fn cases() -> Vec<Case> {
                 "[20.0]",
             ),
             &["selfcal.drift_delta_t_k[0]", "20", "keep Q and f0 > 0"],
+        ),
+        // Monte Carlo keys.
+        parse_case(
+            "misspelt montecarlo key",
+            rename(&m, "montecarlo", "q_sigma_rel", "q_sigma"),
+            &[
+                "montecarlo.q_sigma",
+                "unknown key",
+                "did you mean `q_sigma_rel`?",
+            ],
+        ),
+        parse_case(
+            "unknown distribution",
+            set(&m, "montecarlo", "distribution", "\"gauss\""),
+            &["montecarlo.distribution", "\"normal\" or \"uniform\""],
+        ),
+        parse_case(
+            "montecarlo seed negative",
+            set(&m, "montecarlo", "seed", "-1"),
+            &["montecarlo.seed", "-1"],
+        ),
+        parse_case(
+            "montecarlo spec missing",
+            missing(&m, "montecarlo", "spec_abs_relative_error"),
+            &[
+                "montecarlo.spec_abs_relative_error",
+                "missing",
+                "[montecarlo] requires it",
+            ],
+        ),
+        invalid(
+            "negative spread",
+            set(&m, "montecarlo", "mode_split_sigma_hz", "-0.1"),
+            &[
+                "montecarlo.mode_split_sigma_hz",
+                "-0.1",
+                "a standard deviation",
+            ],
+        ),
+        invalid(
+            "spread nan",
+            set(&m, "montecarlo", "phase_shifter_sigma_deg", "nan"),
+            &["montecarlo.phase_shifter_sigma_deg", "NaN", ">= 0"],
+        ),
+        invalid(
+            "spec zero",
+            set(&m, "montecarlo", "spec_abs_relative_error", "0.0"),
+            &["montecarlo.spec_abs_relative_error", "= 0", "> 0"],
+        ),
+        invalid(
+            "truncation out of range",
+            set(&m, "montecarlo", "truncate_sigma", "0.5"),
+            &["montecarlo.truncate_sigma", "0.5", "from 1 to 8"],
+        ),
+        invalid(
+            "Q spread reaching Q <= 0 at the truncation",
+            set(&m, "montecarlo", "q_sigma_rel", "0.3"),
+            &["montecarlo.q_sigma_rel", "0.3", "below 0.25", "Q <= 0"],
+        ),
+        invalid(
+            "drive-gain spread reaching F2 <= 0 (uniform)",
+            set(
+                &set(&m, "montecarlo", "distribution", "\"uniform\"").0,
+                "montecarlo",
+                "drive_gain_sigma_rel",
+                "0.6",
+            ),
+            &[
+                "montecarlo.drive_gain_sigma_rel",
+                "0.6",
+                "below 0.57735 ",
+                "sqrt(3)",
+            ],
+        ),
+        invalid(
+            "lambda spread reaching lambda <= 0",
+            set(&m, "montecarlo", "lambda_sigma_rel", "0.25"),
+            &["montecarlo.lambda_sigma_rel", "0.25", "lambda <= 0"],
+        ),
+        invalid(
+            "Q mismatch spread reaching Q2 <= 0",
+            set(&m, "montecarlo", "q_mismatch_sigma_rel", "1.0"),
+            &["montecarlo.q_mismatch_sigma_rel", "Q of mode 2 <= 0"],
+        ),
+        invalid(
+            "mode split spread reaching a mode-2 resonance <= 0",
+            set(&m, "montecarlo", "mode_split_sigma_hz", "4000.0"),
+            &[
+                "montecarlo.mode_split_sigma_hz",
+                "4000",
+                "mode-2 resonance > 0",
+            ],
         ),
         // Frequency-sweep keys (the sweep preset has a [sweep] section, so every command
         // judges it).

@@ -49,6 +49,13 @@ impl NoiseRng {
         }
         Self { s }
     }
+
+    /// Uniform in [-1/2, 1/2) on each lane, from the top 53 bits of the next output of its
+    /// stream a (a production lot's uniform draws; the board's noise takes normals).
+    pub fn uniform_centered(&mut self) -> wide::f64x4 {
+        let u = step(&mut self.s[0]).to_array();
+        wide::f64x4::new(u.map(|x| (x >> 11) as f64 * (1.0 / (1u64 << 53) as f64) - 0.5))
+    }
 }
 
 /// One xoshiro256++ step of four lanes' states `s[word]` (Blackman and Vigna 2019): the next
@@ -132,6 +139,21 @@ pub(crate) mod tests {
                 for (l, r) in refs.iter_mut().enumerate() {
                     assert_eq!(v[l], r[h].next(), "lane {l} stream {h}");
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn uniforms_are_the_top_53_bits_of_stream_a() {
+        let seeds = [3, 5, 7, 11];
+        let mut rng = NoiseRng::new(seeds);
+        let mut refs = reference_streams(seeds);
+        for _ in 0..1000 {
+            let u = rng.uniform_centered().to_array();
+            for (l, r) in refs.iter_mut().enumerate() {
+                let want = (r[0].next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                assert_eq!(u[l].to_bits(), want.to_bits());
+                assert!((-0.5..0.5).contains(&u[l]));
             }
         }
     }

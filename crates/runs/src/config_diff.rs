@@ -1,8 +1,10 @@
 //! Which keys differ between the config that wrote an output folder and the one now run, so
 //! a refusal can say what changed instead of two hashes.
 
+use crate::device_file::lot_config;
+use crate::manifest::RunKind;
 use crate::points::result_config;
-use gyroemu_config::Config;
+use gyroemu_config::{parse_config, Config};
 use std::collections::BTreeMap;
 
 /// The keys of the result part of a config ([`result_config`]) whose values differ between
@@ -10,20 +12,45 @@ use std::collections::BTreeMap;
 /// `key: old -> new` (`(unset)` on the side that lacks the key).
 pub fn config_diff(old: &str, new: &Config) -> Result<Vec<String>, String> {
     let mut old: toml::Table = toml::from_str(old).map_err(|e| e.to_string())?;
-    for ignored in ["dump", "selfcal"] {
+    for ignored in ["dump", "selfcal", "sweep", "montecarlo"] {
         old.remove(ignored);
     }
     let new = toml::Table::try_from(result_config(new)).map_err(|e| e.to_string())?;
+    Ok(diff_tables(&old, &new))
+}
+
+/// [`config_diff`] for a folder of `kind`: a lot's identity is [`lot_config`], and `old`
+/// must parse as a config of this version.
+pub fn config_diff_for(kind: RunKind, old: &str, new: &Config) -> Result<Vec<String>, String> {
+    match kind {
+        RunKind::Run => config_diff(old, new),
+        RunKind::Montecarlo => {
+            let old = parse_config(old).map_err(|e| e.to_string())?;
+            let table =
+                |c: &Config| toml::Table::try_from(lot_config(c)).map_err(|e| e.to_string());
+            Ok(diff_tables(&table(&old)?, &table(new)?))
+        }
+    }
+}
+
+/// The keys whose values differ between two canonical config texts, all of their keys
+/// compared.
+pub(crate) fn text_diff(old: &str, new: &str) -> Result<Vec<String>, String> {
+    let table = |t: &str| toml::from_str::<toml::Table>(t).map_err(|e| e.to_string());
+    Ok(diff_tables(&table(old)?, &table(new)?))
+}
+
+/// The keys whose values differ between two config tables, as `key: old -> new`.
+fn diff_tables(old: &toml::Table, new: &toml::Table) -> Vec<String> {
     let (mut a, mut b) = (BTreeMap::new(), BTreeMap::new());
-    flatten("", &old, &mut a);
-    flatten("", &new, &mut b);
+    flatten("", old, &mut a);
+    flatten("", new, &mut b);
     let show = |v: Option<&toml::Value>| v.map_or("(unset)".to_string(), render);
     let keys: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
-    Ok(keys
-        .into_iter()
+    keys.into_iter()
         .filter(|k| a.get(*k) != b.get(*k))
         .map(|k| format!("{k}: {} -> {}", show(a.get(k)), show(b.get(k))))
-        .collect())
+        .collect()
 }
 
 /// A value as a user writes it (floats in Rust's shortest round-trip form, e.g. `1e-13`).

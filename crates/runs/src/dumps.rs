@@ -6,6 +6,7 @@
 use crate::error::RunError;
 use crate::manifest::read_manifest;
 use crate::points::{PointFile, POINTS_DIR};
+use crate::records::RecordFile;
 use gyroemu_board::{LaneResult, Probe};
 use gyroemu_config::Config;
 use gyroemu_experiment::{dump_point, Reporter, DUMP_STEM};

@@ -2,7 +2,6 @@
 //! what to do next, and the canonical config (so `merge` can rebuild the results).
 
 use crate::error::RunError;
-use gyroemu_board::LaneResult;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -12,6 +11,27 @@ pub const MANIFEST_FORMAT: &str = "gyroemu-manifest/1";
 
 /// The manifest of a one-machine run.
 pub const RUN_MANIFEST: &str = "manifest.json";
+
+/// What an output folder holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RunKind {
+    /// A sweep (`gyroemu run`): the points are its operating points.
+    #[default]
+    Run,
+    /// A production lot (`gyroemu montecarlo`): the points are its devices.
+    Montecarlo,
+}
+
+impl RunKind {
+    /// How the user names it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            RunKind::Run => "a sweep of `gyroemu run`",
+            RunKind::Montecarlo => "a lot of `gyroemu montecarlo`",
+        }
+    }
+}
 
 /// A shard's place in the split.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -27,15 +47,18 @@ pub struct ShardId {
 pub struct Manifest {
     /// [`MANIFEST_FORMAT`].
     pub format: String,
+    /// What the folder holds (absent in manifests of older versions: a sweep).
+    #[serde(default)]
+    pub kind: RunKind,
     /// `running`, `interrupted`, `failed` or `complete`.
     pub status: String,
     /// SHA-256 of the canonical config TOML.
     pub config_sha256: String,
     /// The shard (absent: the whole sweep).
     pub shard: Option<ShardId>,
-    /// Operating points of the whole sweep.
+    /// Operating points of the whole sweep (devices of the whole lot).
     pub points_total: usize,
-    /// The point indices this run or shard is responsible for.
+    /// The point (device) indices this run or shard is responsible for.
     pub points: Vec<usize>,
     /// Of those, the ones whose results are in `points/`.
     pub points_done: Vec<usize>,
@@ -49,19 +72,23 @@ pub struct Manifest {
 }
 
 impl Manifest {
-    /// A manifest for `points` of a sweep, those in `done` being finished (`next` empty).
-    pub fn new(
+    /// A manifest for `points` of a sweep or lot, those in `done` being finished (`next`
+    /// empty).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new<V>(
+        kind: RunKind,
         status: &str,
         hash: &str,
         config_toml: &str,
         shard: Option<ShardId>,
         points_total: usize,
         points: &[usize],
-        done: &BTreeMap<usize, LaneResult>,
+        done: &BTreeMap<usize, V>,
     ) -> Self {
         let (d, m): (Vec<usize>, Vec<usize>) = points.iter().partition(|i| done.contains_key(i));
         Self {
             format: MANIFEST_FORMAT.to_string(),
+            kind,
             status: status.to_string(),
             config_sha256: hash.to_string(),
             shard,
@@ -90,6 +117,14 @@ impl Manifest {
     pub fn write(&self, path: &Path) -> Result<(), RunError> {
         gyroemu_io::write_json(path, self)
             .map_err(|e| RunError::Report(gyroemu_report::ReportError::Io(e)))
+    }
+}
+
+/// The manifest of a run in `out`: `manifest.json`, or the shard's `shard-I-of-N.json`.
+pub(crate) fn manifest_path(out: &Path, shard: Option<&crate::shard::Shard>) -> PathBuf {
+    match shard {
+        Some(s) => out.join(s.manifest_name()),
+        None => out.join(RUN_MANIFEST),
     }
 }
 

@@ -1,25 +1,49 @@
-//! Merging the shards of a sweep. Every shard `I/N` of one split must have
-//! left a complete `shard-I-of-N.json` with the same config hash, the shards' points must
-//! cover every operating point exactly once, and every point's file must be there; then the
-//! results are built from the point files exactly as a one-machine run builds them.
+//! Merging the shards of a sweep or a lot. Every shard `I/N` of one split must have left a
+//! complete `shard-I-of-N.json` of the same kind and config hash, the shards' items (points,
+//! devices) must cover every item exactly once, and every item's file must be there; then
+//! the results are built from the files exactly as one machine builds them.
 
-use crate::config_diff::{config_diff, describe_diff};
+use crate::config_diff::{config_diff_for, describe_diff};
 use crate::error::RunError;
-use crate::manifest::{read_manifest, shard_manifest_paths, Manifest, RUN_MANIFEST};
-use crate::points::{config_hash, scan_points, PointFile, POINTS_DIR};
+use crate::manifest::{read_manifest, shard_manifest_paths, Manifest, RunKind, RUN_MANIFEST};
+use crate::points::{config_hash, scan_points, PointFile};
+use crate::records::{scan_records, RecordFile};
 use gyroemu_config::parse_config;
 use gyroemu_experiment::{finish_sweep, resolve_lock, Reporter};
 use gyroemu_report::{check_problems, run_title, write_run};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-fn bad(msg: String) -> RunError {
+pub(crate) fn bad(msg: String) -> RunError {
     RunError::BadInput(msg)
 }
 
-/// Checks the shards in `dir` and writes `results.csv`, `summary.json`, `plot.png` and the
-/// run manifest there; returns the files written.
+/// The shards of one split found in a folder, checked: every index present and complete,
+/// one kind, one config hash.
+pub(crate) struct Split {
+    pub count: usize,
+    pub kind: RunKind,
+    pub hash: String,
+    /// The file name of the first shard's manifest, and the manifest.
+    pub first_name: String,
+    pub first: Manifest,
+    /// Every shard's manifest (file name, manifest) by shard index.
+    pub by_index: BTreeMap<usize, (String, Manifest)>,
+}
+
+/// Checks the shards in `dir` and writes the results one machine would have written there
+/// (a sweep's `results.csv`, `summary.json`, `plot.png`; a lot's `devices.csv`,
+/// `montecarlo.json`, `histogram.png`, `percentiles.png`) and the run manifest; returns the
+/// files written.
 pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunError> {
+    let split = read_split(dir)?;
+    match split.kind {
+        RunKind::Run => merge_run(dir, split, reporter),
+        RunKind::Montecarlo => crate::lot_merge::merge_lot(dir, split, reporter),
+    }
+}
+
+fn read_split(dir: &Path) -> Result<Split, RunError> {
     if !dir.is_dir() {
         return Err(bad(format!("`{}` is not a folder", dir.display())));
     }
@@ -53,8 +77,8 @@ pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunErr
         }
         shards.push((name, m));
     }
-    // One split, one config.
-    let (first_name, first) = &shards[0];
+    // One split, one kind, one config.
+    let (first_name, first) = shards[0].clone();
     let count = first.shard.map_or(0, |s| s.count);
     let hash = first.config_sha256.clone();
     for (name, m) in &shards[1..] {
@@ -66,10 +90,19 @@ pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunErr
                 dir.display()
             )));
         }
+        if m.kind != first.kind {
+            return Err(bad(format!(
+                "`{name}` is a shard of {}, `{first_name}` of {}: keep the shards of one split \
+                 in `{}`",
+                m.kind.describe(),
+                first.kind.describe(),
+                dir.display()
+            )));
+        }
         if m.config_sha256 != hash {
             let differs = parse_config(&m.config_toml)
                 .ok()
-                .and_then(|c| config_diff(&first.config_toml, &c).ok())
+                .and_then(|c| config_diff_for(first.kind, &first.config_toml, &c).ok())
                 .filter(|d| !d.is_empty())
                 .map_or(String::new(), |d| {
                     format!("; they differ in {}", describe_diff(&d, 12))
@@ -82,9 +115,9 @@ pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunErr
             )));
         }
     }
-    let by_index: BTreeMap<usize, &Manifest> = shards
-        .iter()
-        .filter_map(|(_, m)| m.shard.map(|s| (s.index, m)))
+    let by_index: BTreeMap<usize, (String, Manifest)> = shards
+        .into_iter()
+        .filter_map(|(name, m)| m.shard.map(|s| (s.index, (name, m))))
         .collect();
     let absent: Vec<String> = (0..count)
         .filter(|i| !by_index.contains_key(i))
@@ -99,10 +132,11 @@ pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunErr
             dir.display()
         )));
     }
-    for (i, m) in &by_index {
+    let item = item_name(first.kind);
+    for (i, (_, m)) in &by_index {
         if m.status != "complete" {
             return Err(bad(format!(
-                "shard {i}/{count} is {} ({} of its {} points missing): rerun it with --shard \
+                "shard {i}/{count} is {} ({} of its {} {item}s missing): rerun it with --shard \
                  {i}/{count} to finish it",
                 m.status,
                 m.points_missing.len(),
@@ -110,10 +144,175 @@ pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunErr
             )));
         }
     }
-    // The config: the one the shards ran, bit for bit.
-    let cfg = parse_config(&first.config_toml)
+    Ok(Split {
+        count,
+        kind: first.kind,
+        hash,
+        first_name,
+        first,
+        by_index,
+    })
+}
+
+/// What the items of a kind are called.
+fn item_name(kind: RunKind) -> &'static str {
+    match kind {
+        RunKind::Run => "point",
+        RunKind::Montecarlo => "device",
+    }
+}
+
+impl Split {
+    /// Which shard ran each of the `n` items: every item claimed by exactly one shard.
+    pub(crate) fn owners(&self, n: usize) -> Result<BTreeMap<usize, usize>, RunError> {
+        let (count, item) = (self.count, item_name(self.kind));
+        let mut owner: BTreeMap<usize, usize> = BTreeMap::new();
+        for (&i, (_, m)) in &self.by_index {
+            for &p in &m.points {
+                if p >= n {
+                    return Err(bad(format!(
+                        "shard {i}/{count} lists {item} {p}, but the {} has {n} {item}s",
+                        if self.kind == RunKind::Run {
+                            "config"
+                        } else {
+                            "lot"
+                        }
+                    )));
+                }
+                if let Some(j) = owner.insert(p, i) {
+                    return Err(bad(format!(
+                        "{item} {p} is duplicated: shards {j}/{count} and {i}/{count} both ran it"
+                    )));
+                }
+            }
+        }
+        let unclaimed: Vec<usize> = (0..n).filter(|p| !owner.contains_key(p)).collect();
+        if !unclaimed.is_empty() {
+            return Err(bad(format!(
+                "{item}s {unclaimed:?} are missing: no shard ran them"
+            )));
+        }
+        Ok(owner)
+    }
+
+    /// Every item's record of this split's config in `dir`, once each: refuses a file that
+    /// is not a record, a record of another config, a duplicated one, and a missing one
+    /// (naming its shard). Records of the same config beyond `n` are ignored when
+    /// `ignore_beyond` (a lot's devices of a larger lot).
+    pub(crate) fn records<R: RecordFile>(
+        &self,
+        dir: &Path,
+        n: usize,
+        ignore_beyond: bool,
+    ) -> Result<BTreeMap<usize, (PathBuf, R)>, RunError> {
+        let owner = self.owners(n)?;
+        let scan = scan_records::<R>(dir).map_err(bad)?;
+        if let Some((p, why)) = scan.bad.first() {
+            return Err(bad(format!(
+                "`{}` is not a gyroemu {} file ({why}): remove it",
+                p.display(),
+                R::STEM
+            )));
+        }
+        if let Some((p, f)) = scan
+            .files
+            .iter()
+            .find(|(_, f)| f.config_sha256() != self.hash)
+        {
+            let h = f.config_sha256();
+            return Err(bad(format!(
+                "`{}` ({} {}) belongs to another config (sha256 {}): remove it",
+                p.display(),
+                R::STEM,
+                f.index(),
+                &h[..h.len().min(12)]
+            )));
+        }
+        let found = scan
+            .by_index(&self.hash, n, ignore_beyond)
+            .map_err(bad)?
+            .into_iter()
+            .map(|(i, (p, _))| (i, p.to_path_buf()))
+            .collect::<BTreeMap<usize, PathBuf>>();
+        let lost: Vec<String> = (0..n)
+            .filter(|p| !found.contains_key(p))
+            .map(|p| {
+                format!(
+                    "{} (shard {}/{})",
+                    dir.join(R::DIR).join(R::file_name(p)).display(),
+                    owner[&p],
+                    self.count
+                )
+            })
+            .collect();
+        if !lost.is_empty() {
+            return Err(bad(format!(
+                "{} files missing although their shards are complete: {}; rerun those shards",
+                R::STEM,
+                lost.join(", ")
+            )));
+        }
+        let mut files = scan.files;
+        files.retain(|(_, f)| f.config_sha256() == self.hash && f.index() < n);
+        Ok(files
+            .into_iter()
+            .map(|(p, f)| (f.index(), (p, f)))
+            .collect())
+    }
+
+    /// Writes the run manifest of the merge: `complete` with `files` listed, or `failed` with
+    /// the cause of `result`'s error (the shards' manifests stay as they are).
+    pub(crate) fn finish<T>(
+        &self,
+        dir: &Path,
+        n: usize,
+        result: Result<T, RunError>,
+    ) -> Result<(T, PathBuf), RunError> {
+        let all: Vec<usize> = (0..n).collect();
+        let done: BTreeMap<usize, ()> = all.iter().map(|&i| (i, ())).collect();
+        let mut m = Manifest::new(
+            self.kind,
+            "complete",
+            &self.hash,
+            &self.first.config_toml,
+            None,
+            n,
+            &all,
+            &done,
+        );
+        let path = dir.join(RUN_MANIFEST);
+        match result {
+            Ok(t) => {
+                m.next = format!("merged from {} shards", self.count);
+                m.write(&path)?;
+                Ok((t, path))
+            }
+            Err(e) => {
+                m.status = "failed".into();
+                m.next = format!(
+                    "fix the cause ({e}) and rerun gyroemu merge {}",
+                    dir.display()
+                );
+                Err(match m.write(&path) {
+                    Ok(()) => e,
+                    Err(w) => RunError::Unrecorded {
+                        cause: Box::new(e),
+                        manifest: path,
+                        why: w.to_string(),
+                    },
+                })
+            }
+        }
+    }
+}
+
+/// A sweep's merge: the config the shards ran, bit for bit, every point's file, then the
+/// results built from them.
+fn merge_run(dir: &Path, split: Split, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunError> {
+    let first_name = &split.first_name;
+    let cfg = parse_config(&split.first.config_toml)
         .map_err(|e| bad(format!("`{first_name}`: its config does not parse: {e}")))?;
-    if config_hash(&cfg) != hash {
+    if config_hash(&cfg) != split.hash {
         return Err(bad(format!(
             "`{first_name}`: its config text does not match its config hash"
         )));
@@ -125,93 +324,20 @@ pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunErr
         reporter.warn(&format!("{first_name}: {w}"));
     }
     let n = cfg.emulated_rates_dps().len();
-    // Every point claimed by exactly one shard.
-    let mut owner: BTreeMap<usize, usize> = BTreeMap::new();
-    for (&i, m) in &by_index {
-        for &p in &m.points {
-            if p >= n {
-                return Err(bad(format!(
-                    "shard {i}/{count} lists point {p}, but the config has {n} points"
-                )));
-            }
-            if let Some(j) = owner.insert(p, i) {
-                return Err(bad(format!(
-                    "point {p} is duplicated: shards {j}/{count} and {i}/{count} both ran it"
-                )));
-            }
-        }
-    }
-    let unclaimed: Vec<usize> = (0..n).filter(|p| !owner.contains_key(p)).collect();
-    if !unclaimed.is_empty() {
-        return Err(bad(format!(
-            "points {unclaimed:?} are missing: no shard ran them"
-        )));
-    }
-    // Every point's file, once, of this config.
-    let scan = scan_points(dir).map_err(bad)?;
-    if let Some((p, why)) = scan.bad.first() {
-        return Err(bad(format!(
-            "`{}` is not a gyroemu point file ({why}): remove it",
-            p.display()
-        )));
-    }
-    if let Some((p, f)) = scan.files.iter().find(|(_, f)| f.config_sha256 != hash) {
-        return Err(bad(format!(
-            "`{}` (point {}) belongs to another config (sha256 {}): remove it",
-            p.display(),
-            f.index,
-            &f.config_sha256[..f.config_sha256.len().min(12)]
-        )));
-    }
-    let lanes = scan.lanes(&hash, n).map_err(bad)?;
-    let lost: Vec<String> = (0..n)
-        .filter(|p| !lanes.contains_key(p))
-        .map(|p| {
-            format!(
-                "{} (shard {}/{count})",
-                dir.join(POINTS_DIR).join(PointFile::file_name(p)).display(),
-                owner[&p]
-            )
-        })
-        .collect();
-    if !lost.is_empty() {
-        return Err(bad(format!(
-            "point files missing although their shards are complete: {}; rerun those shards",
-            lost.join(", ")
-        )));
-    }
+    split.records::<PointFile>(dir, n, false)?;
+    let lanes = scan_points(dir)
+        .and_then(|s| s.lanes(&split.hash, n))
+        .map_err(bad)?;
     // The shards swept at the carrier a [pll] locked: lock again (the same bits) to read out.
     let (held, lock) = resolve_lock(&cfg)?;
     if let Some(l) = &lock {
         reporter.note(&crate::run::lock_note(l));
     }
     let r = finish_sweep(&held, &lanes)?;
-    let all: Vec<usize> = (0..n).collect();
-    let mut m = Manifest::new("complete", &hash, &first.config_toml, None, n, &all, &lanes);
-    let path = dir.join(RUN_MANIFEST);
-    let mut files = match write_run(dir, &held, &r, &run_title(&cfg)) {
-        Ok(f) => f,
-        Err(e) => {
-            // The run manifest says the merge failed and why (the shards' stay as they are).
-            m.status = "failed".into();
-            m.next = format!(
-                "fix the cause ({e}) and rerun gyroemu merge {}",
-                dir.display()
-            );
-            return Err(match m.write(&path) {
-                Ok(()) => e.into(),
-                Err(w) => RunError::Unrecorded {
-                    cause: Box::new(e.into()),
-                    manifest: path,
-                    why: w.to_string(),
-                },
-            });
-        }
-    };
-    m.next = format!("merged from {count} shards");
-    m.write(&path)?;
+    let written = write_run(dir, &held, &r, &run_title(&cfg)).map_err(RunError::from);
+    let (mut files, path) = split.finish(dir, n, written)?;
     files.push(path);
-    reporter.note(&format!("merged {count} shards ({n} points)"));
+    reporter.note(&format!("merged {} shards ({n} points)", split.count));
     for w in &r.warnings {
         reporter.warn(w);
     }

@@ -4,6 +4,7 @@
 //! run, a shard, and `gyroemu merge` rebuild the sweep's results from these files; the lane
 //! grouping does not change any bits, so the outputs equal a one-machine run's.
 
+use crate::records::{f64_hex, hex_f64, scan_records, write_record, RecordFile, Scan};
 use gyroemu_board::{Health, LaneResult};
 use gyroemu_config::Config;
 use gyroemu_core::Complex64;
@@ -11,7 +12,7 @@ use gyroemu_mixer::{MAX_TABLE_HARMONIC, TABLE_HARMONICS};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Format tag of a point file.
 pub const POINT_FORMAT: &str = "gyroemu-point/3";
@@ -26,13 +27,15 @@ pub fn canonical_toml(cfg: &Config) -> String {
 }
 
 /// The part of a config that decides a sweep's results: all but `[dump]` (what is recorded
-/// on the way), `[selfcal]` (what `selfcal` adds) and `[sweep]` (what `sweep` measures), so a
-/// config differing only there reuses the saved points.
+/// on the way), `[selfcal]` (what `selfcal` adds), `[sweep]` (what `sweep` measures) and
+/// `[montecarlo]` (what a lot draws), so a config differing only there reuses the saved
+/// points.
 pub fn result_config(cfg: &Config) -> Config {
     Config {
         dump: None,
         selfcal: None,
         sweep: None,
+        montecarlo: None,
         ..cfg.clone()
     }
 }
@@ -45,7 +48,7 @@ pub fn config_hash(cfg: &Config) -> String {
     ))
 }
 
-fn hex(bytes: &[u8]) -> String {
+pub(crate) fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
@@ -111,16 +114,13 @@ impl From<HealthCounts> for Health {
 }
 
 fn enc(v: &[Complex64; 2]) -> [String; 4] {
-    [v[0].re, v[0].im, v[1].re, v[1].im].map(|x| format!("{:016x}", x.to_bits()))
+    [v[0].re, v[0].im, v[1].re, v[1].im].map(hex_f64)
 }
 
 fn dec(v: &[String; 4]) -> Result<[Complex64; 2], String> {
     let mut x = [0.0; 4];
     for (o, s) in x.iter_mut().zip(v) {
-        if s.len() != 16 {
-            return Err(format!("`{s}` is not 16 hex digits"));
-        }
-        *o = f64::from_bits(u64::from_str_radix(s, 16).map_err(|e| format!("`{s}`: {e}"))?);
+        *o = f64_hex(s)?;
     }
     Ok([Complex64::new(x[0], x[1]), Complex64::new(x[2], x[3])])
 }
@@ -182,10 +182,20 @@ impl PointFile {
             health: self.health.into(),
         })
     }
+}
 
-    /// The file name of point `index`.
-    pub fn file_name(index: usize) -> String {
-        format!("point-{index}.json")
+impl RecordFile for PointFile {
+    const FORMAT: &'static str = POINT_FORMAT;
+    const DIR: &'static str = POINTS_DIR;
+    const STEM: &'static str = "point";
+    fn format(&self) -> &str {
+        &self.format
+    }
+    fn config_sha256(&self) -> &str {
+        &self.config_sha256
+    }
+    fn index(&self) -> usize {
+        self.index
     }
 }
 
@@ -197,30 +207,13 @@ pub fn write_point(
     rate_dps: f64,
     lane: &LaneResult,
 ) -> Result<(), String> {
-    let dir = out.join(POINTS_DIR);
-    std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
-    let rec = PointFile::new(hash, index, rate_dps, lane);
-    gyroemu_io::write_json(&dir.join(PointFile::file_name(index)), &rec).map_err(|e| e.to_string())
+    write_record(out, &PointFile::new(hash, index, rate_dps, lane))
 }
 
 /// Every point file found in `out/points/`, with its path, or why it could not be read.
-pub struct PointScan {
-    /// Readable point files.
-    pub files: Vec<(PathBuf, PointFile)>,
-    /// Files in the folder that are not valid point files: (path, reason).
-    pub bad: Vec<(PathBuf, String)>,
-}
+pub type PointScan = Scan<PointFile>;
 
-impl PointScan {
-    /// The config hashes present, with how many files carry each.
-    pub fn hashes(&self) -> BTreeMap<&str, usize> {
-        let mut m = BTreeMap::new();
-        for (_, f) in &self.files {
-            *m.entry(f.config_sha256.as_str()).or_insert(0) += 1;
-        }
-        m
-    }
-
+impl Scan<PointFile> {
     /// The lane results of the sweep `hash` with `n_points` points, by index. Errors name a
     /// point present twice (two files with the same index), an index out of range, or a
     /// file whose data do not decode.
@@ -229,73 +222,20 @@ impl PointScan {
         hash: &str,
         n_points: usize,
     ) -> Result<BTreeMap<usize, LaneResult>, String> {
-        let mut out = BTreeMap::new();
-        let mut from: BTreeMap<usize, &Path> = BTreeMap::new();
-        for (path, f) in self.files.iter().filter(|(_, f)| f.config_sha256 == hash) {
-            if f.index >= n_points {
-                return Err(format!(
-                    "`{}` holds point {} but the config has {n_points} points (0..{})",
-                    path.display(),
-                    f.index,
-                    n_points.saturating_sub(1)
-                ));
-            }
-            if let Some(prev) = from.insert(f.index, path) {
-                return Err(format!(
-                    "point {} is duplicated: `{}` and `{}` both hold it",
-                    f.index,
-                    prev.display(),
-                    path.display()
-                ));
-            }
-            let lane = f.lane().map_err(|e| format!("`{}`: {e}", path.display()))?;
-            out.insert(f.index, lane);
-        }
-        Ok(out)
+        self.by_index(hash, n_points, false)?
+            .into_iter()
+            .map(|(i, (path, f))| {
+                let lane = f.lane().map_err(|e| format!("`{}`: {e}", path.display()))?;
+                Ok((i, lane))
+            })
+            .collect()
     }
 }
 
 /// Reads every `*.json` file in `out/points/` (none when the folder does not exist; hidden
 /// temporary files of an interrupted write are skipped).
 pub fn scan_points(out: &Path) -> Result<PointScan, String> {
-    let dir = out.join(POINTS_DIR);
-    let mut scan = PointScan {
-        files: Vec::new(),
-        bad: Vec::new(),
-    };
-    let entries = match std::fs::read_dir(&dir) {
-        Ok(e) => e,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(scan),
-        Err(e) => return Err(format!("cannot read `{}`: {e}", dir.display())),
-    };
-    let mut paths: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            let name = p.file_name().map(|n| n.to_string_lossy().into_owned());
-            name.is_some_and(|n| !n.starts_with('.') && n.ends_with(".json"))
-        })
-        .collect();
-    paths.sort();
-    for p in paths {
-        let parsed = std::fs::read_to_string(&p)
-            .map_err(|e| e.to_string())
-            .and_then(|t| {
-                serde_json::from_str::<PointFile>(&t)
-                    .map_err(|e| gyroemu_config::plain_words(&e.to_string()))
-            })
-            .and_then(|f| {
-                if f.format == POINT_FORMAT {
-                    Ok(f)
-                } else {
-                    Err(format!("format `{}`, expected `{POINT_FORMAT}`", f.format))
-                }
-            });
-        match parsed {
-            Ok(f) => scan.files.push((p, f)),
-            Err(e) => scan.bad.push((p, e)),
-        }
-    }
-    Ok(scan)
+    scan_records(out)
 }
 
 #[cfg(test)]

@@ -1,22 +1,42 @@
-//! Resuming in an output folder: its point files are checked against the config hash (reused
-//! when they match, refused or cleared with `force` when not), unreadable ones reported.
+//! Resuming in an output folder: its record files (a sweep's points, a lot's devices) are
+//! checked against the identity of what runs now (reused when they match, refused or
+//! cleared with `force` when not: another config, or another kind of run), unreadable ones
+//! reported and recomputed.
 
-use crate::config_diff::{config_diff, describe_diff};
+use crate::config_diff::{config_diff_for, describe_diff};
+use crate::device_file::{lot_hash, DeviceFile, DEVICES_DIR};
 use crate::dumps::{dump_files, remove_files};
 use crate::error::RunError;
-use crate::manifest::{read_manifest, shard_manifest_paths, RUN_MANIFEST};
-use crate::points::{config_hash, scan_points, POINTS_DIR};
+use crate::manifest::{read_manifest, shard_manifest_paths, RunKind, RUN_MANIFEST};
+use crate::points::{config_hash, scan_points, PointFile, POINTS_DIR};
+use crate::records::{scan_records, RecordFile};
+use gyroemu_analysis::montecarlo::DeviceResult;
 use gyroemu_board::LaneResult;
 use gyroemu_config::Config;
 use gyroemu_experiment::Reporter;
-use gyroemu_report::RUN_FILES;
+use gyroemu_report::{LOT_FILES, RUN_FILES};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+/// What a command writes into a folder: its kind and its identity.
+struct Identity<'a> {
+    kind: RunKind,
+    hash: String,
+    config: &'a Config,
+}
+
+/// A foreign identity found in the folder: its kind, the files that carry it, and a
+/// manifest's config text (to say what differs) when one names it.
+struct Foreign {
+    kind: RunKind,
+    paths: Vec<PathBuf>,
+    toml: Option<(PathBuf, String)>,
+}
+
 /// The results of a previous run in `out` for `cfg` (by its [`config_hash`]), by point
-/// index. Results of another config are refused (exit 2), naming the keys that differ,
-/// unless `force`, which deletes them and everything built from them. Unreadable point files
-/// are reported and recomputed.
+/// index. Results of another config or another kind are refused (exit 2), naming the keys
+/// that differ, unless `force`, which deletes them and everything built from them.
+/// Unreadable point files are reported and recomputed.
 pub fn previous_points(
     out: &Path,
     cfg: &Config,
@@ -24,94 +44,190 @@ pub fn previous_points(
     force: bool,
     reporter: &dyn Reporter,
 ) -> Result<BTreeMap<usize, LaneResult>, RunError> {
-    let hash = &config_hash(cfg);
+    let id = Identity {
+        kind: RunKind::Run,
+        hash: config_hash(cfg),
+        config: cfg,
+    };
+    if check_foreign(out, &id, force, reporter)? {
+        return Ok(BTreeMap::new());
+    }
     let scan = scan_points(out).map_err(RunError::BadInput)?;
-    let mut foreign: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
-    for (p, f) in &scan.files {
-        if &f.config_sha256 != hash {
-            foreign
-                .entry(f.config_sha256.clone())
-                .or_default()
-                .push(p.clone());
+    warn_bad::<PointFile>(&scan.bad, reporter);
+    scan.lanes(&id.hash, n_points).map_err(RunError::BadInput)
+}
+
+/// The devices of a previous lot in `out` for `cfg` (by its [`lot_hash`]) below `n_devices`,
+/// by index, refusing or clearing (`force`) another config's or kind's results like
+/// [`previous_points`]. Device files of the same lot beyond `n_devices` (a larger lot ran
+/// there) are left alone; unreadable ones are reported and recomputed.
+pub fn previous_devices(
+    out: &Path,
+    cfg: &Config,
+    n_devices: usize,
+    force: bool,
+    reporter: &dyn Reporter,
+) -> Result<BTreeMap<usize, DeviceResult>, RunError> {
+    let id = Identity {
+        kind: RunKind::Montecarlo,
+        hash: lot_hash(cfg),
+        config: cfg,
+    };
+    if check_foreign(out, &id, force, reporter)? {
+        return Ok(BTreeMap::new());
+    }
+    let scan = scan_records::<DeviceFile>(out).map_err(RunError::BadInput)?;
+    warn_bad::<DeviceFile>(&scan.bad, reporter);
+    let mut done = BTreeMap::new();
+    let mut stale: Vec<(&Path, String)> = Vec::new();
+    for (i, (path, f)) in scan
+        .by_index(&id.hash, n_devices, true)
+        .map_err(RunError::BadInput)?
+    {
+        match f.result() {
+            Ok(d) => {
+                done.insert(i, d);
+            }
+            Err(e) => stale.push((path, e)),
         }
     }
-    // The config text of another config's manifest, to say what differs.
-    let mut other_toml: BTreeMap<String, (PathBuf, String)> = BTreeMap::new();
+    // One line for them all: a new gyroemu version can make every file of a lot stale.
+    if let Some((path, why)) = stale.first() {
+        let more = match stale.len() {
+            1 => String::new(),
+            k => format!(" and {} more device files", k - 1),
+        };
+        reporter.warn(&format!(
+            "ignoring `{}`{more} (written by another gyroemu version: {why}); those devices \
+             are computed again",
+            path.display()
+        ));
+    }
+    Ok(done)
+}
+
+fn warn_bad<R: RecordFile>(bad: &[(PathBuf, String)], reporter: &dyn Reporter) {
+    for (p, why) in bad {
+        reporter.warn(&format!(
+            "ignoring `{}` (not a gyroemu {} file: {why})",
+            p.display(),
+            R::STEM
+        ));
+    }
+}
+
+/// Refuses `out` when it holds results of another identity, unless `force`, which deletes
+/// them (then returns `true`).
+fn check_foreign(
+    out: &Path,
+    id: &Identity,
+    force: bool,
+    reporter: &dyn Reporter,
+) -> Result<bool, RunError> {
+    let mut foreign: BTreeMap<String, Foreign> = BTreeMap::new();
+    let mut add = |hash: &str, kind: RunKind, path: &Path, toml: Option<String>| {
+        if hash == id.hash {
+            return;
+        }
+        let f = foreign.entry(hash.to_string()).or_insert(Foreign {
+            kind,
+            paths: Vec::new(),
+            toml: None,
+        });
+        f.paths.push(path.to_path_buf());
+        if let (None, Some(t)) = (&f.toml, toml) {
+            f.kind = kind;
+            f.toml = Some((path.to_path_buf(), t));
+        }
+    };
+    for (p, f) in scan_points(out).map_err(RunError::BadInput)?.files {
+        add(&f.config_sha256, RunKind::Run, &p, None);
+    }
+    for (p, f) in scan_records::<DeviceFile>(out)
+        .map_err(RunError::BadInput)?
+        .files
+    {
+        add(&f.lot_sha256, RunKind::Montecarlo, &p, None);
+    }
     let mut manifests = shard_manifest_paths(out)?;
     manifests.push(out.join(RUN_MANIFEST));
     for p in manifests.iter().filter(|p| p.exists()) {
         if let Ok(m) = read_manifest(p) {
-            if &m.config_sha256 != hash {
-                foreign
-                    .entry(m.config_sha256.clone())
-                    .or_default()
-                    .push(p.clone());
-                other_toml
-                    .entry(m.config_sha256)
-                    .or_insert((p.clone(), m.config_toml));
-            }
+            add(&m.config_sha256, m.kind, p, Some(m.config_toml));
         }
     }
-    if let Some((other, paths)) = foreign.iter().next() {
-        if !force {
-            let differs = match other_toml.get(other) {
-                Some((p, text)) => match config_diff(text, cfg) {
-                    Ok(d) if d.is_empty() => format!(
-                        "; `{}` lists the same settings: it was written by an older gyroemu                          whose config hash differs",
-                        p.display()
-                    ),
-                    Ok(d) => format!(
-                        "; the configs differ in {} (from `{}`)",
-                        describe_diff(&d, 12),
-                        p.display()
-                    ),
-                    Err(e) => format!("; the config in `{}` does not parse: {e}", p.display()),
-                },
-                None => "; no manifest says which config that was".to_string(),
-            };
+    let Some((other, f)) = foreign.iter().next() else {
+        return Ok(false);
+    };
+    if !force {
+        let found = format!(
+            "sha256 {} in `{}`{}",
+            &other[..other.len().min(12)],
+            f.paths[0].display(),
+            if f.paths.len() > 1 {
+                format!(" and {} more files", f.paths.len() - 1)
+            } else {
+                String::new()
+            }
+        );
+        if f.kind != id.kind {
             return Err(RunError::BadInput(format!(
-                "output folder `{}` holds results of another config (sha256 {} in `{}`{}), not of \
-                 this one (sha256 {}){differs}: choose another --out, or add --force to delete \
-                 them",
+                "output folder `{}` holds {} ({found}), not {}: choose another --out, or add \
+                 --force to delete it",
                 out.display(),
-                &other[..other.len().min(12)],
-                paths[0].display(),
-                if paths.len() > 1 {
-                    format!(" and {} more files", paths.len() - 1)
-                } else {
-                    String::new()
-                },
-                &hash[..hash.len().min(12)],
+                f.kind.describe(),
+                id.kind.describe()
             )));
         }
-        reporter.note(&format!(
-            "--force: deleting the results of another config in `{}`",
-            out.display()
-        ));
-        clear_out(out)?;
-        return Ok(BTreeMap::new());
+        let differs = match &f.toml {
+            Some((p, text)) => match config_diff_for(id.kind, text, id.config) {
+                Ok(d) if d.is_empty() => format!(
+                    "; `{}` lists the same settings: it was written by an older gyroemu \
+                     whose config hash differs",
+                    p.display()
+                ),
+                Ok(d) => format!(
+                    "; the configs differ in {} (from `{}`)",
+                    describe_diff(&d, 12),
+                    p.display()
+                ),
+                Err(e) => format!("; the config in `{}` does not parse: {e}", p.display()),
+            },
+            None => "; no manifest says which config that was".to_string(),
+        };
+        return Err(RunError::BadInput(format!(
+            "output folder `{}` holds results of another config ({found}), not of this one \
+             (sha256 {}){differs}: choose another --out, or add --force to delete them",
+            out.display(),
+            &id.hash[..id.hash.len().min(12)],
+        )));
     }
-    for (p, why) in &scan.bad {
-        reporter.warn(&format!(
-            "ignoring `{}` (not a gyroemu point file: {why})",
-            p.display()
-        ));
-    }
-    scan.lanes(hash, n_points).map_err(RunError::BadInput)
+    reporter.note(&format!(
+        "--force: deleting the results of another config in `{}`",
+        out.display()
+    ));
+    clear_out(out)?;
+    Ok(true)
 }
 
-/// Deletes the point files, manifests, final outputs and signal dumps of a previous run in
-/// `out`.
+/// Deletes the record files, manifests, final outputs and signal dumps of a previous run or
+/// lot in `out`.
 fn clear_out(out: &Path) -> Result<(), RunError> {
-    let points = out.join(POINTS_DIR);
-    if points.exists() {
-        std::fs::remove_dir_all(&points).map_err(RunError::io(format!(
-            "cannot delete `{}`",
-            points.display()
-        )))?;
+    for dir in [POINTS_DIR, DEVICES_DIR] {
+        let d = out.join(dir);
+        if d.exists() {
+            std::fs::remove_dir_all(&d)
+                .map_err(RunError::io(format!("cannot delete `{}`", d.display())))?;
+        }
     }
     let mut files = shard_manifest_paths(out)?;
-    files.extend([RUN_MANIFEST].iter().chain(&RUN_FILES).map(|f| out.join(f)));
+    files.extend(
+        [RUN_MANIFEST]
+            .iter()
+            .chain(&RUN_FILES)
+            .chain(&LOT_FILES)
+            .map(|f| out.join(f)),
+    );
     files.retain(|f| f.exists());
     files.extend(dump_files(out));
     remove_files(&files)

@@ -3,10 +3,10 @@
 //! manifest says what is done; an interrupt keeps what finished; a whole run then writes the
 //! results.
 
-use crate::abort::LiveManifest;
 use crate::dumps::reconcile_dump;
 use crate::error::RunError;
-use crate::manifest::{Manifest, ShardId, RUN_MANIFEST};
+use crate::ledger::Ledger;
+use crate::manifest::{manifest_path, RunKind};
 use crate::points::{canonical_toml, config_hash, scan_points, write_point, POINTS_DIR};
 use crate::resume::previous_points;
 use crate::shard::Shard;
@@ -18,26 +18,27 @@ use gyroemu_experiment::{
     SweepOptions, Work,
 };
 use gyroemu_report::{check_problems, run_title, write_run};
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 
-/// What to run.
+/// What to run: a sweep ([`run`]) or a lot ([`crate::run_lot`]).
 pub struct RunRequest<'a> {
-    /// The validated config.
+    /// The validated config (a lot: validated for the devices this run draws, by
+    /// [`gyroemu_analysis::montecarlo::validate_lot`]).
     pub config: &'a Config,
     /// The output folder (it must exist and be writable: see [`prepare_out`]).
     pub out: &'a Path,
-    /// Run only this shard of the points.
+    /// Run only this shard of the points (a lot's devices).
     pub shard: Option<Shard>,
     /// Run even above the cap of [`gyroemu_experiment::MAX_POINT_SAMPLES`], and delete results
-    /// of another config found in `out` instead of refusing.
+    /// of another config or kind found in `out` instead of refusing.
     pub force: bool,
     /// Raised (Ctrl-C, SIGTERM): the run saves what finished and returns
     /// [`RunError::Interrupted`].
     pub cancel: Arc<AtomicBool>,
-    /// Called after each saved lane group with the number of points this run has saved.
+    /// Called after each saved lane group (device) with the number of points (devices) this
+    /// run has saved.
     pub on_saved: Option<&'a (dyn Fn(usize) + Sync)>,
 }
 
@@ -81,10 +82,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     let config_toml = canonical_toml(cfg);
     let rates = cfg.emulated_rates_dps();
     let n = rates.len();
-    let mine: Vec<usize> = match &req.shard {
-        Some(s) => s.points(n),
-        None => (0..n).collect(),
-    };
+    let mine = Shard::items(req.shard.as_ref(), n);
     // Say what this will cost before anything runs; refuse an absurd run unless forced.
     let whole = sweep_work(cfg);
     let share = Work {
@@ -94,10 +92,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     };
     share.check_cap(req.force).map_err(RunError::BadInput)?;
     reporter.note(&share.describe(Some(measured_throughput(cfg))));
-    let manifest_path = match &req.shard {
-        Some(s) => out.join(s.manifest_name()),
-        None => out.join(RUN_MANIFEST),
-    };
+    let manifest_path = manifest_path(out, req.shard.as_ref());
     let mut prev = previous_points(out, cfg, n, req.force, reporter)?;
     let owns_dump = req.shard.is_none() || dump_point(cfg).is_some_and(|i| mine.contains(&i));
     reconcile_dump(
@@ -111,16 +106,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         reporter,
     )?;
     let reused = mine.iter().filter(|i| prev.contains_key(i)).count();
-    let what = match &req.shard {
-        Some(s) => format!(
-            "shard {}/{} ({}): {} of the {n} points",
-            s.index,
-            s.count,
-            s.source,
-            mine.len()
-        ),
-        None => format!("{n} points"),
-    };
+    let what = Shard::describe(req.shard.as_ref(), n, "point");
     let points_dir = out.join(POINTS_DIR);
     reporter.note(&if reused == mine.len() {
         format!(
@@ -136,36 +122,20 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     } else {
         what
     });
-    let shard_id = req.shard.as_ref().map(|s| ShardId {
-        index: s.index,
-        count: s.count,
-    });
-    let manifest = |status: &str, done: &BTreeMap<usize, LaneResult>| {
-        Manifest::new(status, &hash, &config_toml, shard_id, n, &mine, done)
-    };
-    manifest("running", &prev).write(&manifest_path)?;
-    // What an abrupt exit (a second Ctrl-C) leaves: the points saved until then.
-    let mut aborted = manifest("interrupted", &prev);
-    aborted.next = "stopped at once by a second Ctrl-C or SIGTERM: rerun the same command to \
-                    resume"
-        .into();
-    let live = LiveManifest::new(&manifest_path, aborted);
-    let fail = |e: RunError, done: &BTreeMap<usize, LaneResult>| {
-        let mut m = manifest("failed", done);
-        m.next = format!("fix the cause ({e}) and rerun the same command");
-        match live.write_final(&manifest_path, &m) {
-            Ok(()) => e,
-            Err(w) => RunError::Unrecorded {
-                cause: Box::new(e),
-                manifest: manifest_path.clone(),
-                why: w.to_string(),
-            },
-        }
-    };
+    let ledger = Ledger::start(
+        RunKind::Run,
+        &hash,
+        &config_toml,
+        out,
+        req.shard.as_ref(),
+        n,
+        &mine,
+        &prev,
+    )?;
 
     // With a [pll], the carrier is locked on the emulated board first and held for the sweep
     // (deterministic: a resume, a shard and a merge lock to the same bits).
-    let (held, lock) = resolve_lock(cfg).map_err(|e| fail(e.into(), &prev))?;
+    let (held, lock) = resolve_lock(cfg).map_err(|e| ledger.fail(e.into(), &prev))?;
     if let Some(l) = &lock {
         reporter.note(&lock_note(l));
     }
@@ -173,7 +143,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     let on_group = |pts: &[(usize, LaneResult)]| -> Result<(), String> {
         for (i, lane) in pts {
             write_point(out, &hash, *i, rates[*i], lane)?;
-            live.saved(&[*i]);
+            ledger.saved(*i);
         }
         let k = saved.fetch_add(pts.len(), Ordering::SeqCst) + pts.len();
         if let Some(f) = req.on_saved {
@@ -197,49 +167,24 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
                 .ok()
                 .and_then(|s| s.lanes(&hash, n).ok())
                 .unwrap_or_default();
-            return Err(fail(e.into(), &done));
+            return Err(ledger.fail(e.into(), &done));
         }
     };
     task.finish_writing(Some(swept.point_samples), swept.written());
-    let missing = mine.iter().filter(|i| !swept.lanes.contains_key(i)).count();
-    if swept.cancelled || missing > 0 {
-        let mut m = manifest("interrupted", &swept.lanes);
-        m.next = "rerun the same command to resume".into();
-        let e = RunError::Interrupted(format!(
-            "interrupted: {} of {} points saved in `{}`, {missing} missing (listed in `{}`); \
-             rerun the same command to resume",
-            mine.len() - missing,
-            mine.len(),
-            points_dir.display(),
-            manifest_path.display()
-        ));
-        return match live.write_final(&manifest_path, &m) {
-            Ok(()) => Err(e),
-            Err(w) => Err(RunError::Unrecorded {
-                cause: Box::new(e),
-                manifest: manifest_path.clone(),
-                why: w.to_string(),
-            }),
-        };
+    let missing = mine.iter().any(|i| !swept.lanes.contains_key(i));
+    if swept.cancelled || missing {
+        return Err(ledger.interrupted(&swept.lanes, "point", &points_dir));
     }
-    let mut m = manifest("complete", &swept.lanes);
-    if let Some(s) = &req.shard {
-        m.next = format!(
-            "when all {} shards are complete: gyroemu merge {}",
-            s.count,
-            out.display()
-        );
-        live.write_final(&manifest_path, &m)
-            .map_err(|e| fail(e, &swept.lanes))?;
-        return Ok(RunOutcome::ShardComplete { next: m.next });
+    if req.shard.is_some() {
+        let next = ledger.shard_complete(&swept.lanes, out)?;
+        return Ok(RunOutcome::ShardComplete { next });
     }
     let written = finish_sweep(&held, &swept.lanes)
         .map_err(RunError::from)
         .and_then(|r| Ok((write_run(out, &held, &r, &run_title(cfg))?, r)));
-    let (mut files, r) = written.map_err(|e| fail(e, &swept.lanes))?;
-    live.write_final(&manifest_path, &m)
-        .map_err(|e| fail(e, &swept.lanes))?;
-    files.push(manifest_path);
+    let (mut files, r) = written.map_err(|e| ledger.fail(e, &swept.lanes))?;
+    ledger.complete(&swept.lanes)?;
+    files.push(ledger.path().to_path_buf());
     files.extend(swept.dump_files.iter().cloned());
     for w in &r.warnings {
         reporter.warn(w);

@@ -21,6 +21,25 @@ impl Shard {
         (self.index..n_points).step_by(self.count).collect()
     }
 
+    /// The items (points, devices) of `n` that `shard` runs: all without a shard.
+    pub fn items(shard: Option<&Shard>, n: usize) -> Vec<usize> {
+        shard.map_or_else(|| (0..n).collect(), |s| s.points(n))
+    }
+
+    /// `shard 0/4 (--shard 0/4): 3 of the 10 points`, or `10 points` without a shard.
+    pub(crate) fn describe(shard: Option<&Shard>, n: usize, item: &str) -> String {
+        match shard {
+            Some(s) => format!(
+                "shard {}/{} ({}): {} of the {n} {item}s",
+                s.index,
+                s.count,
+                s.source,
+                s.points(n).len()
+            ),
+            None => format!("{n} {item}s"),
+        }
+    }
+
     /// The manifest name of this shard inside the output folder.
     pub fn manifest_name(&self) -> String {
         format!("shard-{}-of-{}.json", self.index, self.count)

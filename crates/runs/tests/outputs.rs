@@ -4,13 +4,14 @@
 //! `[dump]` changes); a folder of another config is refused naming the keys that differ, and
 //! `--force` deletes that config's dumps with its points.
 
+mod common;
+
+use common::*;
 use gyroemu_config::{parse_config, Config};
-use gyroemu_experiment::{Quiet, Reporter, Task};
 use gyroemu_runs::{dump_files, prepare_out, run, RunError, RunOutcome, RunRequest};
-use serde_json::Value;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// Three listed rates plus the implicit zero: one lane group.
 const CONFIG: &str = r#"
@@ -32,22 +33,6 @@ settle_s = 0.05
 "#;
 
 const DUMP: &str = "[dump]\nrate_dps = 50.0\nnodes = [\"tia\", \"lowpass\"]\n";
-
-/// Keeps the notes and warnings.
-#[derive(Default)]
-struct Record(Mutex<Vec<String>>);
-
-impl Reporter for Record {
-    fn task(&self, _: &str) -> Box<dyn Task + '_> {
-        Box::new(Quiet)
-    }
-    fn note(&self, text: &str) {
-        self.0.lock().unwrap().push(text.to_string());
-    }
-    fn warn(&self, text: &str) {
-        self.0.lock().unwrap().push(format!("warning: {text}"));
-    }
-}
 
 fn config(text: &str) -> Config {
     let c = parse_config(text).unwrap();
@@ -76,10 +61,6 @@ fn run_into(
     let r = run(&req, &rec);
     let notes = rec.0.into_inner().unwrap().join("\n");
     (r, computed.load(Ordering::SeqCst), notes)
-}
-
-fn json(p: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
 #[test]

@@ -3,6 +3,9 @@
 //! computes only the missing points and its outputs equal an uninterrupted run's byte for
 //! byte; a third run reuses everything. A cancel raised before the start saves nothing.
 
+mod common;
+
+use common::*;
 use gyroemu_config::{parse_config, Config};
 use gyroemu_experiment::Quiet;
 use gyroemu_runs::{prepare_out, run, RunError, RunOutcome, RunRequest};
@@ -71,10 +74,6 @@ fn run_into(cfg: &Config, out: &Path, stop_after: Option<usize>) -> Result<RunOu
     pool.install(|| run(&req, &Quiet))
 }
 
-fn json(p: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
-
 fn indices(v: &Value) -> Vec<u64> {
     v.as_array()
         .unwrap()
@@ -84,14 +83,7 @@ fn indices(v: &Value) -> Vec<u64> {
 }
 
 fn point_files(out: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(out.join("points"))
-        .map(|d| {
-            d.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-                .collect()
-        })
-        .unwrap_or_default();
-    v.sort();
-    v
+    files_in(out, "points")
 }
 
 #[test]

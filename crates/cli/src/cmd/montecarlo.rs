@@ -1,0 +1,112 @@
+//! `gyroemu montecarlo CONFIG --devices N [--out DIR] [--shard I/N] [--force]`, and
+//! `--print-device I` (one device's config, for `gyroemu selfcal`).
+
+use crate::cmd::out_args::OutArgs;
+use crate::input::{list_written, print_out, read_config, refused, BadInput};
+use crate::progress::Terminal;
+use anyhow::Result;
+use gyroemu_analysis::montecarlo::{device_config, draw_device, validate_lot, LotSummary};
+use gyroemu_runs::shard::Shard;
+use gyroemu_runs::{run_lot, LotOutcome, RunRequest};
+use std::path::Path;
+
+/// The arguments of `gyroemu montecarlo`.
+pub struct MonteCarloArgs<'a> {
+    /// The config file (with a `[montecarlo]` section).
+    pub config: &'a Path,
+    /// `--devices N`: the lot's size.
+    pub devices: Option<usize>,
+    /// `--out`, `--shard`, `--shard-count`, `--force`.
+    pub out: &'a OutArgs,
+    /// `--print-device I`: print device I's config instead of running the lot.
+    pub print_device: Option<u64>,
+}
+
+/// Draws and self-calibrates the devices not yet saved in the output folder, then writes the
+/// lot's files and prints its figures.
+pub fn montecarlo_command(a: &MonteCarloArgs) -> Result<()> {
+    let (cfg, text) = read_config(a.config)?;
+    if let Some(i) = a.print_device {
+        validate_lot(&cfg, &[i]).map_err(|e| refused(a.config, &text, e))?;
+        let mc = cfg
+            .montecarlo
+            .as_ref()
+            .expect("validated: [montecarlo] present");
+        let dev = device_config(&cfg, &draw_device(mc, i));
+        let head = format!(
+            "# Device {i} of the lot of {} (gyroemu montecarlo --print-device {i}):\n\
+             # `gyroemu selfcal` on this config self-calibrates it as the lot does.\n\n",
+            a.config.display()
+        );
+        return print_out(&(head + &toml::to_string(&dev)?));
+    }
+    let n = a
+        .devices
+        .ok_or_else(|| BadInput("--devices N is required".into()))?;
+    if n == 0 {
+        return Err(BadInput("--devices = 0: a lot needs at least 1 device".into()).into());
+    }
+    let shard = a.out.shard()?;
+    let mine: Vec<u64> = Shard::items(shard.as_ref(), n)
+        .into_iter()
+        .map(|i| i as u64)
+        .collect();
+    // The config, its sweeps and every device this process draws, before any sample.
+    let warnings = validate_lot(&cfg, &mine).map_err(|e| refused(a.config, &text, e))?;
+    for w in warnings {
+        eprintln!("warning: {}: {w}", a.config.display());
+    }
+    let (cancel, _lock) = a.out.open(shard.as_ref())?;
+    let req = RunRequest {
+        config: &cfg,
+        out: &a.out.out,
+        shard,
+        force: a.out.force,
+        cancel,
+        on_saved: None,
+    };
+    match run_lot(&req, n, &Terminal)? {
+        LotOutcome::Complete { files, summary } => {
+            print_out(&summary_text(&summary))?;
+            list_written(&a.out.out, &files);
+        }
+        LotOutcome::ShardComplete { next } => eprintln!("shard complete; {next}"),
+    }
+    Ok(())
+}
+
+/// The lot's figures for the terminal.
+fn summary_text(s: &LotSummary) -> String {
+    let pct = |x: f64| format!("{:.3} %", 100.0 * x);
+    let y = &s.yield_within_spec;
+    let mut t = format!(
+        "lot of {} devices, self-calibration error `{}`:\n",
+        s.devices, s.headline
+    );
+    if let Some(sp) = s.headline_spread() {
+        let list = |v: &[(f64, f64)]| {
+            v.iter()
+                .map(|&(p, x)| format!("P{p} {}", pct(x)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        t += &format!("  |error|: {}\n", list(&sp.abs_percentiles));
+        t += &format!(
+            "  signed:  {}; mean {}, std {} ({} devices)\n",
+            list(&sp.percentiles),
+            pct(sp.mean),
+            pct(sp.std),
+            sp.n
+        );
+    }
+    t += &format!(
+        "  yield within |error| <= {}: {} of {} = {} (95 % interval {} .. {}, Wilson)\n",
+        pct(s.spec_abs_relative_error),
+        y.passed,
+        y.devices,
+        pct(y.fraction),
+        pct(y.ci95_low),
+        pct(y.ci95_high)
+    );
+    t
+}

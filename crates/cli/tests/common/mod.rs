@@ -1,0 +1,89 @@
+//! Shared helpers of the CLI tests that run the binary as a scheduler would: the binary with
+//! the scheduler's variables cleared, and the outputs compared byte for byte.
+#![allow(dead_code)]
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Scheduler variables that must not leak into the children from the test's environment.
+pub const SCHED_VARS: [&str; 8] = [
+    "SLURM_ARRAY_TASK_STEP",
+    "SLURM_ARRAY_TASK_ID",
+    "SLURM_ARRAY_TASK_COUNT",
+    "SLURM_ARRAY_TASK_MIN",
+    "SLURM_ARRAY_TASK_MAX",
+    "JOB_COMPLETION_INDEX",
+    "GYROEMU_SHARD_COUNT",
+    "RAYON_NUM_THREADS",
+];
+
+/// `gyroemu ARGS` with `env` added and the scheduler's variables cleared.
+pub fn command(args: &[&str], env: &[(&str, &str)]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_gyroemu"));
+    for v in SCHED_VARS {
+        c.env_remove(v);
+    }
+    c.args(args).envs(env.iter().copied());
+    c
+}
+
+pub fn gyroemu(args: &[&str], env: &[(&str, &str)]) -> Output {
+    command(args, env).output().expect("binary runs")
+}
+
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+pub fn ok(o: Output) -> Output {
+    assert!(o.status.success(), "{}", stderr(&o));
+    o
+}
+
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Writes the config into `dir` and returns its path.
+pub fn config(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+pub fn json(p: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+/// Every file of `names` exists in both folders with the same bytes.
+pub fn assert_same_files(a: &Path, b: &Path, names: &[&str]) {
+    for f in names {
+        let (x, y) = (std::fs::read(a.join(f)), std::fs::read(b.join(f)));
+        assert!(x.is_ok() && y.is_ok(), "{f} missing in {a:?} or {b:?}");
+        assert!(x.unwrap() == y.unwrap(), "{f} differs: {a:?} vs {b:?}");
+    }
+}
+
+/// Runs `gyroemu ARGS`, sends it SIGINT as soon as `started()` (its first result file
+/// appeared) or it ended, and returns its output.
+pub fn interrupted(args: &[&str], started: impl Fn() -> bool) -> Output {
+    let mut child = command(args, &[])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    while !started() {
+        assert!(t0.elapsed().as_secs() < 60, "no result file appeared");
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    child.wait_with_output().unwrap()
+}
