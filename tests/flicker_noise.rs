@@ -282,7 +282,11 @@ fn flicker_draws_from_its_own_streams() {
         probe.write(dir.path(), "d").unwrap();
         let d = gyroemu_io::read_dump(&dir.path().join("d_fullrate")).unwrap();
         let bits = |name: &str| -> Vec<u64> {
-            d.channel(name).unwrap().iter().map(|x| x.to_bits()).collect()
+            d.channel(name)
+                .unwrap()
+                .iter()
+                .map(|x| x.to_bits())
+                .collect()
         };
         (bits("drive1"), bits("tia1_v"))
     };

@@ -45,25 +45,41 @@ pub(crate) fn text_scale(w: u32, h: u32) -> f64 {
         .clamp(0.85, 2.0)
 }
 
-/// The upper corner whose quarter of the plot holds fewer data points (upper left on a tie),
-/// so the legend hides as little as possible.
-fn legend_corner(points: &[(f64, f64)], xa: &AxisScale, ya: &AxisScale) -> SeriesLabelPosition {
+/// The corner whose legend box (`box_frac`: its width and height as fractions of the plot)
+/// covers the fewest data points, so the legend hides as little as possible: upper left,
+/// upper right, lower left, lower right, the first on a tie.
+fn legend_corner(
+    points: &[(f64, f64)],
+    xa: &AxisScale,
+    ya: &AxisScale,
+    (bw, bh): (f64, f64),
+) -> SeriesLabelPosition {
     let frac = |v: f64, a: &AxisScale| (a.map(v) - a.lo) / (a.hi - a.lo);
-    let (mut left, mut right) = (0usize, 0usize);
-    for &(x, y) in points {
-        if frac(y, ya) > 0.5 {
-            if frac(x, xa) < 0.5 {
-                left += 1;
-            } else {
-                right += 1;
-            }
+    let corners = [
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::UpperRight, true, true),
+        (SeriesLabelPosition::LowerLeft, false, false),
+        (SeriesLabelPosition::LowerRight, true, false),
+    ];
+    let covered = |right: bool, upper: bool| {
+        points
+            .iter()
+            .filter(|&&(x, y)| {
+                let (fx, fy) = (frac(x, xa), frac(y, ya));
+                let in_x = if right { fx >= 1.0 - bw } else { fx <= bw };
+                let in_y = if upper { fy >= 1.0 - bh } else { fy <= bh };
+                in_x && in_y
+            })
+            .count()
+    };
+    let mut best = (usize::MAX, SeriesLabelPosition::UpperLeft);
+    for (pos, right, upper) in corners {
+        let n = covered(right, upper);
+        if n < best.0 {
+            best = (n, pos);
         }
     }
-    if right < left {
-        SeriesLabelPosition::UpperRight
-    } else {
-        SeriesLabelPosition::UpperLeft
-    }
+    best.1
 }
 
 /// The axis of one coordinate of the figure's plottable points.
@@ -370,9 +386,22 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
     draw_markers(area, fig, &xa, (x0, x1, y0, y1), s)?;
 
     if fig.series.iter().any(|s| !s.name.is_empty()) {
+        // The legend box as a fraction of the plot: its widest label plus the marker and
+        // margins, one row per series.
+        let (mut label_w, mut label_h) = (0u32, 0u32);
+        for se in &fig.series {
+            let (w, h) = area.estimate_text_size(&se.name, &legend_font)?;
+            label_w = label_w.max(w);
+            label_h = label_h.max(h);
+        }
+        let rows = fig.series.iter().filter(|s| !s.name.is_empty()).count() as f64;
+        let legend_box = (
+            ((label_w as f64 + 60.0 * s) / (x1 - x0).max(1) as f64).min(1.0),
+            ((rows * (label_h as f64 + 8.0 * s) + 20.0 * s) / (y1 - y0).max(1) as f64).min(1.0),
+        );
         chart
             .configure_series_labels()
-            .position(legend_corner(&all, &xa, &ya))
+            .position(legend_corner(&all, &xa, &ya, legend_box))
             .margin(px(10.0))
             .legend_area_size(glyph_w + px(10.0))
             .label_font(legend_font)
@@ -444,4 +473,41 @@ fn draw_markers(
         area.draw(&Text::new(m.label.clone(), (tx, ty), font.clone()))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_legend_goes_to_the_corner_it_hides_least() {
+        let axes = |pts: &[(f64, f64)]| {
+            (
+                AxisScale::from_values(pts.iter().map(|p| p.0), 5),
+                AxisScale::from_values(pts.iter().map(|p| p.1), 5),
+            )
+        };
+        let frame = [(0.0, 0.0), (10.0, 0.0), (0.0, 10.0), (10.0, 10.0)];
+        // A cluster under the upper left: the upper right takes the legend.
+        let mut pts = frame.to_vec();
+        pts.extend([(0.5, 9.5), (1.0, 9.8), (1.5, 9.0)]);
+        let (xa, ya) = axes(&pts);
+        assert_eq!(
+            legend_corner(&pts, &xa, &ya, (0.4, 0.2)),
+            SeriesLabelPosition::UpperRight
+        );
+        // Both upper corners busy, the lower left too: the lower right.
+        pts.extend([(9.5, 9.5), (9.0, 9.8), (0.5, 0.5), (1.0, 1.0)]);
+        let (xa, ya) = axes(&pts);
+        assert_eq!(
+            legend_corner(&pts, &xa, &ya, (0.4, 0.2)),
+            SeriesLabelPosition::LowerRight
+        );
+        // Nothing to hide: the upper left.
+        let (xa, ya) = axes(&frame);
+        assert_eq!(
+            legend_corner(&[], &xa, &ya, (0.4, 0.2)),
+            SeriesLabelPosition::UpperLeft
+        );
+    }
 }

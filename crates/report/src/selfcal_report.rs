@@ -9,7 +9,7 @@ use gyroemu_analysis::selfcal_analyses::{AllanResult, DriftCase, DriftPoint, Tau
 use gyroemu_analysis::SelfcalReport;
 use gyroemu_config::Config;
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
-use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
+use gyroemu_plot::{render_panels_png, render_png, Figure, Series, SeriesStyle};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -135,7 +135,14 @@ fn write_selfcal_files(
     }
     if let Some(d) = drift {
         write_csv(&path("drift.csv"), &drift_table(d))?;
-        render_png(&drift_figure(d), &path("drift.png"))?;
+        render_panels_png(
+            "Drift: self-calibration with the carrier open loop and PLL-tracked",
+            &drift_figures(d),
+            2,
+            1600,
+            650,
+            &path("drift.png"),
+        )?;
     }
     Ok(files)
 }
@@ -440,7 +447,10 @@ fn drift_table(d: &[DriftPoint]) -> CsvTable {
     )
 }
 
-fn drift_figure(d: &[DriftPoint]) -> Figure {
+/// The drift scenario in two panels: the self-calibration errors (small, so not under the
+/// open-loop stale error's hundreds of percent), and the calibration kept from the nominal
+/// temperature.
+fn drift_figures(d: &[DriftPoint]) -> [Figure; 2] {
     let xs: Vec<f64> = d.iter().map(|p| p.delta_t_k).collect();
     let pct = |v: f64| 100.0 * v;
     let series = |name: &str, style: SeriesStyle, f: &dyn Fn(&DriftPoint) -> Option<f64>| {
@@ -451,18 +461,18 @@ fn drift_figure(d: &[DriftPoint]) -> Figure {
             .unzip();
         Series::new(name, style, x, y)
     };
-    Figure::new(
-        "Drift: self-calibration with the carrier open loop and PLL-tracked",
+    let selfcal = Figure::new(
+        "Self-calibrated at each temperature",
         "Temperature offset (K)",
         "Scale-factor error against the rate table (%)",
     )
     .with(series(
-        "self-calibrated, PLL-tracked carrier (mode 1)",
+        "PLL-tracked carrier, mode 1",
         SeriesStyle::Points,
         &|p| p.pll.as_ref().map(|c| pct(c.selfcal_relative_error)),
     ))
     .with(series(
-        "self-calibrated, PLL-tracked carrier (both modes combined)",
+        "PLL-tracked carrier, both modes combined",
         SeriesStyle::Points,
         &|p| {
             p.pll
@@ -471,18 +481,22 @@ fn drift_figure(d: &[DriftPoint]) -> Figure {
         },
     ))
     .with(series(
-        "self-calibrated, open loop at the nominal carrier (mode 1)",
-        SeriesStyle::Points,
-        &|p| Some(pct(p.open_loop.selfcal_relative_error)),
-    ))
-    .with(series(
-        "calibrated once, PLL-tracked carrier",
+        "open loop at the nominal carrier, mode 1",
         SeriesStyle::OpenPoints,
-        &|p| p.pll.as_ref().map(|c| pct(c.stale_relative_error)),
-    ))
+        &|p| Some(pct(p.open_loop.selfcal_relative_error)),
+    ));
+    let stale = Figure::new(
+        "Calibrated once, at the nominal temperature",
+        "Temperature offset (K)",
+        "Scale-factor error against the rate table (%)",
+    )
+    .with(series("PLL-tracked carrier", SeriesStyle::Points, &|p| {
+        p.pll.as_ref().map(|c| pct(c.stale_relative_error))
+    }))
     .with(series(
-        "calibrated once, open loop",
+        "open loop at the nominal carrier",
         SeriesStyle::OpenPoints,
         &|p| Some(pct(p.open_loop.stale_relative_error)),
-    ))
+    ));
+    [selfcal, stale]
 }
