@@ -104,6 +104,13 @@ def wedge_bounds(a, b, fa, fb):
     return [slope, lo, hi]
 
 
+def rows(items, per_line, fmt):
+    """Prints `items` `per_line` to a line (the tables are data: a line each would be
+    thousands of lines of source)."""
+    for k in range(0, len(items), per_line):
+        print("    " + " ".join(fmt(x) + "," for x in items[k:k + per_line]))
+
+
 def lit(x):
     s = repr(float(x))
     return s if ("." in s or "e" in s) else s + ".0"
@@ -135,14 +142,14 @@ def main():
     print(f"pub(crate) const V: f64 = {lit(v)};")
     print("/// Layer widths: X[0] = V / f(r), X[1] = r, X[i+1] = f^-1(V / X[i] + f(X[i])), X[N] = 0; for tests.")
     print("#[cfg(test)]")
+    print("#[rustfmt::skip]")
     print(f"pub(crate) static X: [f64; {N + 1}] = [")
-    for x in xf:
-        print(f"    {lit(x)},")
+    rows(xf, 4, lit)
     print("];")
     print("/// F[i] = f(X[i]) (F[0] = 0: the base strip is never wedge-tested; F[N] = 1).")
+    print("#[rustfmt::skip]")
     print(f"pub(crate) static F: [f64; {N + 1}] = [")
-    for y in ff:
-        print(f"    {lit(y)},")
+    rows(ff, 4, lit)
     print("];")
     wedge = [[0.0, 0.0, 0.0]]
     for i in range(1, N):
@@ -151,15 +158,15 @@ def main():
         wedge.append([float(sl), float(lo), float(hi)])
     print("/// Wedge of layer i >= 1: [S, lo, hi], the slope of the chord c(x) = F[i] + (X[i] - x) S")
     print("/// and bounds lo <= f(x) - c(x) <= hi on the wedge (widened past rounding; row 0 unused).")
+    print("#[rustfmt::skip]")
     print(f"pub(crate) static WEDGE: [[f64; 3]; {N}] = [")
-    for w in wedge:
-        print(f"    [{lit(w[0])}, {lit(w[1])}, {lit(w[2])}],")
+    rows(wedge, 2, lambda w: f"[{lit(w[0])}, {lit(w[1])}, {lit(w[2])}]")
     print("];")
     print("/// Fast path of layer i: [X[i], B[i]], where B[i] = 1 + ceil(2^52 X[i+1] / X[i]) / 2^52")
     print("/// (exact): b = 1 + m / 2^52 lies below B[i] exactly when (b - 1) X[i] < X[i+1].")
+    print("#[rustfmt::skip]")
     print(f"pub(crate) static FAST: Aligned = Aligned([")
-    for i in range(N):
-        print(f"    [{lit(xf[i])}, {lit(bf[i])}],")
+    rows([[xf[i], bf[i]] for i in range(N)], 3, lambda p: f"[{lit(p[0])}, {lit(p[1])}]")
     print("]);")
     print()
     print("/// 16-byte aligned pairs: one aligned 128-bit load fetches a layer's width and bound.")
