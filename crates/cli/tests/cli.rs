@@ -346,3 +346,36 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(stderr(&bad).contains("--repeats = 0"), "{}", stderr(&bad));
 }
+
+/// `config --resolved` fills in every derived key with its rule, and what it prints is a config
+/// that parses to the same complete config (nothing is derived twice or lost).
+#[test]
+fn config_resolved_prints_the_complete_config_with_its_rules() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("min.toml");
+    std::fs::write(
+        &path,
+        "[device]\nf0_hz = 15000.0\nq = 2000.0\nangular_gain = 1.0\n[drive]\nf1 = 1.0\n\
+         [experiment]\nkind = \"rotating\"\nrates_dps = [25.0, 100.0, 175.0]\naverage_s = 8.0\n",
+    )
+    .unwrap();
+    let o = gyroemu(&["config", "--resolved", path.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    for rule in [
+        "#   drive.f2 = 1.0: equal to drive.f1",
+        "#   board.fs_hz = 240000.0: 16 samples per period",
+        "#   board.lpf_cutoff_hz = 150.0:",
+        "#   board.decimation = 76:",
+        "#   drive.carrier_hz = 15000.0:",
+    ] {
+        assert!(text.contains(rule), "{rule} missing from:\n{text}");
+    }
+    let printed = gyroemu_config::parse_config(&text).unwrap();
+    let direct = gyroemu_config::parse_config(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    assert_eq!(printed, direct);
+    // A refused file is refused here too, with exit 2.
+    std::fs::write(&path, "[device]\nf0_hz = -1.0\n").unwrap();
+    let o = gyroemu(&["config", "--resolved", path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
