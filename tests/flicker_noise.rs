@@ -84,33 +84,17 @@ fn drive_phase_flicker_leaves_the_flicker_allan_floor_on_the_phase() {
 #[test]
 fn carrier_phase_flicker_cancels_in_the_demodulation_and_drive_amplitude_leaves_the_phase() {
     let x = 1e-4;
-    let drive = phase_adev(
-        &flicker_cfg(|n| {
-            n.drive_phase_flicker_rad_per_rthz = x;
+    // One source at a time, 60 s records, read from 1 to 10 s.
+    let only = |set: fn(&mut NoiseConfig, f64)| {
+        let c = flicker_cfg(|n| {
+            set(n, x);
             n.flicker_f_lo_hz = Some(1e-3);
-        }),
-        60.0,
-        1.0,
-        10.0,
-    );
-    let carrier = phase_adev(
-        &flicker_cfg(|n| {
-            n.carrier_phase_flicker_rad_per_rthz = x;
-            n.flicker_f_lo_hz = Some(1e-3);
-        }),
-        60.0,
-        1.0,
-        10.0,
-    );
-    let amplitude = phase_adev(
-        &flicker_cfg(|n| {
-            n.drive_amplitude_flicker_per_rthz = x;
-            n.flicker_f_lo_hz = Some(1e-3);
-        }),
-        60.0,
-        1.0,
-        10.0,
-    );
+        });
+        phase_adev(&c, 60.0, 1.0, 10.0)
+    };
+    let drive = only(|n, x| n.drive_phase_flicker_rad_per_rthz = x);
+    let carrier = only(|n, x| n.carrier_phase_flicker_rad_per_rthz = x);
+    let amplitude = only(|n, x| n.drive_amplitude_flicker_per_rthz = x);
     for i in 0..drive.len() {
         // The demodulation follows the carrier's phase at once, the resonator behind its
         // 42 ms envelope time constant: what is left is the carrier phase's part above the

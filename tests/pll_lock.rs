@@ -13,6 +13,19 @@ use gyroemu::resonator::Resonator;
 use gyroemu::tia::Tia;
 use gyroemu::{Complex64, Response};
 
+/// The M^2-TFG Coriolis board (Q = 2000, half-bandwidth 3.75 Hz) the tests lock.
+fn fork() -> Config {
+    config(
+        "coriolis",
+        15e3,
+        2000.0,
+        1.0,
+        1.0,
+        &[25.0, 100.0, 175.0],
+        1.0,
+    )
+}
+
 fn with_pll(mut c: Config, start_offset_hz: f64) -> Config {
     c.drive.carrier_hz = Some(c.device.f0_hz + start_offset_hz);
     c.pll = Some(gyroemu::config::PllConfig {
@@ -51,15 +64,7 @@ fn true_lock_hz(c: &Config, offset: f64, lo: f64, hi: f64) -> f64 {
 
 #[test]
 fn the_pll_locks_the_carrier_where_the_chain_phase_says_resonance() {
-    let base = config(
-        "coriolis",
-        15e3,
-        2000.0,
-        1.0,
-        1.0,
-        &[25.0, 100.0, 175.0],
-        1.0,
-    );
+    let base = fork();
     let half_bw = 15e3 / (2.0 * 2000.0);
     for start in [-3.0, 5.0] {
         let c = with_pll(base.clone(), start * half_bw);
@@ -85,15 +90,7 @@ fn the_pll_locks_the_carrier_where_the_chain_phase_says_resonance() {
 fn a_sweep_with_a_pll_reads_like_a_tuned_board() {
     // Started 4 half-bandwidths off, open loop would read a fifth of the tuned slope (see
     // detuned_carrier.rs); locked, the phases are the tuned board's to 1e-3 of their size.
-    let base = config(
-        "coriolis",
-        15e3,
-        2000.0,
-        1.0,
-        1.0,
-        &[25.0, 100.0, 175.0],
-        1.0,
-    );
+    let base = fork();
     let c = with_pll(base.clone(), 4.0 * 3.75);
     let (held, lock) = resolve_lock(&c).unwrap();
     assert!(lock.is_some() && held.pll.is_none());
