@@ -42,7 +42,7 @@ impl<S: Sample> Stage for Dac<S> {
     type Input = S;
     type Output = S;
 
-    #[inline]
+    #[inline(always)]
     fn tick(&mut self, x: S) -> S {
         match &self.quant {
             Some(q) => q.quantize(x),

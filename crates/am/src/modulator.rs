@@ -88,7 +88,7 @@ impl<S: Sample> Stage for AmModulator<S> {
 
     /// Coriolis: `[gain1 * carrier_i, gain2 * carrier_q]`;
     /// rotating: `[gain1 * mod_cos * carrier_i, gain2 * mod_sin * carrier_i]`.
-    #[inline]
+    #[inline(always)]
     fn tick(&mut self, x: AmInput<S>) -> [S; 2] {
         match (self.pattern, self.unit_gains) {
             (DrivePattern::Coriolis, false) => [self.gain1 * x.carrier_i, self.gain2 * x.carrier_q],

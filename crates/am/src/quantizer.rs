@@ -46,7 +46,7 @@ impl<S: Sample> Quantizer<S> {
     }
 
     /// `clip(round(x / step)) * step`.
-    #[inline]
+    #[inline(always)]
     pub fn quantize(&self, x: S) -> S {
         (x / self.step)
             .round_away()
@@ -57,7 +57,7 @@ impl<S: Sample> Quantizer<S> {
     /// [`Quantizer::quantize`] (the same bits), adding 1 in each lane to `clipped` where the
     /// input lay beyond the end codes and to `zeros` where the output is exactly 0: how a
     /// board tells a clipped or dead converter from a working one.
-    #[inline]
+    #[inline(always)]
     pub fn quantize_counting(&self, x: S, clipped: &mut S, zeros: &mut S) -> S {
         let code = (x / self.step).round_away();
         let kept = code.clamp_to(self.code_lo, self.code_hi);
@@ -72,7 +72,7 @@ impl<S: Sample> Stage for Quantizer<S> {
     type Input = S;
     type Output = S;
 
-    #[inline]
+    #[inline(always)]
     fn tick(&mut self, x: S) -> S {
         self.quantize(x)
     }

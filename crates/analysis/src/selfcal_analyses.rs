@@ -5,9 +5,8 @@
 use crate::allan::{noise_readings, overlapping_adev, AllanPoint, NoiseReadings};
 use crate::selfcal::{drifted, linearised_slope, run_selfcal_core, sweep_configs};
 use crate::selfcal_combined::combined_slope;
-use gyroemu_board::{Board, LaneResult, Point, RunOptions, MAX_LANES};
+use gyroemu_board::{lane_groups, max_lanes, GroupBoard, LaneResult, Point, RunOptions};
 use gyroemu_config::{Config, PllConfig};
-use gyroemu_core::f64x4;
 use gyroemu_experiment::post_process;
 use gyroemu_experiment::sweep::{add_group_progress, canonical_work};
 use gyroemu_experiment::{lock_config_carrier, resolve_lock, Progress, SweepError};
@@ -19,6 +18,9 @@ use std::sync::atomic::AtomicU64;
 
 /// Noise streams of the analyses start here, apart from the sweep points' streams (0..).
 pub const ANALYSIS_STREAM_BASE: u64 = 1 << 32;
+
+/// The Allan record's streams (points at zero rate, one lane group).
+const ALLAN_STREAMS: usize = 4;
 
 /// Allan deviation of the zero-rate output, from four independent records (one per lane).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -55,15 +57,17 @@ pub fn allan_analysis(
             frac: 0.0,
         },
     };
-    let streams: [u64; MAX_LANES] = core::array::from_fn(|i| ANALYSIS_STREAM_BASE + i as u64);
-    let mut board = Board::<f64x4>::new(&cor.board_params(), &[0.0; MAX_LANES], &streams)?;
+    let streams: [u64; ALLAN_STREAMS] = core::array::from_fn(|i| ANALYSIS_STREAM_BASE + i as u64);
+    let mut board = GroupBoard::new(&cor.board_params(), &[0.0; ALLAN_STREAMS], &streams)?;
     let n_settle = cor.n_settle_out();
     let total = (n_settle + n_avg + 1) * cor.decimation() as u64;
     let opts = RunOptions {
         series_block: block,
         ..Default::default()
     };
-    let out = board.run(n_settle, &[point; MAX_LANES], opts, &|d| progress(d, total))?;
+    let out = board.run(n_settle, &[point; ALLAN_STREAMS], opts, &|d| {
+        progress(d, total)
+    })?;
     // Phase lag of mode 1, degrees, unwrapped (the record never wraps at zero rate, but a
     // noisy low-amplitude device could).
     let curves: Vec<Vec<AllanPoint>> = out
@@ -200,11 +204,12 @@ pub fn tau_analysis(
         })
         .collect();
     let n_settle = rot.n_settle_out();
-    let groups: Vec<(usize, &[Point])> = points
-        .chunks(MAX_LANES)
-        .enumerate()
-        .map(|(g, c)| (g * MAX_LANES, c))
-        .collect();
+    let mut groups: Vec<(usize, &[Point])> = Vec::new();
+    let mut first = 0;
+    for size in lane_groups(points.len(), rayon::current_num_threads(), max_lanes()) {
+        groups.push((first, &points[first..first + size]));
+        first += size;
+    }
     let (total, _) = canonical_work(&rot, &points);
     let done = AtomicU64::new(0);
     let params = rot.board_params();
@@ -212,7 +217,7 @@ pub fn tau_analysis(
     for (first, g) in &groups {
         let r: Vec<f64> = g.iter().map(|p| p.rate_rad_s).collect();
         let s: Vec<u64> = (0..g.len()).map(|i| (first + i) as u64).collect();
-        boards.push(Board::<f64x4>::new(&params, &r, &s)?);
+        boards.push(GroupBoard::new(&params, &r, &s)?);
     }
     let results: Vec<Result<Vec<Vec<LaneResult>>, SweepError>> = boards
         .into_par_iter()

@@ -1,6 +1,7 @@
 //! The readout board assembled from the stage crates. Generic over the sample type: `f64` runs
-//! one operating point, `f64x4` runs four in SIMD lanes through the very same stage code (the
-//! carrier NCO is shared, each lane has its own rate, plant and noise stream).
+//! one operating point, `f64x4` four and `F64x8` (AVX-512, `group.rs`) eight in SIMD lanes
+//! through the very same stage code (the carrier NCO is shared, each lane has its own rate,
+//! plant and noise stream).
 
 use crate::fault::NonFinite;
 use crate::flicker::FlickerSources;
@@ -17,9 +18,6 @@ use gyroemu_resonator::{thermomechanical_accel_psd, Resonator};
 use gyroemu_tia::{input_referred_noise_a_per_rthz, Tia};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
-
-/// At most this many lanes (the width of `f64x4`).
-pub const MAX_LANES: usize = 4;
 
 /// The sample loop's shapes, chosen once per run (const generics keep the per-sample path free
 /// of the shape test).
@@ -192,7 +190,18 @@ impl<S: Sample> Board<S> {
         let mix1 = [Stage1Mixer::new(0.0)?, Stage1Mixer::new(0.0)?];
         let seed = p.noise.map_or(0, |n| n.seed);
         let lane_stream = |i: usize| streams[i.min(lanes - 1)];
-        let rng = NoiseRng::new(core::array::from_fn(|i| stream_seed(seed, lane_stream(i))));
+        // Lanes 4q .. 4q + 4 from one four-lane set of streams, so a lane draws the same
+        // normals in every lane type.
+        let rng = |q: usize| {
+            NoiseRng::new(core::array::from_fn(|i| {
+                stream_seed(seed, lane_stream(4 * q + i))
+            }))
+        };
+        let normals = if S::LANES > 4 {
+            NormalBlock::wide(rng(0), rng(1))
+        } else {
+            NormalBlock::new(rng(0))
+        };
         let (sigma_force, sigma_current) = noise_sigmas(p);
         let adc = build_adc(p)?.map(|q| [q, q]);
         let imperfect =
@@ -222,7 +231,7 @@ impl<S: Sample> Board<S> {
             fs_hz: fs,
             mod_shift,
             noise: NoiseState {
-                normals: NormalBlock::new(rng),
+                normals,
                 sigma_force: sigma_force.map(S::splat),
                 sigma_current: sigma_current.map(S::splat),
             },

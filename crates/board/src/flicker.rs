@@ -16,7 +16,7 @@ use crate::params::{BoardParams, NoiseParams};
 use gyroemu_core::detmath::sin_cos;
 use gyroemu_core::flicker::{Flicker, FlickerParams};
 use gyroemu_core::noise::{stream_seed, NoiseRng};
-use gyroemu_core::{ParamResult, Sample, Stage};
+use gyroemu_core::{f64x4, ParamResult, Sample, Stage};
 
 /// Salt of the flicker streams' seeds (apart from the white noise's).
 const FLICKER_SALT: u64 = 0xF11C_4E25_0000_0001;
@@ -46,7 +46,7 @@ pub(crate) struct BlockFlicker<S> {
 /// Every flicker source of one board (one point per lane).
 #[derive(Clone, Debug)]
 pub(crate) struct FlickerSources<S: Sample> {
-    rng: NoiseRng,
+    rng: LaneRng,
     tia: [Source<S>; 2],
     amplitude: [Source<S>; 2],
     phase: [Source<S>; 2],
@@ -62,10 +62,7 @@ impl<S: Sample> FlickerSources<S> {
         let Some(n) = p.noise.filter(has_flicker) else {
             return Ok(None);
         };
-        let last = streams.len() - 1;
-        let seeds =
-            core::array::from_fn(|i| stream_seed(n.seed ^ FLICKER_SALT, streams[i.min(last)]));
-        let mut rng = NoiseRng::new(seeds);
+        let mut rng = LaneRng::new(n.seed ^ FLICKER_SALT, streams);
         let (fs, fs_out) = (p.fs_hz(), p.fs_out_hz());
         let i_v = gyroemu_tia::input_referred_noise_a_per_rthz(
             0.0,
@@ -89,7 +86,7 @@ impl<S: Sample> FlickerSources<S> {
             if params.psd_at_1hz == 0.0 {
                 return Ok(None);
             }
-            Flicker::stationary(&params, || S::from_x4(rng.normal_pair().0)).map(Some)
+            Flicker::stationary(&params, || rng.pair::<S>().0).map(Some)
         };
         let tia = [source(fast(tia_s1))?, source(fast(tia_s1))?];
         let amplitude = [
@@ -121,7 +118,7 @@ impl<S: Sample> FlickerSources<S> {
     pub(crate) fn next_block(&mut self) {
         let rng = &mut self.rng;
         let mut draw = |s: &mut Source<S>| match s {
-            Some(f) => f.tick(S::from_x4(rng.normal_pair().0)),
+            Some(f) => f.tick(rng.pair::<S>().0),
             None => S::splat(0.0),
         };
         let a = [draw(&mut self.amplitude[0]), draw(&mut self.amplitude[1])];
@@ -146,14 +143,51 @@ impl<S: Sample> FlickerSources<S> {
         if self.tia[0].is_none() {
             return [S::splat(0.0); 2];
         }
-        let (w0, w1) = self.rng.normal_pair();
+        let (w0, w1) = self.rng.pair::<S>();
         let mut out = [S::splat(0.0); 2];
         for (k, w) in [w0, w1].into_iter().enumerate() {
             if let Some(f) = &mut self.tia[k] {
-                out[k] = f.tick(S::from_x4(w));
+                out[k] = f.tick(w);
             }
         }
         out
+    }
+}
+
+/// The flicker streams of up to eight lanes, four lanes per generator as the white noise's
+/// (lane `4q + i` is lane `i` of generator `q`), so a point draws the same normals in a group
+/// of four or of eight.
+#[derive(Clone, Debug)]
+struct LaneRng([NoiseRng; 2]);
+
+impl LaneRng {
+    /// Lane `i` on stream `streams[i]` (lanes past the end repeat the last).
+    fn new(seed: u64, streams: &[u64]) -> Self {
+        let last = streams.len() - 1;
+        let rng = |q: usize| {
+            NoiseRng::new(core::array::from_fn(|i| {
+                stream_seed(seed, streams[(4 * q + i).min(last)])
+            }))
+        };
+        Self([rng(0), rng(1)])
+    }
+
+    /// The next pair of standard normals in every lane of `S` (the second generator only
+    /// draws for lane types wider than four).
+    #[inline(always)]
+    fn pair<S: Sample>(&mut self) -> (S, S) {
+        let (a0, b0) = self.0[0].normal_pair();
+        if S::LANES <= 4 {
+            return (S::load(&a0.to_array()), S::load(&b0.to_array()));
+        }
+        let (a1, b1) = self.0[1].normal_pair();
+        let join = |x: f64x4, y: f64x4| {
+            let mut v = [0.0; 8];
+            v[..4].copy_from_slice(&x.to_array());
+            v[4..].copy_from_slice(&y.to_array());
+            S::load(&v)
+        };
+        (join(a0, a1), join(b0, b1))
     }
 }
 

@@ -10,7 +10,7 @@ use crate::params::Shape;
 use crate::point::{LaneResult, Point, RunOptions, RunOutput};
 use crate::probe::Probe;
 use gyroemu_am::AmInput;
-use gyroemu_core::{f64x4, Complex64, Sample, Stage};
+use gyroemu_core::{Complex64, Sample, Stage};
 use gyroemu_lpf::Averager;
 use gyroemu_mixer::{
     table_channel, table_reference, Iq, Stage1Mixer, MAX_TABLE_HARMONIC, TABLE_CHANNELS,
@@ -56,7 +56,9 @@ impl<S: Sample> Board<S> {
         }
     }
 
-    /// One block of the checking replay, in the run's plant shape.
+    /// One block of the checking replay, in the run's plant shape (inlined into
+    /// [`Board::locate_fault`]'s loop, compiled like the sample loop).
+    #[inline(always)]
     pub(crate) fn replay_block(&mut self, n0: u64, probe: &mut Probe) {
         let mut counts = Counters::default();
         macro_rules! by_plant {
@@ -81,9 +83,27 @@ impl<S: Sample> Board<S> {
     ///
     /// Its own function per shape: inlined into the dispatcher beside the other shapes, the
     /// sample loop's registers were allocated worse (measurably slower).
-    #[allow(clippy::needless_range_loop)] // mode and lane indices address parallel arrays
+    ///
+    /// It enters through [`Sample::with_target_features`], so an eight-lane board's loop is
+    /// compiled for AVX-512 with every operation inlined.
     #[inline(never)]
     fn sample_loop<const K: u8, const NOISY: bool, const DECOUPLED: bool>(
+        &mut self,
+        n_settle: u64,
+        points: &[Point],
+        opts: RunOptions,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<RunOutput, u64> {
+        S::with_target_features(
+            #[inline(always)]
+            || self.sample_loop_body::<K, NOISY, DECOUPLED>(n_settle, points, opts, progress),
+        )
+    }
+
+    /// [`Board::sample_loop`]'s body.
+    #[allow(clippy::needless_range_loop)] // mode and lane indices address parallel arrays
+    #[inline(always)]
+    fn sample_loop_body<const K: u8, const NOISY: bool, const DECOUPLED: bool>(
         &mut self,
         n_settle: u64,
         points: &[Point],
@@ -225,9 +245,9 @@ impl<S: Sample> Board<S> {
                     series_acc = [S::splat(0.0); 8];
                 }
             }
-            avg.push(&x);
+            push_average(&mut avg, &x);
             if K == RATE_TABLE {
-                table_avg.push(&tx);
+                push_average(&mut table_avg, &tx);
             }
         }
         progress(n_out * m);
@@ -264,6 +284,9 @@ impl<S: Sample> Board<S> {
         counts: &mut Counters<S>,
     ) -> ([Iq<S>; 2], [S; 2]) {
         let zero = S::splat(0.0);
+        // Lanes per row of the board's normals (`Board::new`: one or two four-lane sets).
+        const { assert!(S::LANES <= 8) };
+        let noise_width: usize = S::LANES.next_multiple_of(4);
         let mut out = ([Iq::<S>::default(); 2], [zero; 2]);
         let m = self.decimation as u64;
         let noisy = NOISY && self.noise_on;
@@ -331,15 +354,16 @@ impl<S: Sample> Board<S> {
                     };
                 }
                 // This sample's normals: force on each mode, then input current on each mode.
-                let nz = if noisy {
-                    self.noise.normals.at(base + 4 * (j - j0) as usize)
+                let nz: [S; 4] = if noisy {
+                    let row = base + 4 * (j - j0) as usize;
+                    core::array::from_fn(|c| S::load(self.noise.normals.row(row + c, noise_width)))
                 } else {
-                    [f64x4::ZERO; 4]
+                    [zero; 4]
                 };
                 if noisy {
                     // Brownian force on each mode, after the DAC (it acts on the proof mass).
-                    u[0] = S::from_x4(nz[0]).mul_add(self.noise.sigma_force[0], u[0]);
-                    u[1] = S::from_x4(nz[1]).mul_add(self.noise.sigma_force[1], u[1]);
+                    u[0] = nz[0].mul_add(self.noise.sigma_force[0], u[0]);
+                    u[1] = nz[1].mul_add(self.noise.sigma_force[1], u[1]);
                 }
                 let mut p = if K == RATE_TABLE {
                     let (_, sin_t) = self.table_nco.tick(());
@@ -356,10 +380,8 @@ impl<S: Sample> Board<S> {
                 };
                 if noisy {
                     // Amplifier noise, referred to the TIA input.
-                    p.current[0] =
-                        S::from_x4(nz[2]).mul_add(self.noise.sigma_current[0], p.current[0]);
-                    p.current[1] =
-                        S::from_x4(nz[3]).mul_add(self.noise.sigma_current[1], p.current[1]);
+                    p.current[0] = nz[2].mul_add(self.noise.sigma_current[0], p.current[0]);
+                    p.current[1] = nz[3].mul_add(self.noise.sigma_current[1], p.current[1]);
                 }
                 if let (Some(f), true) = (&mut self.flicker, fb.is_some()) {
                     // The TIA voltage noise's flicker, referred to the input likewise.
@@ -446,19 +468,31 @@ impl<S: Sample> Board<S> {
         };
         let mut board = (**pristine).clone();
         let mut probe = Probe::finite_check(self.lanes);
-        for k in 0..=k_bad {
-            board.replay_block(k * m, &mut probe);
-            if let Some((stage, sample, lane)) = probe.fault() {
-                return NonFinite {
-                    stage,
-                    sample,
-                    time_s: sample as f64 / self.fs_hz,
-                    rate_dps: rate_dps(lane),
-                };
+        S::with_target_features(|| {
+            for k in 0..=k_bad {
+                board.replay_block(k * m, &mut probe);
+                if let Some((stage, sample, lane)) = probe.fault() {
+                    return NonFinite {
+                        stage,
+                        sample,
+                        time_s: sample as f64 / self.fs_hz,
+                        rate_dps: rate_dps(lane),
+                    };
+                }
             }
-        }
-        fallback
+            fallback
+        })
     }
+}
+
+/// Adds a decimated sample to an average: out of line (once per decimation block, kept apart
+/// from the sample loop's registers) and compiled like the loop, the push inlined.
+#[inline(never)]
+fn push_average<S: Sample, const C: usize>(avg: &mut Averager<S, C>, x: &[S; C]) {
+    S::with_target_features(
+        #[inline(always)]
+        || avg.push(x),
+    )
 }
 
 /// A lane's averaged channels as the result of its experiment shape (`table`: the averaged

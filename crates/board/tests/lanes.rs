@@ -1,12 +1,13 @@
 //! The board in f64x4 lanes gives each lane the result the scalar board gives for that
 //! operating point alone (bit for bit: the arithmetic is lane-wise, and `Sample::mul_add` is
 //! fused or not alike for f64 and f64x4), with and without noise (each point has its own
-//! stream, so its noise does not depend on the lane that runs it).
+//! stream, so its noise does not depend on the lane that runs it); so does a group of eight
+//! lanes on a CPU with AVX-512, and a group of either width chosen by `GroupBoard::new`.
 
 mod common;
 
 use common::{m2tfg, noisy, point};
-use gyroemu_board::{Board, BoardParams, RunOptions, Shape};
+use gyroemu_board::{eight_lanes_available, Board, BoardParams, GroupBoard, RunOptions, Shape};
 use gyroemu_core::f64x4;
 
 fn check(name: &str, p: &BoardParams, n: u64) {
@@ -39,6 +40,71 @@ fn lanes_equal_scalar_for_every_shape_with_and_without_noise() {
         let p = m2tfg(shape);
         check(&format!("{shape:?}"), &p, 110);
         check(&format!("{shape:?} noisy"), &noisy(p, 42), 110);
+    }
+}
+
+/// Seven points in one group of eight lanes (one lane idle), each against the scalar board.
+fn check_eight(name: &str, p: &BoardParams, n: u64) {
+    let rates = [25.0, 100.0, 175.0, -50.0, 0.0, 60.0, -175.0];
+    let points: Vec<_> = rates
+        .iter()
+        .enumerate()
+        .map(|(i, &r)| point(r, n + 3 * i as u64 - 9))
+        .collect();
+    let rad: Vec<f64> = points.iter().map(|p| p.rate_rad_s).collect();
+    let streams: Vec<u64> = (0..7).map(|i| 5 * i + 2).collect();
+    let n_settle = 12;
+    let mut board = GroupBoard::with_width(8, p, &rad, &streams).unwrap();
+    assert_eq!((board.width(), board.lanes()), (8, 7));
+    let lanes = board
+        .run(n_settle, &points, RunOptions::default(), &|_| {})
+        .unwrap()
+        .lanes;
+    for (i, q) in points.iter().enumerate() {
+        let scalar = Board::<f64>::new(p, &[q.rate_rad_s], &[streams[i]])
+            .unwrap()
+            .run(n_settle, &[*q], RunOptions::default(), &|_| {})
+            .unwrap()
+            .lanes;
+        assert_eq!(lanes[i], scalar[0], "{name}: lane {i}");
+    }
+}
+
+#[test]
+fn eight_lanes_equal_scalar_for_every_shape_with_and_without_noise() {
+    if !eight_lanes_available() {
+        eprintln!("no AVX-512 on this CPU: groups of eight are not run here");
+        return;
+    }
+    for shape in [
+        Shape::Coriolis,
+        Shape::RateTable { freq_hz: 2.0 },
+        Shape::Rotating,
+    ] {
+        let p = m2tfg(shape);
+        check_eight(&format!("{shape:?}"), &p, 110);
+        check_eight(&format!("{shape:?} noisy"), &noisy(p, 42), 110);
+    }
+}
+
+#[test]
+fn a_group_board_picks_four_lanes_for_four_points_and_refuses_a_bad_width() {
+    let p = m2tfg(Shape::Coriolis);
+    assert_eq!(
+        GroupBoard::new(&p, &[0.0; 4], &[0, 1, 2, 3])
+            .unwrap()
+            .width(),
+        4
+    );
+    let five = GroupBoard::new(&p, &[0.0; 5], &[0, 1, 2, 3, 4]);
+    assert_eq!(five.is_ok(), eight_lanes_available());
+    for bad in [0, 2, 16] {
+        let e = GroupBoard::with_width(bad, &p, &[0.0], &[0]).err().unwrap();
+        assert!(e.to_string().contains("must be 4 or 8"), "{e}");
+    }
+    if !eight_lanes_available() {
+        let e = GroupBoard::with_width(8, &p, &[0.0], &[0]).err().unwrap();
+        assert!(e.to_string().contains("AVX-512"), "{e}");
     }
 }
 

@@ -1,12 +1,15 @@
 //! The fused kernel against the reference board (every stage through its own `Stage::tick`,
 //! none of the kernel's shortcuts), bit for bit: every experiment shape, with and without
-//! noise and converters, an imperfect device, decimation 1 and 100, each lane of a group.
+//! noise and converters, an imperfect device, decimation 1 and 100, each lane of a group, in
+//! groups of four lanes and (on a CPU with AVX-512) of eight.
 
 mod common;
 
 use common::{flickering, imperfect, m2tfg, noisy, point};
 use gyroemu_board::reference::run_reference;
-use gyroemu_board::{Board, BoardParams, Point, RunOptions, Shape};
+use gyroemu_board::{
+    eight_lanes_available, Board, BoardParams, GroupBoard, Point, RunOptions, Shape,
+};
 use gyroemu_core::f64x4;
 
 const SHAPES: [Shape; 3] = [
@@ -15,10 +18,35 @@ const SHAPES: [Shape; 3] = [
     Shape::Rotating,
 ];
 
+/// The lane widths this CPU runs.
+fn widths() -> Vec<usize> {
+    if eight_lanes_available() {
+        vec![4, 8]
+    } else {
+        eprintln!("no AVX-512 on this CPU: only groups of four lanes are checked");
+        vec![4]
+    }
+}
+
+/// The group's lanes (up to its width of `points`) against the reference board, one point
+/// at a time, in every lane width.
 fn check(name: &str, p: &BoardParams, points: &[Point], n_settle: u64) {
+    for width in widths() {
+        check_width(
+            &format!("{name} in {width} lanes"),
+            width,
+            p,
+            points,
+            n_settle,
+        );
+    }
+}
+
+fn check_width(name: &str, width: usize, p: &BoardParams, points: &[Point], n_settle: u64) {
+    let points = &points[..points.len().min(width)];
     let streams: Vec<u64> = (0..points.len() as u64).map(|i| 3 * i + 1).collect();
     let rates: Vec<f64> = points.iter().map(|q| q.rate_rad_s).collect();
-    let fused = Board::<f64x4>::new(p, &rates, &streams)
+    let fused = GroupBoard::with_width(width, p, &rates, &streams)
         .unwrap()
         .run(n_settle, points, RunOptions::default(), &|_| {})
         .unwrap()
@@ -39,7 +67,15 @@ fn check(name: &str, p: &BoardParams, points: &[Point], n_settle: u64) {
 fn fused_lanes_equal_the_reference_board_for_every_shape() {
     for shape in SHAPES {
         let p = m2tfg(shape);
-        let pts = [point(25.0, 60), point(175.0, 37), point(-100.0, 50)];
+        // Four points in groups of four; six (two lanes idle) in groups of eight.
+        let pts = [
+            point(25.0, 60),
+            point(175.0, 37),
+            point(-100.0, 50),
+            point(60.0, 44),
+            point(-175.0, 52),
+            point(0.0, 41),
+        ];
         check(&format!("{shape:?}"), &p, &pts, 30);
         check(&format!("{shape:?} noisy"), &noisy(p, 42), &pts, 30);
         check(
@@ -71,7 +107,13 @@ fn fused_equals_reference_without_decimation_and_at_rest() {
         };
         // One point at rest: the decoupled plant step in a Coriolis run.
         check(&format!("{shape:?} M = 1"), &p, &[point(0.0, 3000)], 500);
-        let pts = [point(0.0, 2000), point(60.0, 2000)];
+        let pts = [
+            point(0.0, 2000),
+            point(60.0, 2000),
+            point(-30.0, 1900),
+            point(90.0, 2000),
+            point(120.0, 1990),
+        ];
         check(&format!("{shape:?} M = 1 noisy"), &noisy(p, 3), &pts, 500);
     }
 }
@@ -103,4 +145,18 @@ fn the_shortcuts_under_test_are_taken() {
     assert!(!Board::<f64x4>::new(&imperfect(table), &[1.0], &[0])
         .unwrap()
         .plant_decoupled());
+    // Eight lanes: every lane is checked (one rotating lane among decoupled ones).
+    if eight_lanes_available() {
+        let rot = m2tfg(Shape::Rotating);
+        let eight = |p: &BoardParams, rates: &[f64]| {
+            let streams: Vec<u64> = (0..rates.len() as u64).collect();
+            GroupBoard::with_width(8, p, rates, &streams)
+                .unwrap()
+                .plant_decoupled()
+        };
+        assert!(eight(&rot, &[0.5; 8]));
+        let cor = m2tfg(Shape::Coriolis);
+        assert!(eight(&cor, &[0.0; 8]));
+        assert!(!eight(&cor, &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1e-3]));
+    }
 }

@@ -21,6 +21,10 @@ struct Cli {
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long, global = true)]
     threads: Option<usize>,
+    /// For tests and benchmarks: the widest lane group, 4 or 8 operating points (default: 8
+    /// on a CPU with AVX-512, else 4). Results do not depend on it.
+    #[arg(long, global = true, hide = true)]
+    lanes: Option<usize>,
     #[command(subcommand)]
     command: Command,
 }
@@ -193,6 +197,12 @@ fn run_cli() -> ExitCode {
         let _ = rayon::ThreadPoolBuilder::new()
             .num_threads(t)
             .build_global();
+    }
+    if let Some(n) = cli.lanes {
+        if let Err(e) = gyroemu_board::set_max_lanes(n) {
+            eprintln!("error: {e}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
     }
     let result = match cli.command {
         Command::Reproduce { out, quick } => cmd::reproduce::reproduce_command(&out, quick),

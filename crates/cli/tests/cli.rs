@@ -298,9 +298,9 @@ fn inspect_refuses_missing_or_damaged_dumps_with_exit_2() {
     assert_eq!(pngs, 0);
 }
 
-/// `bench` measures the whole chain, noiseless and with noise, and every stage on 1 and on all
-/// threads (the figures are timing, so only their presence and sign are checked), and refuses
-/// zero repeats.
+/// `bench` measures the whole chain, noiseless and with noise, in the lanes a run uses here and
+/// in each lane type the CPU runs, and every stage, on 1 and on all threads (the figures are
+/// timing, so only their presence and sign are checked), and refuses zero repeats.
 #[test]
 fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
     let o = gyroemu(&[
@@ -314,34 +314,55 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8_lossy(&o.stdout);
-    for name in [
-        "whole chain",
-        "whole chain with noise",
-        "resonator (decoupled step)",
-        "low-pass bank (I1, Q1, I2, Q2)",
-        "tia",
-    ] {
+    // Groups of eight exist on a CPU with AVX-512 only; the rows without a lane type are the
+    // figures of the type a run uses.
+    let eight = gyroemu(&["--lanes", "8", "config"]).status.success();
+    let native = if eight { "f64x8" } else { "f64x4" };
+    assert!(
+        stderr(&o).contains(&format!("in {native} lanes")),
+        "{}",
+        stderr(&o)
+    );
+    let mut names = vec![
+        "whole chain".to_string(),
+        "whole chain with noise".to_string(),
+        "resonator (decoupled step)".to_string(),
+        "low-pass bank (I1, Q1, I2, Q2)".to_string(),
+        "tia".to_string(),
+    ];
+    for t in ["f64x4", "f64x8"].iter().take(if eight { 2 } else { 1 }) {
+        names.push(format!("whole chain ({t})"));
+        names.push(format!("whole chain with noise ({t})"));
+    }
+    let figures = |name: &str, threads: &str| -> Vec<f64> {
+        let row = text
+            .lines()
+            .find(|l| {
+                // The label is the text left of the three figures.
+                let words: Vec<&str> = l.split_whitespace().collect();
+                words.len() > 3
+                    && words[..words.len() - 3].join(" ") == name
+                    && words[words.len() - 3] == threads
+            })
+            .unwrap_or_else(|| panic!("no `{name}` row on {threads} threads:\n{text}"));
+        row.split_whitespace()
+            .rev()
+            .take(2)
+            .map(|x| x.parse().unwrap())
+            .collect()
+    };
+    for name in &names {
         for threads in ["1", "2"] {
-            let row = text
-                .lines()
-                .find(|l| {
-                    // The label is the text left of the three figures.
-                    let words: Vec<&str> = l.split_whitespace().collect();
-                    words.len() > 3
-                        && words[..words.len() - 3].join(" ") == name
-                        && words[words.len() - 3] == threads
-                })
-                .unwrap_or_else(|| panic!("no `{name}` row on {threads} threads:\n{text}"));
-            let v: Vec<f64> = row
-                .split_whitespace()
-                .rev()
-                .take(2)
-                .map(|x| x.parse().unwrap())
-                .collect();
+            let v = figures(name, threads);
             // Best (second from the right) is at least the median (rightmost), both positive.
-            assert!(v[0] > 0.0 && v[1] >= v[0], "{row}");
+            assert!(v[0] > 0.0 && v[1] >= v[0], "{name}: {v:?}");
         }
     }
+    for label in ["whole chain", "whole chain with noise"] {
+        let typed = format!("{label} ({native})");
+        assert_eq!(figures(label, "1"), figures(&typed, "1"), "{label}");
+    }
+    assert!(!text.contains("(f64x8)") || eight, "{text}");
     let bad = gyroemu(&["bench", "--repeats", "0"]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(stderr(&bad).contains("--repeats = 0"), "{}", stderr(&bad));

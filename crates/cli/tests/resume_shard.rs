@@ -4,13 +4,15 @@
 //! four shards (three by `--shard`, one by Slurm's array variables) and three Kubernetes-style
 //! shards merged equal the one-machine run byte for byte; merge refuses a missing shard, a
 //! duplicated point, a missing point file, an unfinished shard and a shard of another config;
-//! a run refuses an output folder holding another config's results unless `--force`.
+//! a run refuses an output folder holding another config's results unless `--force`; a machine
+//! running lane groups of eight (AVX-512) writes the bytes one running groups of four writes,
+//! whole runs, point files and shards merged across the two.
 
 mod common;
 
 use common::*;
 use serde_json::Value;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Output;
 
 /// A Coriolis sweep with every noise source (so each point's random stream matters): nine
@@ -197,6 +199,72 @@ fn kubernetes_indexed_job_shards_merge_too() {
     }
     ok(gyroemu(&["merge", s(&out)], &[]));
     assert_same_outputs(&reference, &out);
+}
+
+/// Every file of a run's output folder, by path inside it.
+fn tree(out: &Path) -> std::collections::BTreeMap<PathBuf, Vec<u8>> {
+    let mut files = std::collections::BTreeMap::new();
+    let mut dirs = vec![out.to_path_buf()];
+    while let Some(d) = dirs.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                dirs.push(p);
+            } else {
+                let rel = p.strip_prefix(out).unwrap().to_path_buf();
+                files.insert(rel, std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    files
+}
+
+#[test]
+fn eight_lane_and_four_lane_machines_write_the_same_bytes() {
+    let eight = gyroemu(&["--lanes", "8", "config"], &[]).status.success();
+    if !eight {
+        eprintln!("no AVX-512 on this CPU: groups of eight are not run here");
+        let o = gyroemu(&["--lanes", "8", "config"], &[]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains("AVX-512"), "{}", stderr(&o));
+        return;
+    }
+    let o = gyroemu(&["--lanes", "5", "config"], &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("must be 4 or 8"), "{}", stderr(&o));
+    for (name, text) in [("noisy", NOISY), ("rotating", ROTATING)] {
+        let dir = tempfile::tempdir().unwrap();
+        let cfg = config(dir.path(), &format!("{name}.toml"), text);
+        let lanes = |n: &str, out: &Path, extra: &[&str]| {
+            let mut args = vec![
+                "--lanes",
+                n,
+                "--threads",
+                "1",
+                "run",
+                s(&cfg),
+                "--out",
+                s(out),
+            ];
+            args.extend(extra);
+            let o = ok(gyroemu(&args, &[]));
+            // One thread, more than four points: the groups are as wide as allowed.
+            let plan = format!("lane groups of up to {n}");
+            assert!(stderr(&o).contains(&plan), "{}", stderr(&o));
+        };
+        let (four, wide) = (dir.path().join("four"), dir.path().join("eight"));
+        lanes("4", &four, &[]);
+        lanes("8", &wide, &[]);
+        let files = tree(&four);
+        assert!(files.keys().any(|p| p.starts_with("points")), "{files:?}");
+        assert!(files == tree(&wide), "{name}: the outputs differ");
+        // Two shards, one per kind of machine, merged.
+        let mixed = dir.path().join("mixed");
+        lanes("8", &mixed, &["--shard", "0/2"]);
+        lanes("4", &mixed, &["--shard", "1/2"]);
+        ok(gyroemu(&["merge", s(&mixed)], &[]));
+        assert_same_outputs(&four, &mixed);
+    }
 }
 
 fn copy_dir(from: &Path, to: &Path) {

@@ -175,14 +175,55 @@ fn tail(s: &mut [u64x4; 4], lane: usize) -> f64 {
     }
 }
 
-/// [`NoiseRng::fill_pairs`] without AVX-512: stream a, then stream b, four lanes at a time.
-pub(crate) fn fill_pairs_portable(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
+/// Fills `out` (of even length) with the next normals of stream a and stream b of four
+/// lanes in turn, with AVX-512F when the CPU has it (the same bits).
+#[inline]
+pub(crate) fn fill_one(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
+    assert!(out.len().is_multiple_of(2), "normals come in pairs");
+    #[cfg(target_arch = "x86_64")]
+    if crate::gauss_avx512::available() {
+        // SAFETY: the CPU has AVX-512F (checked just above).
+        unsafe { crate::gauss_avx512::fill_one(s, out) };
+        return;
+    }
+    fill_one_portable(s, out);
+}
+
+/// [`fill_one`] without AVX-512: stream a, then stream b, four lanes at a time.
+pub(crate) fn fill_one_portable(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
     let [mut a, mut b] = *s;
     for pair in out.chunks_exact_mut(2) {
         pair[0] = next_normal(&mut a);
         pair[1] = next_normal(&mut b);
     }
     *s = [a, b];
+}
+
+/// Fills `out` (a multiple of four long) with the next normals of the four-lane stream sets
+/// `s[0][0], s[0][1], s[1][0], s[1][1]` in turn (stream a of lanes 0-3 and 4-7, then stream
+/// b of lanes 0-3 and 4-7: rows of eight lanes), with AVX-512F when the CPU has it.
+#[inline]
+pub(crate) fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4]) {
+    assert!(out.len().is_multiple_of(4), "whole rows of eight lanes");
+    #[cfg(target_arch = "x86_64")]
+    if crate::gauss_avx512::available() {
+        // SAFETY: the CPU has AVX-512F (checked just above).
+        unsafe { crate::gauss_avx512::fill_two(s, out) };
+        return;
+    }
+    fill_two_portable(s, out);
+}
+
+/// [`fill_two`] without AVX-512.
+pub(crate) fn fill_two_portable(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4]) {
+    let [[mut a0, mut a1], [mut b0, mut b1]] = *s;
+    for round in out.chunks_exact_mut(4) {
+        round[0] = next_normal(&mut a0);
+        round[1] = next_normal(&mut a1);
+        round[2] = next_normal(&mut b0);
+        round[3] = next_normal(&mut b1);
+    }
+    *s = [[a0, a1], [b0, b1]];
 }
 
 impl NoiseRng {
@@ -197,53 +238,67 @@ impl NoiseRng {
     /// Fills `out` (of even length) with the next pairs: `out[2k]` and `out[2k + 1]` are what
     /// the k-th call of [`NoiseRng::normal_pair`] gives (the same bits).
     pub fn fill_pairs(&mut self, out: &mut [f64x4]) {
-        assert!(out.len().is_multiple_of(2), "normals come in pairs");
-        #[cfg(target_arch = "x86_64")]
-        if crate::gauss_avx512::available() {
-            // SAFETY: the CPU has AVX-512F (checked just above).
-            unsafe { crate::gauss_avx512::fill_pairs(&mut self.s, out) };
-            return;
-        }
-        fill_pairs_portable(&mut self.s, out);
+        fill_one(&mut self.s, out);
     }
 }
 
-/// Normals drawn ahead in blocks, for a loop that takes four per sample: the sequence of
-/// [`NoiseRng::normal_pair`] calls, with the generator's state in registers while it fills.
+/// Normals drawn ahead in blocks, for a loop that takes four per sample, of four lanes (one
+/// [`NoiseRng`]) or eight (two): row `k` holds every lane's `k`-th normal, which alternate
+/// between the lane's stream a and stream b as [`NoiseRng::normal_pair`] gives them. A lane's
+/// rows are the same in a block of four lanes and of eight.
 #[derive(Clone, Debug)]
 pub struct NormalBlock {
-    rng: NoiseRng,
-    buf: Box<[f64x4; NormalBlock::LEN]>,
-    /// The next unread entry (`LEN`: all read).
+    /// The four-lane stream sets, paired as one AVX-512 register fills them (each pair one
+    /// row of eight lanes, or two rows of four): one [`NoiseRng`]: its (a, b); two: (a of
+    /// lanes 0-3, a of lanes 4-7), then (b of lanes 0-3, b of lanes 4-7).
+    s: [[[u64x4; 4]; 2]; 2],
+    /// Lanes per row: 4 or 8.
+    width: usize,
+    buf: Box<Rows>,
+    /// The next unread row (`LEN`: all read).
     pos: usize,
 }
 
+/// The rows of a [`NormalBlock`], `LEN` rows of up to eight lanes, as chunks of four lanes;
+/// aligned so that a row of eight is one cache line.
+#[derive(Clone, Debug)]
+#[repr(C, align(64))]
+struct Rows([f64x4; 2 * NormalBlock::LEN]);
+
 impl NormalBlock {
-    /// Normals per lane drawn at a time (64 samples of four; a power of two).
+    /// Rows (normals per lane) drawn at a time: 64 samples of four (a power of two).
     pub const LEN: usize = 256;
 
-    /// Normals from `rng`'s streams, from their current state on.
+    /// Four lanes' normals from `rng`'s streams, from their current state on.
     pub fn new(rng: NoiseRng) -> Self {
+        Self::with_sets([rng.s, [[u64x4::ZERO; 4]; 2]], 4)
+    }
+
+    /// Eight lanes' normals: lanes 0-3 from `lo`'s streams, lanes 4-7 from `hi`'s.
+    pub fn wide(lo: NoiseRng, hi: NoiseRng) -> Self {
+        let [la, lb] = lo.s;
+        let [ha, hb] = hi.s;
+        Self::with_sets([[la, ha], [lb, hb]], 8)
+    }
+
+    fn with_sets(s: [[[u64x4; 4]; 2]; 2], width: usize) -> Self {
         Self {
-            rng,
-            buf: Box::new([f64x4::ZERO; Self::LEN]),
+            s,
+            width,
+            buf: Box::new(Rows([f64x4::ZERO; 2 * Self::LEN])),
             pos: Self::LEN,
         }
     }
 
-    /// The next two pairs of every lane, in order: a, b, a, b.
-    #[inline(always)]
-    pub fn next4(&mut self) -> [f64x4; 4] {
-        self.ready(1);
-        let n = self.at(self.pos);
-        self.pos += 4;
-        n
+    /// Lanes per row (4 or 8).
+    pub fn width(&self) -> usize {
+        self.width
     }
 
-    /// Makes the normals of up to `samples` samples (four each) ready, drawing more if none
-    /// are left, and returns how many samples they cover (at least one): a loop can then read
-    /// them with [`NormalBlock::at`] from [`NormalBlock::pos`] on, without a call per sample,
-    /// and [`NormalBlock::advance`] past them.
+    /// Makes the normals of up to `samples` samples (four rows each) ready, drawing more if
+    /// none are left, and returns how many samples they cover (at least one): a loop can then
+    /// read them with [`NormalBlock::row`] from [`NormalBlock::pos`] on, without a call per
+    /// sample, and [`NormalBlock::advance`] past them.
     #[inline(always)]
     pub fn ready(&mut self, samples: u64) -> u64 {
         if self.pos == Self::LEN {
@@ -252,25 +307,23 @@ impl NormalBlock {
         samples.min(((Self::LEN - self.pos) / 4) as u64)
     }
 
-    /// The index of the next unread normal.
+    /// The index of the next unread row.
     #[inline(always)]
     pub fn pos(&self) -> usize {
         self.pos
     }
 
-    /// The four normals from index `i` (a multiple of four, below `LEN`).
+    /// Row `r` (below `LEN`) of a block of `width` lanes ([`NormalBlock::width`], passed by a
+    /// caller that knows it at compile time): lane `l`'s normal at index `l`.
     #[inline(always)]
-    pub fn at(&self, i: usize) -> [f64x4; 4] {
-        let i = i & (Self::LEN - 4);
-        [
-            self.buf[i],
-            self.buf[i + 1],
-            self.buf[i + 2],
-            self.buf[i + 3],
-        ]
+    pub fn row(&self, r: usize, width: usize) -> &[f64] {
+        debug_assert_eq!(width, self.width);
+        let flat: &[f64; 8 * Self::LEN] = wide::bytemuck::cast_ref(&self.buf.0);
+        let i = (r & (Self::LEN - 1)) * width;
+        &flat[i..i + width]
     }
 
-    /// Marks `samples` samples' normals (four each) as read.
+    /// Marks `samples` samples' rows (four each) as read.
     #[inline(always)]
     pub fn advance(&mut self, samples: u64) {
         self.pos += 4 * samples as usize;
@@ -278,7 +331,12 @@ impl NormalBlock {
 
     #[inline(never)]
     fn refill(&mut self) {
-        self.rng.fill_pairs(&mut self.buf[..]);
+        let rows = &mut self.buf.0[..Self::LEN * self.width / 4];
+        if self.width == 8 {
+            fill_two(&mut self.s, rows);
+        } else {
+            fill_one(&mut self.s[0], rows);
+        }
         self.pos = 0;
     }
 }

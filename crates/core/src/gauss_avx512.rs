@@ -1,6 +1,6 @@
 //! The fast path of `gauss` with AVX-512F, chosen at run time (the build targets x86-64-v3):
-//! one 512-bit register holds stream a and stream b of the four lanes, so each step, table
-//! look-up and test serves eight normals. The operations are the portable path's (integer
+//! one 512-bit register holds two sets of four streams (stream a and stream b of four lanes,
+//! or stream a of eight lanes), so each step, table look-up and test serves eight normals. The operations are the portable path's (integer
 //! steps, the same table entries, one exact subtraction and one rounded product per normal,
 //! exact comparisons), and draws that miss their piece's core finish in the portable code, so
 //! the bits are the same on either path (tested).
@@ -35,58 +35,114 @@ fn halves(v: __m512i) -> [u64x4; 2] {
     ]
 }
 
-/// [`crate::NoiseRng::fill_pairs`] with AVX-512F.
+/// The constants of [`draw`].
+#[derive(Clone, Copy)]
+struct Consts {
+    index: __m512i,
+    one: __m512i,
+    sign_bit: __m512i,
+}
+
+impl Consts {
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn new() -> Self {
+        Self {
+            index: _mm512_set1_epi64(N as i64 - 1),
+            one: _mm512_set1_epi64(ONE_BITS as i64),
+            sign_bit: _mm512_set1_epi64(SIGN_BIT as i64),
+        }
+    }
+}
+
+/// The next normal of the eight streams in `st` (two sets of four joined) into `pair` (two
+/// f64x4: the low set's lanes, then the high set's); returns the streams' new state. By value
+/// in and out, so the caller's state stays in registers.
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
+    let [mut s0, mut s1, mut s2, mut s3] = st;
+    // xoshiro256++ of all eight streams.
+    let w = _mm512_add_epi64(_mm512_rol_epi64::<23>(_mm512_add_epi64(s0, s3)), s0);
+    let t = _mm512_slli_epi64::<17>(s1);
+    s2 = _mm512_xor_si512(s2, s0);
+    s3 = _mm512_xor_si512(s3, s1);
+    s1 = _mm512_xor_si512(s1, s2);
+    s0 = _mm512_xor_si512(s0, s3);
+    s2 = _mm512_xor_si512(s2, t);
+    s3 = _mm512_rol_epi64::<45>(s3);
+    // Each stream's piece: [width, bound] pairs, 16 bytes apart.
+    let mut off = [0u64; 8];
+    // SAFETY: `off` is 64 bytes.
+    unsafe {
+        _mm512_storeu_si512(
+            off.as_mut_ptr().cast(),
+            _mm512_slli_epi64::<4>(_mm512_and_si512(w, k.index)),
+        )
+    };
+    let base = FAST.0.as_ptr() as *const u8;
+    // SAFETY: every offset is below 16 N, inside the table of N pairs.
+    let p = |k: usize| unsafe { _mm_loadu_pd(base.add(off[k] as usize).cast()) };
+    let lo = |k: usize, j: usize| _mm256_insertf128_pd::<1>(_mm256_castpd128_pd256(p(k)), p(j));
+    // Pieces of streams 0, 2, 4, 6 and of 1, 3, 5, 7, then width and bound of all eight.
+    let even = _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(lo(0, 2)), lo(4, 6));
+    let odd = _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(lo(1, 3)), lo(5, 7));
+    let width = _mm512_unpacklo_pd(even, odd);
+    let bound = _mm512_unpackhi_pd(even, odd);
+    let b = _mm512_castsi512_pd(_mm512_or_si512(_mm512_srli_epi64::<12>(w), k.one));
+    let sign = _mm512_sll_epi64(
+        _mm512_and_si512(w, k.sign_bit),
+        _mm_cvtsi32_si128(SIGN_SHIFT as i32),
+    );
+    let x = _mm512_mul_pd(_mm512_sub_pd(b, _mm512_set1_pd(1.0)), width);
+    let x = _mm512_castsi512_pd(_mm512_or_si512(_mm512_castpd_si512(x), sign));
+    let core = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(b, bound);
+    assert!(pair.len() == 2);
+    // SAFETY: `pair` is two adjacent f64x4, 64 bytes.
+    unsafe { _mm512_storeu_pd(pair.as_mut_ptr().cast(), x) };
+    if core != 0xFF {
+        finish([s0, s1, s2, s3], w, pair, core as u32)
+    } else {
+        [s0, s1, s2, s3]
+    }
+}
+
+/// [`crate::gauss::fill_one_portable`] with AVX-512F: stream a and stream b of the four lanes
+/// in one register.
 ///
 /// # Safety
 /// The CPU must have AVX-512F.
 #[target_feature(enable = "avx512f")]
-pub(crate) unsafe fn fill_pairs(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
+pub(crate) unsafe fn fill_one(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
     let mut st: [__m512i; 4] = core::array::from_fn(|w| join(s[0][w], s[1][w]));
-    let index = _mm512_set1_epi64(N as i64 - 1);
-    let one = _mm512_set1_epi64(ONE_BITS as i64);
-    let sign_bit = _mm512_set1_epi64(SIGN_BIT as i64);
-    let base = FAST.0.as_ptr() as *const u8;
+    let k = Consts::new();
     for pair in out.chunks_exact_mut(2) {
-        let [s0, s1, s2, s3] = &mut st;
-        // xoshiro256++ of all eight streams.
-        let w = _mm512_add_epi64(_mm512_rol_epi64::<23>(_mm512_add_epi64(*s0, *s3)), *s0);
-        let t = _mm512_slli_epi64::<17>(*s1);
-        *s2 = _mm512_xor_si512(*s2, *s0);
-        *s3 = _mm512_xor_si512(*s3, *s1);
-        *s1 = _mm512_xor_si512(*s1, *s2);
-        *s0 = _mm512_xor_si512(*s0, *s3);
-        *s2 = _mm512_xor_si512(*s2, t);
-        *s3 = _mm512_rol_epi64::<45>(*s3);
-        // Each stream's piece: [width, bound] pairs, 16 bytes apart.
-        let mut off = [0u64; 8];
-        _mm512_storeu_si512(
-            off.as_mut_ptr().cast(),
-            _mm512_slli_epi64::<4>(_mm512_and_si512(w, index)),
-        );
-        // SAFETY: every offset is below 16 N, inside the table of N pairs.
-        let p = |k: usize| unsafe { _mm_loadu_pd(base.add(off[k] as usize).cast()) };
-        let lo = |k: usize, j: usize| _mm256_insertf128_pd::<1>(_mm256_castpd128_pd256(p(k)), p(j));
-        // Pieces of streams 0, 2, 4, 6 and of 1, 3, 5, 7, then width and bound of all eight.
-        let even = _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(lo(0, 2)), lo(4, 6));
-        let odd = _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(lo(1, 3)), lo(5, 7));
-        let width = _mm512_unpacklo_pd(even, odd);
-        let bound = _mm512_unpackhi_pd(even, odd);
-        let b = _mm512_castsi512_pd(_mm512_or_si512(_mm512_srli_epi64::<12>(w), one));
-        let sign = _mm512_sll_epi64(
-            _mm512_and_si512(w, sign_bit),
-            _mm_cvtsi32_si128(SIGN_SHIFT as i32),
-        );
-        let x = _mm512_mul_pd(_mm512_sub_pd(b, _mm512_set1_pd(1.0)), width);
-        let x = _mm512_castsi512_pd(_mm512_or_si512(_mm512_castpd_si512(x), sign));
-        let core = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(b, bound);
-        // SAFETY: `pair` is two adjacent f64x4, 64 bytes.
-        unsafe { _mm512_storeu_pd(pair.as_mut_ptr().cast(), x) };
-        if core != 0xFF {
-            st = finish(st, w, pair, core as u32);
-        }
+        st = draw(st, pair, k);
     }
     for (w, v) in st.iter().enumerate() {
         [s[0][w], s[1][w]] = halves(*v);
+    }
+}
+
+/// [`crate::gauss::fill_two_portable`] with AVX-512F: stream a of the eight lanes in one
+/// register, stream b in another.
+///
+/// # Safety
+/// The CPU must have AVX-512F.
+#[target_feature(enable = "avx512f")]
+pub(crate) unsafe fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4]) {
+    let [mut sa, mut sb]: [[__m512i; 4]; 2] =
+        core::array::from_fn(|j| core::array::from_fn(|w| join(s[j][0][w], s[j][1][w])));
+    let k = Consts::new();
+    for round in out.chunks_exact_mut(4) {
+        let (a, b) = round.split_at_mut(2);
+        sa = draw(sa, a, k);
+        sb = draw(sb, b, k);
+    }
+    for (j, st) in [sa, sb].iter().enumerate() {
+        for (w, v) in st.iter().enumerate() {
+            [s[j][0][w], s[j][1][w]] = halves(*v);
+        }
     }
 }
 

@@ -163,25 +163,28 @@ fn each_stream_is_the_plain_ziggurat_on_its_xoshiro_stream() {
 fn the_avx512_path_gives_the_portable_bits() {
     #[cfg(target_arch = "x86_64")]
     if crate::gauss_avx512::available() {
-        let mut a = NoiseRng::new([1, 2, 3, 4]);
-        let mut b = a.clone();
-        let mut fa = vec![f64x4::ZERO; 2 * 4096];
-        let mut fb = fa.clone();
+        let sets = |seed: u64| {
+            let q = |j: u64| NoiseRng::new(core::array::from_fn(|l| seed + 8 * j + l as u64)).s;
+            [q(0), q(1)]
+        };
+        let bits = |v: &[f64x4]| -> Vec<[u64; 4]> {
+            v.iter().map(|x| x.to_array().map(f64::to_bits)).collect()
+        };
+        let words = |s: &[[u64x4; 4]; 2]| s.map(|h| h.map(|w| w.to_array()));
+        let (mut a, mut b) = (sets(1), sets(1));
+        let (mut fa, mut fb) = (vec![f64x4::ZERO; 4096], vec![f64x4::ZERO; 4096]);
         for _ in 0..64 {
+            // One register pair (stream a and b of four lanes), then two (eight lanes).
             // SAFETY: AVX-512F checked above.
-            unsafe { crate::gauss_avx512::fill_pairs(&mut a.s, &mut fa) };
-            fill_pairs_portable(&mut b.s, &mut fb);
-            for (x, y) in fa.iter().zip(&fb) {
-                assert_eq!(
-                    x.to_array().map(f64::to_bits),
-                    y.to_array().map(f64::to_bits)
-                );
-            }
-            for h in 0..2 {
-                for w in 0..4 {
-                    assert_eq!(a.s[h][w].to_array(), b.s[h][w].to_array());
-                }
-            }
+            unsafe { crate::gauss_avx512::fill_one(&mut a[0], &mut fa) };
+            fill_one_portable(&mut b[0], &mut fb);
+            assert_eq!(bits(&fa), bits(&fb));
+            assert_eq!(words(&a[0]), words(&b[0]));
+            // SAFETY: as above.
+            unsafe { crate::gauss_avx512::fill_two(&mut a, &mut fa) };
+            fill_two_portable(&mut b, &mut fb);
+            assert_eq!(bits(&fa), bits(&fb));
+            assert_eq!(a.map(|s| words(&s)), b.map(|s| words(&s)));
         }
         return;
     }
@@ -192,31 +195,59 @@ fn the_avx512_path_gives_the_portable_bits() {
 fn blocks_pairs_and_fills_give_one_sequence() {
     let seeds = [11, 12, 13, 14];
     let mut pairs = NoiseRng::new(seeds);
-    let mut block = NormalBlock::new(NoiseRng::new(seeds));
     let mut fill = NoiseRng::new(seeds);
     let mut buf = vec![f64x4::ZERO; 2 * 1000];
     fill.fill_pairs(&mut buf);
     let bits = |v: f64x4| v.to_array().map(f64::to_bits);
-    for k in 0..500 {
-        let (a1, b1) = pairs.normal_pair();
-        let (a2, b2) = pairs.normal_pair();
-        let n = block.next4();
-        assert_eq!([a1, b1, a2, b2].map(bits), n.map(bits), "sample {k}");
-        assert_eq!(bits(buf[4 * k]), bits(a1));
-        assert_eq!(bits(buf[4 * k + 3]), bits(b2));
-    }
-    // A run read through ready / at / advance is the same sequence.
-    let mut run = NormalBlock::new(NoiseRng::new(seeds));
-    let mut again = NormalBlock::new(NoiseRng::new(seeds));
-    let mut done = 0;
-    while done < 300 {
-        let n = run.ready(300 - done);
-        let base = run.pos();
-        for k in 0..n as usize {
-            assert_eq!(run.at(base + 4 * k).map(bits), again.next4().map(bits));
+    // Read through ready / row / advance, in runs of up to 7 samples.
+    let mut block = NormalBlock::new(NoiseRng::new(seeds));
+    assert_eq!(block.width(), 4);
+    let mut k = 0;
+    while k < 500 {
+        let n = block.ready(7.min(500 - k as u64));
+        let base = block.pos();
+        for j in 0..n as usize {
+            let (a1, b1) = pairs.normal_pair();
+            let (a2, b2) = pairs.normal_pair();
+            let rows: [f64x4; 4] = core::array::from_fn(|c| {
+                f64x4::new(block.row(base + 4 * j + c, 4).try_into().unwrap())
+            });
+            assert_eq!([a1, b1, a2, b2].map(bits), rows.map(bits), "sample {k}");
+            assert_eq!(bits(buf[4 * k]), bits(a1));
+            assert_eq!(bits(buf[4 * k + 3]), bits(b2));
+            k += 1;
         }
-        run.advance(n);
-        done += n;
+        block.advance(n);
+    }
+}
+
+#[test]
+fn a_wide_block_gives_each_lane_the_rows_of_a_four_lane_block() {
+    let seeds: [u64; 8] = [5, 6, 7, 8, 9, 10, 0xFFFF, 3];
+    let quad = |q: usize| NoiseRng::new(core::array::from_fn(|l| seeds[4 * q + l]));
+    let mut wide = NormalBlock::wide(quad(0), quad(1));
+    let mut four = [NormalBlock::new(quad(0)), NormalBlock::new(quad(1))];
+    assert_eq!(wide.width(), 8);
+    // 20 000 samples: many refills, and every lane through wedges and tails.
+    for _ in 0..20_000 {
+        assert_eq!(wide.ready(1), 1);
+        let rows: Vec<Vec<u64>> = (0..4)
+            .map(|c| {
+                wide.row(wide.pos() + c, 8)
+                    .iter()
+                    .map(|x| x.to_bits())
+                    .collect()
+            })
+            .collect();
+        for (q, b) in four.iter_mut().enumerate() {
+            assert_eq!(b.ready(1), 1);
+            for (c, row) in rows.iter().enumerate() {
+                let want: Vec<u64> = b.row(b.pos() + c, 4).iter().map(|x| x.to_bits()).collect();
+                assert_eq!(&row[4 * q..4 * q + 4], &want[..], "lanes {}..", 4 * q);
+            }
+            b.advance(1);
+        }
+        wide.advance(1);
     }
 }
 

@@ -5,8 +5,9 @@ use core::fmt::Debug;
 use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 use wide::f64x4;
 
-/// A real sample, scalar or lane-parallel. All arithmetic is plain IEEE `+ - * /` (no fused
-/// multiply-add) so that every lane of `f64x4` gives the bits the scalar `f64` path gives.
+/// A real sample, scalar or lane-parallel. All arithmetic is plain IEEE `+ - * /`, fused
+/// only where [`Sample::mul_add`] is written, so that every lane of a lane-parallel type gives
+/// the bits the scalar `f64` path gives.
 pub trait Sample:
     Copy
     + Default
@@ -46,9 +47,19 @@ pub trait Sample:
     /// `.cargo/config.toml`), two roundings otherwise. The choice is the same for every lane
     /// type, so f64x4 lanes keep the bits of the scalar path in either build.
     fn mul_add(self, a: Self, b: Self) -> Self;
-    /// The first `LANES` lanes of a 4-lane vector (lane 0 for `f64`): how lane-parallel
-    /// helpers such as the noise generator hand their lanes to either sample type.
-    fn from_x4(v: f64x4) -> Self;
+    /// Lanes `0 .. LANES` from `v[0 .. LANES]` (`v` at least that long): how lane-parallel
+    /// helpers such as the noise generator hand their lanes to any sample type.
+    fn load(v: &[f64]) -> Self;
+    /// Runs `f` compiled for the instructions this sample type's operations need: the sample
+    /// loop enters through it, so a lane type the build does not target (eight lanes on a
+    /// CPU with AVX-512, chosen at run time) gets its whole loop compiled for it, every
+    /// operation inlined. Only what is inlined into `f` is compiled so, which is why the stage
+    /// methods the per-sample loop calls are `#[inline(always)]`. `f64` and `f64x4` run `f`
+    /// as it is.
+    #[inline(always)]
+    fn with_target_features<R>(f: impl FnOnce() -> R) -> R {
+        f()
+    }
 }
 
 impl Sample for f64 {
@@ -66,8 +77,8 @@ impl Sample for f64 {
         self
     }
     #[inline(always)]
-    fn from_x4(v: f64x4) -> Self {
-        v.to_array()[0]
+    fn load(v: &[f64]) -> Self {
+        v[0]
     }
     #[inline(always)]
     fn clamp_to(self, lo: Self, hi: Self) -> Self {
@@ -128,8 +139,9 @@ impl Sample for f64x4 {
         self.to_array()[i]
     }
     #[inline(always)]
-    fn from_x4(v: f64x4) -> Self {
-        v
+    fn load(v: &[f64]) -> Self {
+        let a: [f64; 4] = v[..4].try_into().expect("four lanes");
+        f64x4::new(a)
     }
     #[inline(always)]
     fn clamp_to(self, lo: Self, hi: Self) -> Self {

@@ -1,15 +1,15 @@
 //! divan benchmarks of the board (`cargo bench -p gyroemu-experiment`): the whole fused chain
-//! in f64x4 lanes (four operating points per group) on one lane group and on one group per
-//! core, noiseless and with every noise source, DAC and ADC on. Throughput is reported in
+//! in the lanes this CPU runs (eight operating points per group in f64x8 lanes with AVX-512,
+//! else four in f64x4) on one lane group and on one group per core, noiseless and with every
+//! noise source, DAC and ADC on. Throughput is reported in
 //! point-samples (one input sample of one operating point). `gyroemu bench` prints the same
 //! chain figure and each stage alone.
 
 use divan::counter::ItemsCount;
 use divan::{black_box, Bencher};
-use gyroemu_board::{Board, Point, RunOptions};
+use gyroemu_board::{max_lanes, GroupBoard, Point, RunOptions};
 use gyroemu_config::presets::preset;
 use gyroemu_config::Config;
-use gyroemu_core::f64x4;
 use gyroemu_lpf::Window;
 
 /// Input samples per lane group per iteration (2^22: 41 943 decimated blocks; shorter runs
@@ -32,10 +32,12 @@ fn rotating(noise: bool) -> Config {
 /// Runs `groups` lane groups of N_IN samples each, one per rayon worker.
 fn run_groups(b: Bencher, noise: bool, groups: usize) {
     let cfg = rotating(noise);
-    let rates: Vec<f64> = cfg.experiment.rates_dps[..4]
-        .iter()
-        .map(|r| r.to_radians())
+    let lanes = max_lanes();
+    let listed = &cfg.experiment.rates_dps;
+    let rates: Vec<f64> = (0..lanes)
+        .map(|i| listed[i % listed.len()].to_radians())
         .collect();
+    let streams: Vec<u64> = (0..lanes as u64).collect();
     let m = cfg.decimation() as u64;
     let n_out = N_IN / m;
     let point = |r: f64| Point {
@@ -47,11 +49,11 @@ fn run_groups(b: Bencher, noise: bool, groups: usize) {
     };
     let points: Vec<Point> = rates.iter().map(|&r| point(r)).collect();
     let n_settle = n_out - n_out / 2 - 1;
-    b.counter(ItemsCount::new(n_out * m * 4 * groups as u64))
+    b.counter(ItemsCount::new(n_out * m * (lanes * groups) as u64))
         .with_inputs(|| {
             (0..groups)
                 .map(|_| {
-                    Board::<f64x4>::new(&cfg.board_params(), &rates, &[0, 1, 2, 3])
+                    GroupBoard::with_width(lanes, &cfg.board_params(), &rates, &streams)
                         .expect("valid preset")
                 })
                 .collect::<Vec<_>>()

@@ -2,7 +2,7 @@
 //! and on all threads, and each stage alone. Used by `gyroemu bench` and the criterion-free
 //! benchmark; timing lives here, never in tests.
 
-use gyroemu_board::{Board, Point, RunOptions};
+use gyroemu_board::{max_lanes, GroupBoard, Point, RunOptions};
 use gyroemu_config::Config;
 use gyroemu_core::{f64x4, Sample, Stage};
 use gyroemu_lpf::Window;
@@ -36,9 +36,18 @@ fn best_and_median(repeats: usize, mut measure: impl FnMut() -> f64) -> (f64, f6
     (v[n - 1], median)
 }
 
-/// Four operating points of `cfg` (its first rates, padded) for one lane group.
-fn lane_rates(cfg: &Config) -> Vec<f64> {
-    (0..4)
+/// The sample type of a lane group of `width` lanes, as the bench rows name it.
+pub fn lane_type(width: usize) -> &'static str {
+    if width == 8 {
+        "f64x8"
+    } else {
+        "f64x4"
+    }
+}
+
+/// `lanes` operating points of `cfg` (its first rates, repeated) for one lane group.
+fn lane_rates(cfg: &Config, lanes: usize) -> Vec<f64> {
+    (0..lanes)
         .map(|i| cfg.experiment.rates_dps[i % cfg.experiment.rates_dps.len()].to_radians())
         .collect()
 }
@@ -63,10 +72,15 @@ pub fn with_noise(cfg: &Config) -> Config {
     c
 }
 
-/// Runs `groups` lane groups of `n_in` input samples each, spread over the rayon pool;
-/// returns point-samples per second.
+/// Runs `groups` lane groups of `n_in` input samples each, spread over the rayon pool, in the
+/// lanes this CPU runs ([`max_lanes`]); returns point-samples per second.
 pub fn chain(cfg: &Config, n_in: u64, groups: usize) -> f64 {
-    let rates = lane_rates(cfg);
+    chain_in(max_lanes(), cfg, n_in, groups)
+}
+
+/// [`chain`] in groups of `width` lanes (4, or 8 on a CPU with AVX-512), every lane in use.
+pub fn chain_in(width: usize, cfg: &Config, n_in: u64, groups: usize) -> f64 {
+    let rates = lane_rates(cfg, width);
     let params = cfg.board_params();
     let m = cfg.decimation() as u64;
     let n_out = n_in / m;
@@ -81,8 +95,11 @@ pub fn chain(cfg: &Config, n_in: u64, groups: usize) -> f64 {
         })
         .collect();
     let n_settle = n_out - n_out / 2 - 1;
-    let mut boards: Vec<Board<f64x4>> = (0..groups)
-        .map(|_| Board::new(&params, &rates, &[0, 1, 2, 3]).expect("bench config is valid"))
+    let streams: Vec<u64> = (0..width as u64).collect();
+    let mut boards: Vec<GroupBoard> = (0..groups)
+        .map(|_| {
+            GroupBoard::with_width(width, &params, &rates, &streams).expect("bench config is valid")
+        })
         .collect();
     let t = Instant::now();
     boards.par_iter_mut().for_each(|b| {
@@ -92,7 +109,7 @@ pub fn chain(cfg: &Config, n_in: u64, groups: usize) -> f64 {
         );
     });
     let s = t.elapsed().as_secs_f64();
-    (n_out * m * 4 * groups as u64) as f64 / s
+    (n_out * m * (width * groups) as u64) as f64 / s
 }
 
 /// Times `n` ticks of a copy of `st` fed by `input(i)` on each of `threads` threads; returns
@@ -136,9 +153,10 @@ impl Stage for DecoupledPlant {
     }
 }
 
-/// Every figure, each the best and the median of `repeats` runs: the chain, noiseless and
-/// with noise, then each stage,
-/// on 1 thread and on all threads.
+/// Every figure, each the best and the median of `repeats` runs, on 1 thread and on all
+/// threads: the chain, noiseless and with noise, in the lanes this CPU runs (rows `whole
+/// chain`, `whole chain with noise`), then in each lane type it can run (the same rows with
+/// `(f64x4)` or `(f64x8)`), then each stage.
 pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     use gyroemu_am::{AmInput, AmModulator, DrivePattern};
     use gyroemu_lpf::{LowPass, LowPassBank, LowPassDesign};
@@ -147,27 +165,46 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     use gyroemu_resonator::Resonator;
     use gyroemu_tia::Tia;
     let threads = rayon::current_num_threads();
-    let mut out = Vec::new();
-    let mut push_n = |name: &str, threads: usize, measure: &mut dyn FnMut() -> f64| {
+    let row = |name: &str, threads: usize, measure: &mut dyn FnMut() -> f64| {
         let (best, median) = best_and_median(repeats, measure);
-        out.push(Throughput {
+        Throughput {
             name: name.into(),
             threads,
             point_samples_per_s: best,
             median_point_samples_per_s: median,
-        })
+        }
     };
-    push_n("whole chain", 1, &mut || chain(cfg, n_in, 1));
-    if threads > 1 {
-        push_n("whole chain", threads, &mut || chain(cfg, n_in, threads));
-    }
+    // The chain in every lane type this CPU runs; the rows without a lane type repeat the
+    // figures of the type a run uses here ([`max_lanes`]).
     let noisy = with_noise(cfg);
-    push_n("whole chain with noise", 1, &mut || chain(&noisy, n_in, 1));
-    if threads > 1 {
-        push_n("whole chain with noise", threads, &mut || {
-            chain(&noisy, n_in, threads)
-        });
+    let native = max_lanes();
+    let mut widths = vec![4];
+    if native == 8 {
+        widths.push(8);
     }
+    let mut typed = Vec::new();
+    for &w in &widths {
+        for (label, c) in [("whole chain", cfg), ("whole chain with noise", &noisy)] {
+            let name = format!("{label} ({})", lane_type(w));
+            typed.push(row(&name, 1, &mut || chain_in(w, c, n_in, 1)));
+            if threads > 1 {
+                typed.push(row(&name, threads, &mut || chain_in(w, c, n_in, threads)));
+            }
+        }
+    }
+    let suffix = format!(" ({})", lane_type(native));
+    let mut out: Vec<Throughput> = typed
+        .iter()
+        .filter(|r| r.name.ends_with(&suffix))
+        .map(|r| Throughput {
+            name: r.name.replace(&suffix, ""),
+            ..r.clone()
+        })
+        .collect();
+    out.extend(typed);
+    let mut push_n = |name: &str, threads: usize, measure: &mut dyn FnMut() -> f64| {
+        out.push(row(name, threads, measure));
+    };
     let x = |i: u64| f64x4::splat((i & 1023) as f64 * 1e-3);
     let fs = cfg.fs_hz();
     let mut push = |name: &str, measure: Box<dyn Fn(usize) -> f64 + '_>| {
@@ -182,7 +219,7 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
         "carrier RotatingNco (scalar, 4 lanes share it)",
         Box::new(|t| stage(&carrier, n_in, 4, t, |_| ())),
     );
-    let mods: Vec<Nco> = lane_rates(cfg)
+    let mods: Vec<Nco> = lane_rates(cfg, 4)
         .iter()
         .map(|r| Nco::new(r / std::f64::consts::TAU, fs, 0.0).expect("valid"))
         .collect();
@@ -213,7 +250,7 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
         }),
     );
     let params = cfg.resonator_params();
-    let scalar: Vec<Resonator<f64>> = lane_rates(cfg)
+    let scalar: Vec<Resonator<f64>> = lane_rates(cfg, 4)
         .iter()
         .map(|&r| Resonator::new(&params, r).expect("valid"))
         .collect();

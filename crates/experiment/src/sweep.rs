@@ -1,13 +1,16 @@
-//! A sweep over operating points: the board runs sample by sample, four points per SIMD lane
-//! group, groups in parallel; any subset (a shard, a resumed run) gives every point the bits
+//! A sweep over operating points: the board runs sample by sample, four or eight points per
+//! SIMD lane group (eight on a CPU with AVX-512), groups in parallel; any subset (a shard, a resumed run) gives every point the bits
 //! of a whole run. `readout.rs` turns the averages into phases.
 
 use crate::dump::DumpPlan;
 use crate::progress::{Progress, Written};
 use crate::readout::{post_process, SweepResult};
-use gyroemu_board::{Board, LaneResult, NonFinite, Point, Probe, RunOptions, MAX_LANES};
+use gyroemu_board::{
+    lane_groups, max_lanes, GroupBoard, LaneResult, NonFinite, Point, Probe, RunOptions,
+    CANONICAL_LANES,
+};
 use gyroemu_config::Config;
-use gyroemu_core::{f64x4, ParamError};
+use gyroemu_core::ParamError;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -124,9 +127,10 @@ pub fn group_samples(cfg: &Config, points: &[Point]) -> u64 {
 
 /// The canonical lane grouping of a sweep (all points in index order, four per group) and
 /// its work: (input samples per lane group summed, operating-point samples). Reported in the
-/// results, so they are the same whichever subset, order or shard actually ran the points.
+/// results, so they are the same whichever subset, order, shard or lane width actually ran
+/// the points.
 pub fn canonical_work(cfg: &Config, points: &[Point]) -> (u64, u64) {
-    points.chunks(MAX_LANES).fold((0, 0), |(s, ps), g| {
+    points.chunks(CANONICAL_LANES).fold((0, 0), |(s, ps), g| {
         let n = group_samples(cfg, g);
         (s + n, ps + n * g.len() as u64)
     })
@@ -147,10 +151,10 @@ pub fn add_group_progress(
     progress(all, total);
 }
 
-/// Runs the points of a sweep that `opts` assigns and that are not done yet, four per lane
-/// group, groups in parallel. A group runs as long as its longest window, so the points are
-/// packed by window length (longest first, index order among equals) and a short window does
-/// not idle a lane beside a long one. Each point draws the noise stream of its index, and
+/// Runs the points of a sweep that `opts` assigns and that are not done yet, in lane groups
+/// of four or eight ([`lane_groups`]), groups in parallel. A group runs as long as its longest
+/// window, so the points are packed by window length (longest first, index order among
+/// equals) and a short window does not idle a lane beside a long one. Each point draws the noise stream of its index, and
 /// lanes do not interact, so any subset or grouping gives every point the same bits.
 pub fn run_sweep_with(
     cfg: &Config,
@@ -175,7 +179,13 @@ pub fn run_sweep_with(
     let mut todo = todo;
     todo.sort_by_key(|&i| core::cmp::Reverse(plan(i).window.samples()));
     let n_settle = cfg.n_settle_out();
-    let groups: Vec<&[usize]> = todo.chunks(MAX_LANES).collect();
+    let mut groups: Vec<&[usize]> = Vec::new();
+    let mut rest = &todo[..];
+    for size in lane_groups(todo.len(), rayon::current_num_threads(), max_lanes()) {
+        let (g, r) = rest.split_at(size);
+        groups.push(g);
+        rest = r;
+    }
     let samples_of =
         |g: &[usize]| group_samples(cfg, &g.iter().map(|&i| plan(i)).collect::<Vec<_>>());
     let total: u64 = groups.iter().map(|g| samples_of(g)).sum();
@@ -202,7 +212,7 @@ pub fn run_sweep_with(
         let r: Vec<f64> = g.iter().map(|&i| plan(i).rate_rad_s).collect();
         // Each point draws the noise stream of its index in the emulated rates.
         let streams: Vec<u64> = g.iter().map(|&i| i as u64).collect();
-        let mut board = Board::<f64x4>::new(&params, &r, &streams)?;
+        let mut board = GroupBoard::new(&params, &r, &streams)?;
         board.set_cancel(stop.clone());
         boards.push(board);
     }

@@ -37,9 +37,10 @@ impl Work {
     pub fn describe(&self, point_samples_per_s: Option<f64>) -> String {
         let time = point_samples_per_s.map_or(String::new(), |r| {
             format!(
-                ", about {:.3} s at the {:.0} M point-samples/s measured here",
+                ", about {:.3} s at the {:.0} M point-samples/s measured here (lane groups of up to {})",
                 self.point_samples as f64 / r,
-                r / 1e6
+                r / 1e6,
+                gyroemu_board::max_lanes()
             )
         });
         format!(

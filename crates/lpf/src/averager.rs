@@ -129,7 +129,7 @@ impl<S: Sample, const C: usize> Averager<S, C> {
     }
 
     /// Adds the next sample of every channel with each lane's weight.
-    #[inline]
+    #[inline(always)]
     pub fn push(&mut self, x: &[S; C]) {
         let (j, w) = (self.j, &self.windows);
         let weight = S::from_fn(|i| w[i].weight(j));

@@ -26,7 +26,7 @@ impl<S: Sample> KahanSum<S> {
     }
 
     /// Adds `x`.
-    #[inline]
+    #[inline(always)]
     pub fn add(&mut self, x: S) {
         let t = self.sum + x;
         // TwoSum: (sum + x) - t exactly, whatever the magnitudes.
@@ -37,7 +37,7 @@ impl<S: Sample> KahanSum<S> {
     }
 
     /// The compensated value of the sum.
-    #[inline]
+    #[inline(always)]
     pub fn value(&self) -> S {
         self.sum + self.comp
     }

@@ -38,7 +38,7 @@ impl<S: Sample> Stage for Stage2Mixer<S> {
     type Input = (Iq<S>, [S; 2]);
     type Output = Stage2Out<S>;
 
-    #[inline]
+    #[inline(always)]
     fn tick(&mut self, (z, [rc, rs]): (Iq<S>, [S; 2])) -> Stage2Out<S> {
         // Doubling is exact, so 2 z r = z (2 r) bit for bit.
         Stage2Out {

@@ -79,7 +79,7 @@ impl<S: Sample> Stage for TableMixer<S> {
     type Input = ([Iq<S>; 2], Complex64);
     type Output = [S; TABLE_CHANNELS];
 
-    #[inline]
+    #[inline(always)]
     fn tick(&mut self, (z, base): Self::Input) -> Self::Output {
         let mut out = [S::splat(0.0); TABLE_CHANNELS];
         // p = e^{-j n theta} by repeated multiplication (n <= 15 roundings: negligible).

@@ -11,7 +11,10 @@ use gyroemu_core::{ParamError, ParamResult, Sample, Stage};
 /// Samples between exact re-sets of the rotated phasor.
 pub const RESYNC: u32 = 64;
 
-/// Up to four NCOs (one per lane) advanced together; output `(cos, sin)` per lane.
+/// The widest sample type's lanes (eight: f64 lanes of a 512-bit register).
+const MAX_LANES: usize = 8;
+
+/// Up to eight NCOs (one per lane) advanced together; output `(cos, sin)` per lane.
 #[derive(Clone, Debug)]
 pub struct RotatingNco<S: Sample> {
     re: S,
@@ -19,11 +22,11 @@ pub struct RotatingNco<S: Sample> {
     rot_re: S,
     rot_im: S,
     /// Per lane: the exact phase word of the sample `count` ticks ahead (the next re-set).
-    phase: [u64; 4],
-    step: [u64; 4],
-    phase0: [u64; 4],
-    step0: [u64; 4],
-    fs_hz: [f64; 4],
+    phase: [u64; MAX_LANES],
+    step: [u64; MAX_LANES],
+    phase0: [u64; MAX_LANES],
+    step0: [u64; MAX_LANES],
+    fs_hz: [f64; MAX_LANES],
     count: u32,
 }
 
@@ -32,9 +35,9 @@ impl<S: Sample> RotatingNco<S> {
     /// last NCO). `ncos` must not be empty.
     pub fn new(ncos: &[Nco]) -> Self {
         let pick = |i: usize| &ncos[i.min(ncos.len() - 1)];
-        let phase: [u64; 4] = core::array::from_fn(|i| pick(i).phase_word());
-        let step: [u64; 4] = core::array::from_fn(|i| pick(i).step_word());
-        let fs_hz: [f64; 4] = core::array::from_fn(|i| pick(i).fs_hz());
+        let phase: [u64; MAX_LANES] = core::array::from_fn(|i| pick(i).phase_word());
+        let step: [u64; MAX_LANES] = core::array::from_fn(|i| pick(i).step_word());
+        let fs_hz: [f64; MAX_LANES] = core::array::from_fn(|i| pick(i).fs_hz());
         let rot = |i: usize| phasor_of_word(step[i]);
         let mut s = Self {
             re: S::splat(0.0),
@@ -82,7 +85,7 @@ impl<S: Sample> RotatingNco<S> {
         Ok(())
     }
 
-    /// Lane `lane`'s realised (step-quantised) frequency, signed, in Hz (`lane < 4`).
+    /// Lane `lane`'s realised (step-quantised) frequency, signed, in Hz (`lane < S::LANES`).
     pub fn f_hz(&self, lane: usize) -> f64 {
         (self.step[lane] as i64) as f64 * (self.fs_hz[lane] / 18_446_744_073_709_551_616.0)
     }
@@ -98,14 +101,24 @@ impl<S: Sample> RotatingNco<S> {
     #[cold]
     #[inline(never)]
     fn resync(&mut self) {
-        let p: [gyroemu_core::Complex64; 4] =
-            core::array::from_fn(|i| phasor_of_word(self.phase[i]));
+        let p = self.phasors(self.phase);
         self.re = S::from_fn(|i| p[i].re);
         self.im = S::from_fn(|i| p[i].im);
-        for i in 0..4 {
+        for i in 0..S::LANES {
             self.phase[i] = self.phase[i].wrapping_add(self.step[i].wrapping_mul(RESYNC as u64));
         }
         self.count = RESYNC;
+    }
+
+    /// The phasor of each lane's `words[i]` (the lanes past `S::LANES` left at 0).
+    fn phasors(&self, words: [u64; MAX_LANES]) -> [gyroemu_core::Complex64; MAX_LANES] {
+        core::array::from_fn(|i| {
+            if i < S::LANES {
+                phasor_of_word(words[i])
+            } else {
+                gyroemu_core::Complex64::new(0.0, 0.0)
+            }
+        })
     }
 }
 
@@ -131,8 +144,7 @@ impl<S: Sample> Stage for RotatingNco<S> {
         self.phase = self.phase0;
         if self.step != self.step0 {
             self.step = self.step0;
-            let rot: [gyroemu_core::Complex64; 4] =
-                core::array::from_fn(|i| phasor_of_word(self.step[i]));
+            let rot = self.phasors(self.step);
             self.rot_re = S::from_fn(|i| rot[i].re);
             self.rot_im = S::from_fn(|i| rot[i].im);
         }

@@ -107,7 +107,7 @@ impl<S: Sample> Resonator<S> {
     /// taken constant over the step `[n Ts, (n+1) Ts)`; for a continuously varying rate pass
     /// its value at the midpoint `(n + 1/2) Ts`, which makes the step second-order accurate.
     /// At `omega == omega_design` this is bit-identical to [`Stage::tick`].
-    #[inline]
+    #[inline(always)]
     pub fn tick_with_rate(&mut self, force: [S; 2], omega_z_rad_s: S) -> PlantOutput<S> {
         let y = self.output();
         let d = omega_z_rad_s - self.omega_c;
@@ -217,7 +217,7 @@ impl<S: Sample> Stage for Resonator<S> {
     type Output = PlantOutput<S>;
 
     /// One step at the design rate (state before the update, see the type docs).
-    #[inline]
+    #[inline(always)]
     fn tick(&mut self, force: [S; 2]) -> PlantOutput<S> {
         let y = self.output();
         let x = self.x;

@@ -110,7 +110,7 @@ impl Tia<f64> {
 impl<S: Sample> Tia<S> {
     /// 1.0 in the lanes where the output `y` of [`Stage::tick`] sits on a rail (clamped), 0.0
     /// elsewhere and always without rails: a count of saturated samples.
-    #[inline]
+    #[inline(always)]
     pub fn rail_flags(&self, y: S) -> S {
         if self.has_rails {
             y.flag_eq(self.hi) + y.flag_eq(self.lo)
@@ -124,7 +124,7 @@ impl<S: Sample> Stage for Tia<S> {
     type Input = S;
     type Output = S;
 
-    #[inline]
+    #[inline(always)]
     fn tick(&mut self, x: S) -> S {
         let mut y = self.a.mul_add(self.y, self.b * x);
         if self.has_rails {

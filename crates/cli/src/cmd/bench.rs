@@ -16,9 +16,18 @@ pub fn bench_command(preset_name: &str, samples: u64, repeats: usize) -> Result<
         ))
         .into());
     }
+    let lanes = gyroemu_board::max_lanes();
+    let lane_type = gyroemu_experiment::bench::lane_type;
+    let typed = if lanes == 8 {
+        "rows marked (f64x4) and (f64x8): groups of 4 and 8"
+    } else {
+        "rows marked (f64x4): the same"
+    };
     eprintln!(
-        "bench: preset {preset_name}, fs = {} Hz, {samples} input samples per lane group, 4 operating points per group, best and median of {repeats} runs",
-        cfg.fs_hz()
+        "bench: preset {preset_name}, fs = {} Hz, {samples} input samples per lane group, best and median of {repeats} runs; \
+         whole chain: {lanes} operating points per group in {} lanes (what a run uses on this CPU), {typed}; stages: 4 lanes",
+        cfg.fs_hz(),
+        lane_type(lanes)
     );
     print_out(&format!(
         "{:<48} {:>7} {:>10} {:>10}\n",

@@ -1,0 +1,114 @@
+//! A lane group's board in the lane type picked at run time: [`Board`] in `f64x4` lanes, or
+//! in eight `F64x8` lanes on a CPU with AVX-512 (`lanes.rs` says when). Every lane is its
+//! point alone, so the results are the same bits in either.
+
+use crate::board::Board;
+#[cfg(target_arch = "x86_64")]
+use crate::f64x8::F64x8;
+use crate::fault::NonFinite;
+use crate::lanes::{eight_lanes_available, max_lanes};
+use crate::params::{BoardParams, STAGE};
+use crate::point::{Point, RunOptions, RunOutput};
+use gyroemu_core::{f64x4, ParamError};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+/// The board of one lane group of up to [`max_lanes`] points.
+#[derive(Clone)]
+pub struct GroupBoard(Lanes);
+
+#[derive(Clone)]
+enum Lanes {
+    Four(Box<Board<f64x4>>),
+    #[cfg(target_arch = "x86_64")]
+    Eight(Box<Board<F64x8>>),
+}
+
+/// The same call on whichever board the group holds.
+macro_rules! on_board {
+    ($self:expr, $b:ident => $e:expr) => {
+        match $self {
+            Lanes::Four($b) => $e,
+            #[cfg(target_arch = "x86_64")]
+            Lanes::Eight($b) => $e,
+        }
+    };
+}
+
+impl GroupBoard {
+    /// The board for `rates_rad_s.len()` points, as [`Board::new`] takes them: four lanes for
+    /// up to four points, eight for more (up to [`max_lanes`]).
+    pub fn new(p: &BoardParams, rates_rad_s: &[f64], streams: &[u64]) -> Result<Self, ParamError> {
+        let width = if rates_rad_s.len() <= 4 {
+            4
+        } else {
+            max_lanes()
+        };
+        Self::with_width(width, p, rates_rad_s, streams)
+    }
+
+    /// The board in lanes of `width` (4 or 8) whatever the points (benchmarks, and tests that
+    /// compare the widths). Eight lanes on a CPU without AVX-512 are refused.
+    pub fn with_width(
+        width: usize,
+        p: &BoardParams,
+        rates_rad_s: &[f64],
+        streams: &[u64],
+    ) -> Result<Self, ParamError> {
+        match width {
+            4 => Ok(Self(Lanes::Four(Box::new(Board::new(
+                p,
+                rates_rad_s,
+                streams,
+            )?)))),
+            #[cfg(target_arch = "x86_64")]
+            8 if eight_lanes_available() => Ok(Self(Lanes::Eight(Box::new(Board::new(
+                p,
+                rates_rad_s,
+                streams,
+            )?)))),
+            8 => Err(ParamError::new(
+                STAGE,
+                "lanes",
+                width,
+                "eight lanes need a CPU with AVX-512 (F, VL, DQ and BW)",
+            )),
+            _ => Err(ParamError::new(STAGE, "lanes", width, "must be 4 or 8")),
+        }
+    }
+
+    /// Lanes of the group's sample type (4 or 8).
+    pub fn width(&self) -> usize {
+        match &self.0 {
+            Lanes::Four(_) => 4,
+            #[cfg(target_arch = "x86_64")]
+            Lanes::Eight(_) => 8,
+        }
+    }
+
+    /// The operating points this board runs (lanes in use).
+    pub fn lanes(&self) -> usize {
+        on_board!(&self.0, b => b.lanes())
+    }
+
+    /// See [`Board::set_cancel`].
+    pub fn set_cancel(&mut self, flag: Arc<AtomicBool>) {
+        on_board!(&mut self.0, b => b.set_cancel(flag))
+    }
+
+    /// See [`Board::run`].
+    pub fn run(
+        &mut self,
+        n_settle: u64,
+        points: &[Point],
+        opts: RunOptions,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<RunOutput, NonFinite> {
+        on_board!(&mut self.0, b => b.run(n_settle, points, opts, progress))
+    }
+
+    /// See [`Board::plant_decoupled`].
+    pub fn plant_decoupled(&self) -> bool {
+        on_board!(&self.0, b => b.plant_decoupled())
+    }
+}
