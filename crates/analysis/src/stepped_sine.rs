@@ -70,6 +70,7 @@ pub fn stepped_sine_work(cfg: &Config) -> Work {
         points: 2 * n,
         point_samples: 2 * n as u64 * per_run,
         longest_s: per_run as f64 / cfg.fs_hz(),
+        longest_samples: per_run,
     }
 }
 

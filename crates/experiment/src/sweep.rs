@@ -87,6 +87,11 @@ pub struct SweepOptions<'a> {
     /// The dump to record instead of the config's `[dump]` (if any); written into the
     /// `dump_dir` given to [`run_sweep_with`].
     pub dump: Option<DumpPlan>,
+    /// The threads the lane groups are sized for; `None`: the pool's. A caller whose pool
+    /// runs other work beside this sweep (reproduce runs every experiment in one pool) gives
+    /// 1: each group is then as wide as the CPU runs (most points per CPU-second), and the
+    /// other work keeps the remaining threads busy.
+    pub group_threads: Option<usize>,
 }
 
 /// The points a [`run_sweep_with`] call has, and whether it was cancelled.
@@ -181,7 +186,10 @@ pub fn run_sweep_with(
     let n_settle = cfg.n_settle_out();
     let mut groups: Vec<&[usize]> = Vec::new();
     let mut rest = &todo[..];
-    for size in lane_groups(todo.len(), rayon::current_num_threads(), max_lanes()) {
+    let threads = opts
+        .group_threads
+        .unwrap_or_else(rayon::current_num_threads);
+    for size in lane_groups(todo.len(), threads, max_lanes()) {
         let (g, r) = rest.split_at(size);
         groups.push(g);
         rest = r;

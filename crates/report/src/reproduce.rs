@@ -81,6 +81,12 @@ impl ReproducePlan {
     }
 }
 
+/// Input samples of `cfg`'s longest point (settling plus window): the length of its longest
+/// lane group.
+fn longest_input_samples(cfg: &Config) -> f64 {
+    gyroemu_experiment::sweep_work(cfg).longest_s * cfg.fs_hz()
+}
+
 /// The presets of the figures (with `quick`, Fig. 9 averages 15 s instead of 500 s), each
 /// validated before any sample is computed.
 pub fn plan_reproduce(quick: bool) -> Result<ReproducePlan, ReportError> {
@@ -150,23 +156,37 @@ pub fn reproduce(
         task.update(sum(0), sum(1));
     };
     let rt_cfg = &jobs[job_index(jobs, "m2tfg-ratetable")].cfg;
+    // The experiment whose longest point has the most input samples first: its lane group
+    // bounds the run, so it starts at once while the others fill the other threads.
+    let mut order: Vec<usize> = (0..jobs.len()).collect();
+    order.sort_by(|&a, &b| {
+        longest_input_samples(&jobs[b].cfg).total_cmp(&longest_input_samples(&jobs[a].cfg))
+    });
     let (swept, bandwidth_runs) = rayon::join(
         || {
-            jobs.par_iter()
-                .enumerate()
-                .map(|(i, job)| {
+            let mut swept: Vec<(usize, Result<_, ReportError>)> = order
+                .par_iter()
+                .map(|&i| {
+                    let job = &jobs[i];
                     // The dump only records: the results are those of a run without it.
+                    // Groups sized for one thread: the pool is shared by every experiment,
+                    // so each group is as wide as the CPU runs (bits do not depend on it).
                     let opts = SweepOptions {
                         dump: Some(reproduce_dump(&job.cfg)),
+                        group_threads: Some(1),
                         ..Default::default()
                     };
                     let dir = out.join(job.preset);
                     let progress = |d: u64, t: u64| report(i, d, t);
-                    let run = run_sweep_with(&job.cfg, &progress, Some(&dir), opts)?;
-                    let r = finish_sweep(&job.cfg, &run.lanes)?;
-                    Ok((run, r))
+                    let res = run_sweep_with(&job.cfg, &progress, Some(&dir), opts)
+                        .map_err(ReportError::from)
+                        .and_then(|run| Ok((finish_sweep(&job.cfg, &run.lanes)?, run)))
+                        .map(|(r, run)| (run, r));
+                    (i, res)
                 })
-                .collect::<Vec<Result<_, ReportError>>>()
+                .collect();
+            swept.sort_by_key(|(i, _)| *i);
+            swept.into_iter().map(|(_, r)| r).collect::<Vec<_>>()
         },
         || bandwidth(rt_cfg),
     );

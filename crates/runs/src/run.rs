@@ -158,6 +158,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         cancel: Some(req.cancel.clone()),
         on_group: Some(&on_group),
         dump: None,
+        group_threads: None,
     };
     let swept = match run_sweep_with(&held, &|d, t| task.update(d, t), Some(out), opts) {
         Ok(s) => s,

@@ -125,29 +125,10 @@ pub fn device_work(device: &Config) -> (Work, u64) {
 /// The work of the devices `indices` of the lot of `cfg`, and their input samples.
 pub fn lot_work(cfg: &Config, indices: &[u64]) -> (Work, u64) {
     let Some(mc) = &cfg.montecarlo else {
-        return (
-            Work {
-                points: 0,
-                point_samples: 0,
-                longest_s: 0.0,
-            },
-            0,
-        );
+        return (Work::default(), 0);
     };
     indices
         .par_iter()
         .map(|&i| device_work(&device_config(cfg, &draw_device(mc, i))))
-        .reduce(
-            || {
-                (
-                    Work {
-                        points: 0,
-                        point_samples: 0,
-                        longest_s: 0.0,
-                    },
-                    0,
-                )
-            },
-            |(a, x), (b, y)| (a.plus(b), x + y),
-        )
+        .reduce(|| (Work::default(), 0), |(a, x), (b, y)| (a.plus(b), x + y))
 }
