@@ -81,12 +81,6 @@ impl ReproducePlan {
     }
 }
 
-/// Input samples of `cfg`'s longest point (settling plus window): the length of its longest
-/// lane group.
-fn longest_input_samples(cfg: &Config) -> f64 {
-    gyroemu_experiment::sweep_work(cfg).longest_s * cfg.fs_hz()
-}
-
 /// The presets of the figures (with `quick`, Fig. 9 averages 15 s instead of 500 s), each
 /// validated before any sample is computed.
 pub fn plan_reproduce(quick: bool) -> Result<ReproducePlan, ReportError> {
@@ -159,8 +153,8 @@ pub fn reproduce(
     // The experiment whose longest point has the most input samples first: its lane group
     // bounds the run, so it starts at once while the others fill the other threads.
     let mut order: Vec<usize> = (0..jobs.len()).collect();
-    order.sort_by(|&a, &b| {
-        longest_input_samples(&jobs[b].cfg).total_cmp(&longest_input_samples(&jobs[a].cfg))
+    order.sort_by_key(|&i| {
+        core::cmp::Reverse(gyroemu_experiment::sweep_work(&jobs[i].cfg).longest_samples)
     });
     let (swept, bandwidth_runs) = rayon::join(
         || {
@@ -178,10 +172,11 @@ pub fn reproduce(
                     };
                     let dir = out.join(job.preset);
                     let progress = |d: u64, t: u64| report(i, d, t);
-                    let res = run_sweep_with(&job.cfg, &progress, Some(&dir), opts)
-                        .map_err(ReportError::from)
-                        .and_then(|run| Ok((finish_sweep(&job.cfg, &run.lanes)?, run)))
-                        .map(|(r, run)| (run, r));
+                    let res = (|| {
+                        let run = run_sweep_with(&job.cfg, &progress, Some(&dir), opts)?;
+                        let r = finish_sweep(&job.cfg, &run.lanes)?;
+                        Ok((run, r))
+                    })();
                     (i, res)
                 })
                 .collect();
