@@ -158,6 +158,16 @@ pub struct Board<S: Sample> {
     pub(crate) cancel: Option<Arc<AtomicBool>>,
 }
 
+/// The generator of lanes `4q .. 4q + 4`, lane `i` on stream `streams[i]` (lanes past the end
+/// repeat the last): every lane-parallel noise source draws from four-lane sets like this one,
+/// so a lane draws the same numbers in every lane type.
+pub(crate) fn lane_set_rng(seed: u64, streams: &[u64], q: usize) -> NoiseRng {
+    let last = streams.len() - 1;
+    NoiseRng::new(core::array::from_fn(|i| {
+        stream_seed(seed, streams[(4 * q + i).min(last)])
+    }))
+}
+
 impl<S: Sample> Board<S> {
     /// Builds the board for up to `S::LANES` operating points (rates in rad/s: rotation,
     /// excitation or table amplitude, by `p.shape`; unused lanes repeat the last point); lane
@@ -189,14 +199,7 @@ impl<S: Sample> Board<S> {
             .collect::<Result<_, _>>()?;
         let mix1 = [Stage1Mixer::new(0.0)?, Stage1Mixer::new(0.0)?];
         let seed = p.noise.map_or(0, |n| n.seed);
-        let lane_stream = |i: usize| streams[i.min(lanes - 1)];
-        // Lanes 4q .. 4q + 4 from one four-lane set of streams, so a lane draws the same
-        // normals in every lane type.
-        let rng = |q: usize| {
-            NoiseRng::new(core::array::from_fn(|i| {
-                stream_seed(seed, lane_stream(4 * q + i))
-            }))
-        };
+        let rng = |q: usize| lane_set_rng(seed, streams, q);
         let normals = if S::LANES > 4 {
             NormalBlock::wide(rng(0), rng(1))
         } else {

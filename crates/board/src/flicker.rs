@@ -12,10 +12,11 @@
 //! Every source is a seeded [`Flicker`] started in its stationary state, lane-parallel like
 //! the white noise, so a lane gives the bits of that point alone.
 
+use crate::board::lane_set_rng;
 use crate::params::{BoardParams, NoiseParams};
 use gyroemu_core::detmath::sin_cos;
 use gyroemu_core::flicker::{Flicker, FlickerParams};
-use gyroemu_core::noise::{stream_seed, NoiseRng};
+use gyroemu_core::noise::NoiseRng;
 use gyroemu_core::{f64x4, ParamResult, Sample, Stage};
 
 /// Salt of the flicker streams' seeds (apart from the white noise's).
@@ -154,22 +155,18 @@ impl<S: Sample> FlickerSources<S> {
     }
 }
 
-/// The flicker streams of up to eight lanes, four lanes per generator as the white noise's
-/// (lane `4q + i` is lane `i` of generator `q`), so a point draws the same normals in a group
-/// of four or of eight.
+/// The flicker streams of up to eight lanes, in four-lane sets as the white noise's
+/// ([`lane_set_rng`]), so a point draws the same normals in a group of four or of eight.
 #[derive(Clone, Debug)]
 struct LaneRng([NoiseRng; 2]);
 
 impl LaneRng {
     /// Lane `i` on stream `streams[i]` (lanes past the end repeat the last).
     fn new(seed: u64, streams: &[u64]) -> Self {
-        let last = streams.len() - 1;
-        let rng = |q: usize| {
-            NoiseRng::new(core::array::from_fn(|i| {
-                stream_seed(seed, streams[(4 * q + i).min(last)])
-            }))
-        };
-        Self([rng(0), rng(1)])
+        Self([
+            lane_set_rng(seed, streams, 0),
+            lane_set_rng(seed, streams, 1),
+        ])
     }
 
     /// The next pair of standard normals in every lane of `S` (the second generator only
