@@ -5,6 +5,7 @@
 
 use crate::fault::NonFinite;
 use crate::flicker::FlickerSources;
+use crate::lanes::MAX_LANES;
 use crate::params::{build_adc, build_dac, build_lowpass, build_tia, BoardParams, Shape};
 use crate::point::{Point, RunOptions, RunOutput};
 use gyroemu_am::{AmModulator, Dac, DrivePattern, Quantizer};
@@ -84,7 +85,12 @@ pub(crate) fn table_nco(p: &BoardParams) -> Result<Nco, ParamError> {
         Shape::RateTable { freq_hz } => freq_hz,
         _ => 0.0,
     };
-    Nco::new(f, p.fs_hz(), core::f64::consts::PI * f / p.fs_hz())
+    table_nco_at(f, p.fs_hz())
+}
+
+/// [`table_nco`] at table frequency `f_hz`.
+fn table_nco_at(f_hz: f64, fs_hz: f64) -> Result<Nco, ParamError> {
+    Nco::new(f_hz, fs_hz, core::f64::consts::PI * f_hz / fs_hz)
 }
 
 /// The table harmonics a board demodulates (none but the mean outside rate-table runs).
@@ -122,8 +128,8 @@ pub struct Board<S: Sample> {
     pub(crate) shifter: PhaseShifter,
     /// Modulation e^{j Omega t}, one Omega per lane (rotating runs).
     pub(crate) modulation: RotatingNco<S>,
-    /// Rate-table sine, shared frequency (rate-table runs).
-    pub(crate) table_nco: RotatingNco<f64>,
+    /// Rate-table sine, one table per lane (rate-table runs; usually one frequency for all).
+    pub(crate) table_nco: RotatingNco<S>,
     pub(crate) rate: S,
     pub(crate) am: AmModulator<S>,
     pub(crate) dac: [Dac<S>; 2],
@@ -139,7 +145,10 @@ pub struct Board<S: Sample> {
     /// Demodulation at the table harmonics (rate-table runs).
     pub(crate) table_mix: TableMixer<S>,
     pub(crate) fs_hz: f64,
-    pub(crate) table_f_hz: f64,
+    /// Each lane's realised table frequency, Hz (lanes past the points repeat the last).
+    pub(crate) table_f_hz: [f64; MAX_LANES],
+    /// Every lane follows the same table (its reference is computed once per output).
+    pub(crate) table_shared: bool,
     /// Phase-shifter error on the modulation's quadrature copy (rotating runs): (cos, sin).
     pub(crate) mod_shift: Option<(S, S)>,
     pub(crate) noise: NoiseState<S>,
@@ -174,6 +183,46 @@ impl<S: Sample> Board<S> {
     /// `i` draws noise stream `streams[i]` (a sweep passes each point's index, so its noise
     /// does not depend on the lane group or shard that runs it).
     pub fn new(p: &BoardParams, rates_rad_s: &[f64], streams: &[u64]) -> Result<Self, ParamError> {
+        Self::build(p, rates_rad_s, None, streams)
+    }
+
+    /// [`Board::new`] for a rate-table board whose lane `i` follows its own table at
+    /// `table_hz[i]` (> 0), in place of `p`'s: a lane then holds the bits of a board built
+    /// with that frequency in `p` (the bandwidth sweep packs its table frequencies so).
+    pub fn with_table_hz(
+        p: &BoardParams,
+        rates_rad_s: &[f64],
+        table_hz: &[f64],
+        streams: &[u64],
+    ) -> Result<Self, ParamError> {
+        let Shape::RateTable { .. } = p.shape else {
+            return Err(ParamError::new(
+                crate::params::STAGE,
+                "table_hz",
+                table_hz.len(),
+                "a table frequency per lane needs a rate-table board",
+            ));
+        };
+        if table_hz.len() != rates_rad_s.len() {
+            return Err(ParamError::new(
+                crate::params::STAGE,
+                "table_hz",
+                table_hz.len(),
+                format!("must list one frequency per point ({})", rates_rad_s.len()),
+            ));
+        }
+        for &f in table_hz {
+            gyroemu_core::error::positive(crate::params::STAGE, "table_freq_hz", f)?;
+        }
+        Self::build(p, rates_rad_s, Some(table_hz), streams)
+    }
+
+    fn build(
+        p: &BoardParams,
+        rates_rad_s: &[f64],
+        table_hz: Option<&[f64]>,
+        streams: &[u64],
+    ) -> Result<Self, ParamError> {
         let lanes = rates_rad_s.len();
         if lanes == 0 || lanes > S::LANES || streams.len() != lanes {
             return Err(ParamError::new(
@@ -193,7 +242,13 @@ impl<S: Sample> Board<S> {
         let modulation: Vec<Nco> = (0..S::LANES)
             .map(|i| Nco::new(modulation_hz(p.shape, lane_rate(i)), fs, 0.0))
             .collect::<Result<_, _>>()?;
-        let table_nco = table_nco(p)?;
+        let table: Vec<Nco> = match table_hz {
+            Some(f) => (0..S::LANES)
+                .map(|i| table_nco_at(f[i.min(lanes - 1)], fs))
+                .collect::<Result<_, _>>()?,
+            None => vec![table_nco(p)?],
+        };
+        let table_f_hz = core::array::from_fn(|i| table[i.min(table.len() - 1)].f_hz());
         let scalar: Vec<Resonator<f64>> = (0..S::LANES)
             .map(|i| Resonator::<f64>::new(&p.plant, plant_rate(p.shape, lane_rate(i))))
             .collect::<Result<_, _>>()?;
@@ -218,8 +273,9 @@ impl<S: Sample> Board<S> {
             carrier: RotatingNco::new(&[carrier]),
             shifter: shifter(p)?,
             modulation: RotatingNco::new(&modulation),
-            table_f_hz: table_nco.f_hz(),
-            table_nco: RotatingNco::new(&[table_nco]),
+            table_shared: table_f_hz.iter().all(|&f| f == table_f_hz[0]),
+            table_f_hz,
+            table_nco: RotatingNco::new(&table),
             rate: S::from_fn(lane_rate),
             am: AmModulator::new(pattern(p.shape), p.drive[0], p.drive[1])?,
             dac: [build_dac(p)?, build_dac(p)?],

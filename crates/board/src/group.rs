@@ -24,6 +24,16 @@ enum Lanes {
     Eight(Box<Board<F64x8>>),
 }
 
+/// The lanes [`GroupBoard::new`] runs `n` points in: four for up to four, else the widest
+/// this process runs.
+fn width_for(n: usize) -> usize {
+    if n <= 4 {
+        4
+    } else {
+        max_lanes()
+    }
+}
+
 /// The same call on whichever board the group holds.
 macro_rules! on_board {
     ($self:expr, $b:ident => $e:expr) => {
@@ -39,12 +49,32 @@ impl GroupBoard {
     /// The board for `rates_rad_s.len()` points, as [`Board::new`] takes them: four lanes for
     /// up to four points, eight for more (up to [`max_lanes`]).
     pub fn new(p: &BoardParams, rates_rad_s: &[f64], streams: &[u64]) -> Result<Self, ParamError> {
-        let width = if rates_rad_s.len() <= 4 {
-            4
-        } else {
-            max_lanes()
-        };
-        Self::with_width(width, p, rates_rad_s, streams)
+        Self::with_width(width_for(rates_rad_s.len()), p, rates_rad_s, streams)
+    }
+
+    /// [`Board::with_table_hz`] (a rate table per lane) in the lanes [`GroupBoard::new`]
+    /// picks.
+    pub fn with_table_hz(
+        p: &BoardParams,
+        rates_rad_s: &[f64],
+        table_hz: &[f64],
+        streams: &[u64],
+    ) -> Result<Self, ParamError> {
+        Ok(Self(match width_for(rates_rad_s.len()) {
+            #[cfg(target_arch = "x86_64")]
+            8 => Lanes::Eight(Box::new(Board::with_table_hz(
+                p,
+                rates_rad_s,
+                table_hz,
+                streams,
+            )?)),
+            _ => Lanes::Four(Box::new(Board::with_table_hz(
+                p,
+                rates_rad_s,
+                table_hz,
+                streams,
+            )?)),
+        }))
     }
 
     /// The board in lanes of `width` (4 or 8) whatever the points (benchmarks, and tests that

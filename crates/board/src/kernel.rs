@@ -202,8 +202,7 @@ impl<S: Sample> Board<S> {
                 RATE_TABLE => {
                     // z at every table harmonic, against the table phase of the input sample
                     // this output stands for.
-                    let base = table_reference(n0 + m - 1, self.table_f_hz, self.fs_hz);
-                    tx = self.table_mix.tick((z, base));
+                    tx = self.table_mix.tick((z, self.table_base(n0 + m - 1)));
                 }
                 _ => {
                     for (base, zm) in [(0, z[0]), (4, z[1])] {
@@ -367,7 +366,7 @@ impl<S: Sample> Board<S> {
                 }
                 let mut p = if K == RATE_TABLE {
                     let (_, sin_t) = self.table_nco.tick(());
-                    let rate = self.rate * S::splat(sin_t);
+                    let rate = self.rate * sin_t;
                     if DECOUPLED {
                         self.plant.tick_with_rate_split(u, rate)
                     } else {
@@ -450,6 +449,31 @@ impl<S: Sample> Board<S> {
 }
 
 impl<S: Sample> Board<S> {
+    /// `e^{-j theta}` of each lane's table at input sample `n`, as `(re, im)`
+    /// ([`table_reference`]; once for all lanes when they share the table). Out of line (once
+    /// per decimation block) and compiled like the loop.
+    #[inline(never)]
+    fn table_base(&self, n: u64) -> (S, S) {
+        S::with_target_features(
+            #[inline(always)]
+            || {
+                let at = |i: usize| table_reference(n, self.table_f_hz[i], self.fs_hz);
+                if self.table_shared {
+                    let b = at(0);
+                    return (S::splat(b.re), S::splat(b.im));
+                }
+                let b: [Complex64; crate::lanes::MAX_LANES] = core::array::from_fn(|i| {
+                    if i < S::LANES {
+                        at(i)
+                    } else {
+                        Complex64::new(0.0, 0.0)
+                    }
+                });
+                (S::from_fn(|i| b[i].re), S::from_fn(|i| b[i].im))
+            },
+        )
+    }
+
     /// Replays the run from the board as built, checking every stage's output on every
     /// sample up to block `k_bad` (where the decimated output stopped being finite), and
     /// names the first stage and sample that went non-finite.

@@ -173,7 +173,8 @@ pub fn run_reference(
             }
             Shape::RateTable { .. } => {
                 let z = zk.map(|v| Iq::new(v.re, v.im));
-                table_avg.push(&table_mix.tick((z, table_reference(n, table_f_hz, fs))));
+                let r = table_reference(n, table_f_hz, fs);
+                table_avg.push(&table_mix.tick((z, (r.re, r.im))));
             }
             Shape::Rotating => {
                 for (md, zm) in zk.iter().enumerate() {

@@ -75,29 +75,36 @@ pub fn table_reference(n_in: u64, table_hz: f64, fs_hz: f64) -> Complex64 {
 }
 
 impl<S: Sample> Stage for TableMixer<S> {
-    /// The low-passed stage-1 outputs of both modes and `e^{-j theta}`.
-    type Input = ([Iq<S>; 2], Complex64);
+    /// The low-passed stage-1 outputs of both modes and `e^{-j theta}` as `(re, im)` per lane
+    /// (each lane may follow its own table: the bandwidth sweep runs one frequency per lane).
+    type Input = ([Iq<S>; 2], (S, S));
     type Output = [S; TABLE_CHANNELS];
 
     #[inline(always)]
-    fn tick(&mut self, (z, base): Self::Input) -> Self::Output {
+    fn tick(&mut self, (z, (b_re, b_im)): Self::Input) -> Self::Output {
         let mut out = [S::splat(0.0); TABLE_CHANNELS];
-        // p = e^{-j n theta} by repeated multiplication (n <= 15 roundings: negligible).
-        let mut p = Complex64::new(1.0, 0.0);
+        // p = e^{-j n theta} by repeated multiplication (n <= 15 roundings: negligible), lane
+        // by lane the arithmetic of `Complex64`'s product.
+        let (mut p_re, mut p_im) = (S::splat(1.0), S::splat(0.0));
         for n in 0..=self.harmonics as isize {
             for sign in [1, -1] {
                 if n == 0 && sign < 0 {
                     continue;
                 }
-                let r = if sign > 0 { p } else { p.conj() };
-                let (c, s) = (S::splat(r.re), S::splat(r.im));
+                let (c, s) = if sign > 0 {
+                    (p_re, p_im)
+                } else {
+                    (p_re, -p_im)
+                };
                 for (md, zm) in z.iter().enumerate() {
                     let ch = table_channel(sign * n, md, self.harmonics);
                     out[ch] = zm.i * c - zm.q * s;
                     out[ch + 1] = zm.i * s + zm.q * c;
                 }
             }
-            p *= base;
+            let re = p_re * b_re - p_im * b_im;
+            p_im = p_re * b_im + p_im * b_re;
+            p_re = re;
         }
         out
     }

@@ -74,12 +74,14 @@ fn stage2_blocks_reset_lanes_and_latency() {
     check::latency_matches("mixer.stage2", lat, |x| m.tick(path(x)).c.i, 8, 0.0);
 }
 
-fn table_input<S: Sample>(g: &mut Gen) -> ([Iq<S>; 2], Complex64) {
+/// Each lane its own table reference (lanes may follow different tables).
+fn table_input<S: Sample>(g: &mut Gen) -> ([Iq<S>; 2], (S, S)) {
     let z = [
         Iq::new(g.sample(-3.0, 3.0), g.sample(-3.0, 3.0)),
         Iq::new(g.sample(-3.0, 3.0), g.sample(-3.0, 3.0)),
     ];
-    (z, g.phasor())
+    let r: Vec<Complex64> = (0..S::LANES).map(|_| g.phasor()).collect();
+    (z, (S::from_fn(|l| r[l].re), S::from_fn(|l| r[l].im)))
 }
 
 #[test]
@@ -95,7 +97,12 @@ fn table_mixer_blocks_reset_lanes_and_latency() {
             &v,
             &[s; 4],
             table_input,
-            |(z, r), l| (z.map(|zm| Iq::new(zm.i.lane(l), zm.q.lane(l))), *r),
+            |(z, r), l| {
+                (
+                    z.map(|zm| Iq::new(zm.i.lane(l), zm.q.lane(l))),
+                    (r.0.lane(l), r.1.lane(l)),
+                )
+            },
             |o, l| o.map(|x| x.lane(l)),
             |o| *o,
         );
@@ -103,7 +110,7 @@ fn table_mixer_blocks_reset_lanes_and_latency() {
         let mut m = s;
         let lat = m.latency_samples();
         let zero = Iq::new(0.0, 0.0);
-        let path = |x: f64| ([Iq::new(x, 0.0), zero], Complex64::new(1.0, 0.0));
+        let path = |x: f64| ([Iq::new(x, 0.0), zero], (1.0, 0.0));
         let ch = table_channel(0, 0, n);
         check::latency_matches("mixer.table", lat, |x| m.tick(path(x))[ch], 8, 0.0);
     }

@@ -70,7 +70,8 @@ fn whole_period_averages_are_the_harmonics() {
     for k in 0..3 * period {
         let theta = TAU * k as f64 * ft / fs;
         let z = [f(theta), g(theta)].map(|v| Iq::new(v.re, v.im));
-        let o = mix.tick((z, table_reference(k, ft, fs)));
+        let r = table_reference(k, ft, fs);
+        let o = mix.tick((z, (r.re, r.im)));
         for (a, x) in acc.iter_mut().zip(o) {
             *a += x / (3 * period) as f64;
         }
