@@ -3,9 +3,8 @@
 //! low-pass of THEORY.md section 3 (DC gain 2 Q lambda / w0, corner f0/(2Q)).
 
 use gyroemu_config::{Config, RateTable};
-use gyroemu_experiment::{run_sweep, SweepError};
+use gyroemu_experiment::{run_table_sweeps, SweepError};
 use gyroemu_theory::rate_table_gain;
-use rayon::prelude::*;
 
 /// Rate-table frequencies of the bandwidth sweep, Hz (the corner is f0/(2Q) = 0.21 Hz at
 /// 15 kHz and Q = 36 000).
@@ -29,34 +28,43 @@ pub struct BandwidthPoint {
 }
 
 /// Runs the rate-table config `base` at each of [`BANDWIDTH_FREQS_HZ`] with the amplitude
-/// [`BANDWIDTH_AMPLITUDE_DPS`] (each over at least two table periods and 4 s), in parallel.
-pub fn bandwidth(base: &Config) -> Result<Vec<BandwidthPoint>, SweepError> {
+/// [`BANDWIDTH_AMPLITUDE_DPS`] (each over at least two table periods and 4 s), the frequencies
+/// packed into shared lane groups (each lane on its own table: the bits of nine separate
+/// runs); `group_threads` as in [`gyroemu_experiment::SweepOptions`].
+pub fn bandwidth(
+    base: &Config,
+    group_threads: Option<usize>,
+) -> Result<Vec<BandwidthPoint>, SweepError> {
     let d = &base.device;
-    let configs: Vec<(f64, Config)> = BANDWIDTH_FREQS_HZ
+    let configs: Vec<Config> = BANDWIDTH_FREQS_HZ
         .iter()
-        .map(|&f| {
-            let mut cfg = base.clone();
-            cfg.experiment.rate_table = RateTable::Sinusoid;
-            cfg.experiment.table_freq_hz = Some(f);
-            cfg.experiment.rates_dps = vec![BANDWIDTH_AMPLITUDE_DPS];
-            cfg.experiment.average_s = (2.0 / f).max(4.0);
-            cfg.validate()?;
-            Ok((f, cfg))
-        })
+        .map(|&f| bandwidth_config(base, f))
         .collect::<Result<_, SweepError>>()?;
-    configs
-        .par_iter()
-        .map(|(f, cfg)| {
-            let r = run_sweep(cfg, &|_, _| {}, None)?;
+    let runs = run_table_sweeps(&configs, group_threads)?;
+    Ok(BANDWIDTH_FREQS_HZ
+        .iter()
+        .zip(runs)
+        .map(|(&f, r)| {
             let p = &r.points[0];
-            let (g, ph) = rate_table_gain(d.f0_hz, d.q, d.angular_gain, 1.0, 1.0, *f);
-            Ok(BandwidthPoint {
-                table_freq_hz: *f,
+            let (g, ph) = rate_table_gain(d.f0_hz, d.q, d.angular_gain, 1.0, 1.0, f);
+            BandwidthPoint {
+                table_freq_hz: f,
                 gain_deg_per_dps: p.phase_deg.map(|x| x / BANDWIDTH_AMPLITUDE_DPS),
                 theory_gain_deg_per_dps: g,
                 lag_deg: p.table_lag_deg.unwrap_or([f64::NAN; 2]),
                 theory_lag_deg: ph.to_degrees(),
-            })
+            }
         })
-        .collect()
+        .collect())
+}
+
+/// The config of the bandwidth sweep's point at table frequency `f_hz`.
+pub fn bandwidth_config(base: &Config, f_hz: f64) -> Result<Config, SweepError> {
+    let mut cfg = base.clone();
+    cfg.experiment.rate_table = RateTable::Sinusoid;
+    cfg.experiment.table_freq_hz = Some(f_hz);
+    cfg.experiment.rates_dps = vec![BANDWIDTH_AMPLITUDE_DPS];
+    cfg.experiment.average_s = (2.0 / f_hz).max(4.0);
+    cfg.validate()?;
+    Ok(cfg)
 }

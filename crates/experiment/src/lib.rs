@@ -10,6 +10,7 @@ pub mod lock;
 pub mod progress;
 pub mod readout;
 pub mod sweep;
+pub mod table_sweep;
 pub mod work;
 
 pub use dump::{dump_extra, DumpPlan};
@@ -20,4 +21,5 @@ pub use sweep::{
     dump_point, finish_sweep, run_sweep, run_sweep_with, OnGroup, SweepError, SweepOptions,
     SweepRun, DUMP_STEM,
 };
+pub use table_sweep::run_table_sweeps;
 pub use work::{sweep_work, Work, MAX_POINT_SAMPLES};

@@ -156,6 +156,8 @@ pub fn reproduce(
     order.sort_by_key(|&i| {
         core::cmp::Reverse(gyroemu_experiment::sweep_work(&jobs[i].cfg).longest_samples)
     });
+    // Each experiment writes its results, its dump's figures and its own figure as soon as
+    // its sweep is done (unless it has problems), while the longest one still runs.
     let (swept, bandwidth_runs) = rayon::join(
         || {
             let mut swept: Vec<(usize, Result<_, ReportError>)> = order
@@ -175,7 +177,12 @@ pub fn reproduce(
                     let res = (|| {
                         let run = run_sweep_with(&job.cfg, &progress, Some(&dir), opts)?;
                         let r = finish_sweep(&job.cfg, &run.lanes)?;
-                        Ok((run, r))
+                        let written = if r.problems.is_empty() {
+                            Some(write_job(out, job, &run.dump_files, &r))
+                        } else {
+                            None
+                        };
+                        Ok((run, r, written))
                     })();
                     (i, res)
                 })
@@ -183,15 +190,22 @@ pub fn reproduce(
             swept.sort_by_key(|(i, _)| *i);
             swept.into_iter().map(|(_, r)| r).collect::<Vec<_>>()
         },
-        || bandwidth(rt_cfg),
+        || -> Result<_, ReportError> {
+            let runs = bandwidth(rt_cfg, Some(1))?;
+            let (figure, csv) = bandwidth_outputs(rt_cfg, &runs, out)?;
+            let path = out.join("fig_bandwidth.png");
+            render_png(&figure, &path)?;
+            // The bandwidth sweep's table goes before its figure.
+            Ok([csv, path])
+        },
     );
     let mut runs = Vec::with_capacity(jobs.len());
     for s in swept {
         runs.push(s?);
     }
-    let bandwidth_runs = bandwidth_runs?;
-    let point_samples: u64 = runs.iter().map(|(_, r)| r.point_samples).sum();
-    let written = runs.iter().map(|(run, _)| run.written()).fold(
+    let bandwidth_files = bandwidth_runs?;
+    let point_samples: u64 = runs.iter().map(|(_, r, _)| r.point_samples).sum();
+    let written = runs.iter().map(|(run, _, _)| run.written()).fold(
         Default::default(),
         |a: gyroemu_experiment::Written, w| gyroemu_experiment::Written {
             files: a.files + w.files,
@@ -200,74 +214,43 @@ pub fn reproduce(
         },
     );
     task.finish_writing(Some(point_samples), written);
-    for (job, (_, r)) in jobs.iter().zip(&runs) {
+    for (job, (_, r, _)) in jobs.iter().zip(&runs) {
         for w in &r.warnings {
             reporter.warn(&format!("{}: {w}", job.preset));
         }
         check_problems(job.preset, &r.problems)?;
     }
-    // Each experiment's results and plot, and its dump's figures (read back from the
-    // files), in parallel.
-    let per_job: Vec<Result<Vec<PathBuf>, ReportError>> = jobs
-        .par_iter()
-        .zip(runs.par_iter())
-        .map(|(job, (run, r))| {
-            let dir = out.join(job.preset);
-            let mut files = write_run(&dir, &job.cfg, r, job.title)?;
-            files.extend(run.dump_files.iter().cloned());
-            files.extend(write_dump_figures(
-                &read_dump_set(&dir.join("dump"))?,
-                &dir,
-            )?);
-            Ok(files)
-        })
-        .collect();
+    // In the order of a sequential run: each experiment's files, then the figures.
     let mut files = Vec::new();
-    for f in per_job {
-        files.extend(f?);
+    let mut job_figures = Vec::new();
+    let mut results: Vec<SweepResult> = Vec::with_capacity(jobs.len());
+    for (_, r, w) in runs {
+        // Every experiment passed `check_problems`, so each wrote its outputs.
+        if let Some(w) = w {
+            let (f, fig) = w?;
+            files.extend(f);
+            job_figures.extend(fig);
+        }
+        results.push(r);
     }
-    let results: Vec<SweepResult> = runs.into_iter().map(|(_, r)| r).collect();
     let get = |name: &str| {
         let i = job_index(jobs, name);
         (&jobs[i].cfg, &results[i], jobs[i].title)
     };
-    // Every figure built, then rendered in parallel.
-    let mut figures: Vec<(String, Figure)> = Vec::new();
-    for (fig, name) in [
-        ("fig8", "m2tfg-coriolis"),
-        ("fig9", "m2tfg-rotating"),
-        ("fig4", "baw-coriolis"),
-        ("fig5", "baw-rotating"),
-        ("fig_ratetable", "m2tfg-ratetable"),
-    ] {
-        let (cfg, r, title) = get(name);
-        let mut f = sweep_figure(cfg, r, title);
-        if let Some(paper) = paper_i_series(r) {
-            f = f.with(paper);
+    for fig in ["fig8", "fig9", "fig4", "fig5", "fig_ratetable"] {
+        if let Some(p) = job_figures
+            .iter()
+            .find(|p| p.ends_with(format!("{fig}.png")))
+        {
+            files.push(p.clone());
         }
-        figures.push((format!("{fig}.png"), f));
     }
-    let (figure, csv) = bandwidth_outputs(rt_cfg, &bandwidth_runs, out)?;
-    figures.push(("fig_bandwidth.png".into(), figure));
     let (cc, cr, _) = get("baw-coriolis");
     let (_, rr, _) = get("baw-rotating");
-    figures.push(("fig6.png".into(), fig6(cc, cr, rr)));
-    let rendered: Vec<Result<PathBuf, ReportError>> = figures
-        .par_iter()
-        .map(|(name, f)| {
-            let path = out.join(name);
-            render_png(f, &path)?;
-            Ok(path)
-        })
-        .collect();
-    for r in rendered {
-        let path = r?;
-        // The bandwidth sweep's table goes before its figure.
-        if path.ends_with("fig_bandwidth.png") {
-            files.push(csv.clone());
-        }
-        files.push(path);
-    }
+    files.extend(bandwidth_files);
+    let path = out.join("fig6.png");
+    render_png(&fig6(cc, cr, rr), &path)?;
+    files.push(path);
     let pair = |c: &str, rname: &str| {
         let (cfg, rc, _) = get(c);
         let (_, rrot, _) = get(rname);
@@ -383,6 +366,57 @@ fn bandwidth_outputs(
 }
 
 /// The paper-style real-I-channel estimate of mode 1, for the rotating figures.
+/// The figure `reproduce` draws of an experiment alone.
+fn figure_name(preset: &str) -> Option<&'static str> {
+    Some(match preset {
+        "m2tfg-coriolis" => "fig8",
+        "m2tfg-rotating" => "fig9",
+        "baw-coriolis" => "fig4",
+        "baw-rotating" => "fig5",
+        "m2tfg-ratetable" => "fig_ratetable",
+        _ => return None,
+    })
+}
+
+/// An experiment's outputs: its results, its dump (`dump_files`, written by the sweep) and
+/// the dump's figures in its folder, and its own figure in `out`. Returns the files of its
+/// folder, then its figure.
+fn write_job(
+    out: &Path,
+    job: &Job,
+    dump_files: &[PathBuf],
+    r: &SweepResult,
+) -> Result<(Vec<PathBuf>, Option<PathBuf>), ReportError> {
+    let dir = out.join(job.preset);
+    // In parallel: the last experiment to finish has the pool to itself.
+    let ((run, dump), figure) = rayon::join(
+        || {
+            rayon::join(
+                || write_run(&dir, &job.cfg, r, job.title),
+                || -> Result<_, ReportError> {
+                    write_dump_figures(&read_dump_set(&dir.join("dump"))?, &dir)
+                },
+            )
+        },
+        || -> Result<_, ReportError> {
+            let Some(name) = figure_name(job.preset) else {
+                return Ok(None);
+            };
+            let mut f = sweep_figure(&job.cfg, r, job.title);
+            if let Some(paper) = paper_i_series(r) {
+                f = f.with(paper);
+            }
+            let path = out.join(format!("{name}.png"));
+            render_png(&f, &path)?;
+            Ok(Some(path))
+        },
+    );
+    let mut files = run?;
+    files.extend(dump_files.iter().cloned());
+    files.extend(dump?);
+    Ok((files, figure?))
+}
+
 fn paper_i_series(r: &SweepResult) -> Option<Series> {
     let ys: Option<Vec<f64>> = r
         .points

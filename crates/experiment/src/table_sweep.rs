@@ -1,0 +1,223 @@
+//! Rate-table sweeps that differ only in their table frequency and averaging time (the
+//! bandwidth sweep: one point per frequency), run in shared lane groups, each lane on its own
+//! table. Run one by one, each would be a group of one point; packed, nine frequencies take
+//! two groups. Every point keeps the bits of its own sweep.
+
+use crate::readout::SweepResult;
+use crate::sweep::{finish_sweep, SweepError};
+use gyroemu_board::{
+    lane_groups, max_lanes, BoardParams, GroupBoard, LaneResult, RunOptions, Shape,
+};
+use gyroemu_config::Config;
+use gyroemu_mixer::MAX_TABLE_HARMONIC;
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+
+/// A finished lane: its sweep, its index there and its result.
+type Finished = (usize, usize, LaneResult);
+
+/// One point of one of the sweeps.
+struct Job {
+    /// The sweep (index in the caller's configs) and the point's index in its rates.
+    sweep: usize,
+    index: usize,
+    point: gyroemu_board::Point,
+    table_hz: f64,
+    /// The table harmonics its own board would demodulate.
+    harmonics: usize,
+}
+
+/// What the sweeps of one lane group must share: the board but for the table's frequency and
+/// harmonics, and the settling.
+fn board_key(cfg: &Config) -> (BoardParams, u64) {
+    let p = cfg.board_params();
+    let key = BoardParams {
+        shape: Shape::RateTable { freq_hz: 0.0 },
+        table_harmonics: 0,
+        ..p
+    };
+    (key, cfg.n_settle_out())
+}
+
+/// Runs each of `cfgs` (validated rate-table configs) as [`crate::run_sweep`] would, without
+/// progress or dumps, and returns their results in order: the same bits, in fewer lane
+/// groups. Configs whose boards differ beyond the table (or whose settling differs) run in
+/// groups of their own. `group_threads` as in [`crate::SweepOptions`].
+pub fn run_table_sweeps(
+    cfgs: &[Config],
+    group_threads: Option<usize>,
+) -> Result<Vec<SweepResult>, SweepError> {
+    let lanes = run_table_lanes(cfgs, group_threads)?;
+    cfgs.iter()
+        .zip(&lanes)
+        .map(|(cfg, l)| finish_sweep(cfg, l))
+        .collect()
+}
+
+/// The lane results of [`run_table_sweeps`], per config by point index: those of
+/// [`crate::run_sweep_with`] on each config alone, bit for bit.
+fn run_table_lanes(
+    cfgs: &[Config],
+    group_threads: Option<usize>,
+) -> Result<Vec<BTreeMap<usize, LaneResult>>, SweepError> {
+    // Classes of configs that can share a group, each with its points.
+    let mut classes: Vec<((BoardParams, u64), Vec<Job>)> = Vec::new();
+    for (sweep, cfg) in cfgs.iter().enumerate() {
+        let p = cfg.board_params();
+        let Shape::RateTable { freq_hz } = p.shape else {
+            return Err(SweepError::Param(gyroemu_core::ParamError::new(
+                "experiment",
+                "rate_table",
+                "constant",
+                "a table sweep takes rate-table configs only",
+            )));
+        };
+        let key = board_key(cfg);
+        let jobs = match classes.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, jobs)) => jobs,
+            None => {
+                classes.push((key, Vec::new()));
+                &mut classes.last_mut().expect("just pushed").1
+            }
+        };
+        for (index, &r) in cfg.emulated_rates_dps().iter().enumerate() {
+            jobs.push(Job {
+                sweep,
+                index,
+                point: cfg.plan_point(r),
+                table_hz: freq_hz,
+                harmonics: p.table_harmonics,
+            });
+        }
+    }
+    let threads = group_threads.unwrap_or_else(rayon::current_num_threads);
+    // Every group's board first, so a bad parameter fails before any sample is computed.
+    let mut groups: Vec<(GroupBoard, Vec<&Job>, u64)> = Vec::new();
+    for ((key, n_settle), jobs) in &classes {
+        let mut order: Vec<&Job> = jobs.iter().collect();
+        // Longest window first, so a group's lanes end together (as in a sweep).
+        order.sort_by_key(|j| core::cmp::Reverse(j.point.window.samples()));
+        let mut rest = &order[..];
+        for size in lane_groups(order.len(), threads, max_lanes()) {
+            let (g, r) = rest.split_at(size);
+            rest = r;
+            // The board demodulates the most harmonics any of its lanes needs; a lane's
+            // harmonics do not depend on how many others are demodulated beside them.
+            let p = BoardParams {
+                shape: Shape::RateTable {
+                    freq_hz: g[0].table_hz,
+                },
+                table_harmonics: g.iter().map(|j| j.harmonics).max().unwrap_or(1),
+                ..*key
+            };
+            let rates: Vec<f64> = g.iter().map(|j| j.point.rate_rad_s).collect();
+            let table_hz: Vec<f64> = g.iter().map(|j| j.table_hz).collect();
+            // Each point draws the stream of its index in its own sweep.
+            let streams: Vec<u64> = g.iter().map(|j| j.index as u64).collect();
+            let board = GroupBoard::with_table_hz(&p, &rates, &table_hz, &streams)?;
+            groups.push((board, g.to_vec(), *n_settle));
+        }
+    }
+    let done: Vec<Result<Vec<Finished>, SweepError>> = groups
+        .into_par_iter()
+        .map(|(mut board, g, n_settle)| {
+            let points: Vec<_> = g.iter().map(|j| j.point).collect();
+            let out = board.run(n_settle, &points, RunOptions::default(), &|_| {})?;
+            Ok(g.iter()
+                .zip(out.lanes)
+                .map(|(j, mut lane)| {
+                    // Harmonics beyond the point's own are zero in its own sweep.
+                    for md in 0..2 {
+                        for (i, h) in lane.table_z[md].iter_mut().enumerate() {
+                            if i.abs_diff(MAX_TABLE_HARMONIC) > j.harmonics {
+                                *h = Default::default();
+                            }
+                        }
+                    }
+                    (j.sweep, j.index, lane)
+                })
+                .collect())
+        })
+        .collect();
+    let mut lanes: Vec<BTreeMap<usize, LaneResult>> = vec![BTreeMap::new(); cfgs.len()];
+    for g in done {
+        for (sweep, index, lane) in g? {
+            lanes[sweep].insert(index, lane);
+        }
+    }
+    Ok(lanes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run_sweep;
+
+    /// The rate-table preset, short, at table frequency `f` with rate amplitudes `rates`.
+    fn cfg(f: f64, average_s: f64, rates: &[f64]) -> Config {
+        let mut c = gyroemu_config::presets::preset("m2tfg-ratetable").unwrap();
+        c.experiment.table_freq_hz = Some(f);
+        c.experiment.average_s = average_s;
+        c.experiment.settle_s = Some(0.02);
+        c.experiment.rates_dps = rates.to_vec();
+        c.validate().unwrap();
+        c
+    }
+
+    fn noisy(mut c: Config, seed: u64) -> Config {
+        c.noise = Some(gyroemu_config::NoiseConfig {
+            seed,
+            tia_current_noise_a_per_rthz: 5e-13,
+            ..Default::default()
+        });
+        c.validate().unwrap();
+        c
+    }
+
+    #[test]
+    fn packed_sweeps_give_each_sweep_its_own_bits() {
+        let mut other_drive = cfg(3.0, 0.34, &[50.0]);
+        other_drive.drive.f1 *= 1.5;
+        let cfgs = vec![
+            cfg(2.0, 0.5, &[5.0]),
+            cfg(7.0, 0.3, &[5.0]),
+            cfg(0.5, 2.0, &[5.0, 900.0]),
+            noisy(cfg(2.5, 0.4, &[100.0]), 3),
+            noisy(cfg(4.0, 0.25, &[100.0, 20.0]), 3),
+            other_drive,
+            cfg(11.0, 0.3, &[5.0]),
+        ];
+        // The packing is exercised: lanes of one group need different harmonics.
+        let h: Vec<usize> = cfgs.iter().map(|c| c.table_harmonics()).collect();
+        assert!(h[0] != h[2] || h[1] != h[2], "harmonics {h:?}");
+        // Lane by lane: the harmonics beyond a point's own are zero as in its own sweep.
+        let lanes = run_table_lanes(&cfgs, Some(1)).unwrap();
+        for (i, (c, l)) in cfgs.iter().zip(&lanes).enumerate() {
+            let alone = crate::run_sweep_with(c, &|_, _| {}, None, Default::default()).unwrap();
+            assert_eq!(*l, alone.lanes, "sweep {i}");
+        }
+        for threads in [Some(1), Some(2), None] {
+            let packed = run_table_sweeps(&cfgs, threads).unwrap();
+            assert_eq!(packed.len(), cfgs.len());
+            for (i, (c, p)) in cfgs.iter().zip(&packed).enumerate() {
+                let alone = run_sweep(c, &|_, _| {}, None).unwrap();
+                // Through Debug: a one-rate sweep's line fit is NaN, which `==` never equals
+                // (Debug prints each float's shortest exact form).
+                assert_eq!(
+                    format!("{p:?}"),
+                    format!("{alone:?}"),
+                    "sweep {i} ({threads:?} threads)"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_constant_rate_config_is_refused() {
+        let mut c = cfg(2.0, 0.5, &[5.0]);
+        c.experiment.rate_table = gyroemu_config::RateTable::Constant;
+        c.experiment.table_freq_hz = None;
+        let e = run_table_sweeps(&[c], None).err().unwrap().to_string();
+        assert!(e.contains("rate-table configs only"), "{e}");
+    }
+}
