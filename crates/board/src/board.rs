@@ -25,6 +25,13 @@ use std::sync::Arc;
 pub(crate) const CORIOLIS: u8 = 0;
 pub(crate) const RATE_TABLE: u8 = 1;
 pub(crate) const ROTATING: u8 = 2;
+/// A rate table whose lanes follow different tables ([`Board::with_table_hz`]).
+pub(crate) const RATE_TABLE_LANES: u8 = 3;
+
+/// Shape `k` is a rate table (shared or per lane).
+pub(crate) const fn is_table(k: u8) -> bool {
+    k == RATE_TABLE || k == RATE_TABLE_LANES
+}
 
 /// The seeded noise of one lane group: each lane's (operating point's) normals, drawn ahead,
 /// four a sample (force on both modes, then input current on both modes), and the per-sample
@@ -128,8 +135,11 @@ pub struct Board<S: Sample> {
     pub(crate) shifter: PhaseShifter,
     /// Modulation e^{j Omega t}, one Omega per lane (rotating runs).
     pub(crate) modulation: RotatingNco<S>,
-    /// Rate-table sine, one table per lane (rate-table runs; usually one frequency for all).
-    pub(crate) table_nco: RotatingNco<S>,
+    /// Rate-table sine shared by the lanes (rate-table runs).
+    pub(crate) table_nco: RotatingNco<f64>,
+    /// Rate-table sine of each lane, when the lanes follow different tables
+    /// ([`Board::with_table_hz`]); the shared one is the cheaper in the sample loop.
+    pub(crate) table_lanes: Option<RotatingNco<S>>,
     pub(crate) rate: S,
     pub(crate) am: AmModulator<S>,
     pub(crate) dac: [Dac<S>; 2],
@@ -248,7 +258,9 @@ impl<S: Sample> Board<S> {
                 .collect::<Result<_, _>>()?,
             None => vec![table_nco(p)?],
         };
-        let table_f_hz = core::array::from_fn(|i| table[i.min(table.len() - 1)].f_hz());
+        let table_f_hz: [f64; MAX_LANES] =
+            core::array::from_fn(|i| table[i.min(table.len() - 1)].f_hz());
+        let table_shared = table_f_hz.iter().all(|&f| f == table_f_hz[0]);
         let scalar: Vec<Resonator<f64>> = (0..S::LANES)
             .map(|i| Resonator::<f64>::new(&p.plant, plant_rate(p.shape, lane_rate(i))))
             .collect::<Result<_, _>>()?;
@@ -273,9 +285,10 @@ impl<S: Sample> Board<S> {
             carrier: RotatingNco::new(&[carrier]),
             shifter: shifter(p)?,
             modulation: RotatingNco::new(&modulation),
-            table_shared: table_f_hz.iter().all(|&f| f == table_f_hz[0]),
+            table_shared,
             table_f_hz,
-            table_nco: RotatingNco::new(&table),
+            table_nco: RotatingNco::new(&table[..1]),
+            table_lanes: (!table_shared).then(|| RotatingNco::new(&table)),
             rate: S::from_fn(lane_rate),
             am: AmModulator::new(pattern(p.shape), p.drive[0], p.drive[1])?,
             dac: [build_dac(p)?, build_dac(p)?],

@@ -2,7 +2,7 @@
 //! monomorphised loop per experiment shape, noise shape and plant step. Its results equal the
 //! reference board's (`reference.rs`, plain `Stage::tick` calls) bit for bit.
 
-use crate::board::{Board, CORIOLIS, RATE_TABLE, ROTATING};
+use crate::board::{is_table, Board, CORIOLIS, RATE_TABLE, RATE_TABLE_LANES, ROTATING};
 use crate::fault::NonFinite;
 use crate::flicker::{turn, BlockFlicker};
 use crate::health::{Counters, Health, ADC_CLIP, ADC_ZERO, DAC_CLIP, DAC_ZERO, TIA_RAIL};
@@ -51,6 +51,7 @@ impl<S: Sample> Board<S> {
         }
         match self.shape {
             Shape::Coriolis => by_plant!(CORIOLIS),
+            Shape::RateTable { .. } if self.table_lanes.is_some() => by_plant!(RATE_TABLE_LANES),
             Shape::RateTable { .. } => by_plant!(RATE_TABLE),
             Shape::Rotating => by_plant!(ROTATING),
         }
@@ -72,6 +73,7 @@ impl<S: Sample> Board<S> {
         }
         match self.shape {
             Shape::Coriolis => by_plant!(CORIOLIS),
+            Shape::RateTable { .. } if self.table_lanes.is_some() => by_plant!(RATE_TABLE_LANES),
             Shape::RateTable { .. } => by_plant!(RATE_TABLE),
             Shape::Rotating => by_plant!(ROTATING),
         }
@@ -119,7 +121,7 @@ impl<S: Sample> Board<S> {
             .expect("the points' windows are valid and one per lane");
         let mut table_avg = Averager::<S, TABLE_CHANNELS>::new(
             &windows,
-            if K == RATE_TABLE {
+            if is_table(K) {
                 self.table_mix.channels()
             } else {
                 0
@@ -199,7 +201,7 @@ impl<S: Sample> Board<S> {
                         x[2 * md + 1] = z[md].q;
                     }
                 }
-                RATE_TABLE => {
+                RATE_TABLE | RATE_TABLE_LANES => {
                     // z at every table harmonic, against the table phase of the input sample
                     // this output stands for.
                     tx = self.table_mix.tick((z, self.table_base(n0 + m - 1)));
@@ -219,7 +221,7 @@ impl<S: Sample> Board<S> {
                     if n != j {
                         break;
                     }
-                    let table = if K == RATE_TABLE {
+                    let table = if is_table(K) {
                         table_avg.mean_if_ended(i, frac, &tx)
                     } else {
                         [0.0; TABLE_CHANNELS]
@@ -245,7 +247,7 @@ impl<S: Sample> Board<S> {
                 }
             }
             push_average(&mut avg, &x);
-            if K == RATE_TABLE {
+            if is_table(K) {
                 push_average(&mut table_avg, &tx);
             }
         }
@@ -364,8 +366,13 @@ impl<S: Sample> Board<S> {
                     u[0] = nz[0].mul_add(self.noise.sigma_force[0], u[0]);
                     u[1] = nz[1].mul_add(self.noise.sigma_force[1], u[1]);
                 }
-                let mut p = if K == RATE_TABLE {
-                    let (_, sin_t) = self.table_nco.tick(());
+                let mut p = if is_table(K) {
+                    // The shared table is the cheaper in the loop; the lanes' only where
+                    // they differ.
+                    let sin_t = match &mut self.table_lanes {
+                        Some(t) if K == RATE_TABLE_LANES => t.tick(()).1,
+                        _ => S::splat(self.table_nco.tick(()).1),
+                    };
                     let rate = self.rate * sin_t;
                     if DECOUPLED {
                         self.plant.tick_with_rate_split(u, rate)
@@ -528,7 +535,7 @@ pub(crate) fn lane_result<const K: u8>(v: &[f64; 8], table: &[f64], n: usize) ->
             z: [ph(0), ph(2)],
             ..Default::default()
         },
-        RATE_TABLE => LaneResult {
+        RATE_TABLE | RATE_TABLE_LANES => LaneResult {
             table_z: table_harmonics_of(table, n),
             ..Default::default()
         },
