@@ -158,7 +158,7 @@ pub fn reproduce(
     });
     // Each experiment writes its results, its dump's figures and its own figure as soon as
     // its sweep is done (unless it has problems), while the longest one still runs.
-    let (swept, bandwidth_runs) = rayon::join(
+    let (swept, bandwidth_files) = rayon::join(
         || {
             let mut swept: Vec<(usize, Result<_, ReportError>)> = order
                 .par_iter()
@@ -203,7 +203,7 @@ pub fn reproduce(
     for s in swept {
         runs.push(s?);
     }
-    let bandwidth_files = bandwidth_runs?;
+    let bandwidth_files = bandwidth_files?;
     let point_samples: u64 = runs.iter().map(|(_, r, _)| r.point_samples).sum();
     let written = runs.iter().map(|(run, _, _)| run.written()).fold(
         Default::default(),
