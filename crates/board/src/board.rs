@@ -157,8 +157,6 @@ pub struct Board<S: Sample> {
     pub(crate) fs_hz: f64,
     /// Each lane's realised table frequency, Hz (lanes past the points repeat the last).
     pub(crate) table_f_hz: [f64; MAX_LANES],
-    /// Every lane follows the same table (its reference is computed once per output).
-    pub(crate) table_shared: bool,
     /// Phase-shifter error on the modulation's quadrature copy (rotating runs): (cos, sin).
     pub(crate) mod_shift: Option<(S, S)>,
     pub(crate) noise: NoiseState<S>,
@@ -285,7 +283,6 @@ impl<S: Sample> Board<S> {
             carrier: RotatingNco::new(&[carrier]),
             shifter: shifter(p)?,
             modulation: RotatingNco::new(&modulation),
-            table_shared,
             table_f_hz,
             table_nco: RotatingNco::new(&table[..1]),
             table_lanes: (!table_shared).then(|| RotatingNco::new(&table)),

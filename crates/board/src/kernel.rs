@@ -465,7 +465,7 @@ impl<S: Sample> Board<S> {
             #[inline(always)]
             || {
                 let at = |i: usize| table_reference(n, self.table_f_hz[i], self.fs_hz);
-                if self.table_shared {
+                if self.table_lanes.is_none() {
                     let b = at(0);
                     return (S::splat(b.re), S::splat(b.im));
                 }
