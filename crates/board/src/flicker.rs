@@ -54,12 +54,52 @@ pub(crate) struct FlickerSources<S: Sample> {
     carrier: Source<S>,
     /// The values of the block running now.
     pub(crate) block: BlockFlicker<S>,
+    /// The TIA sources' values over the block running now, or nothing (drawn per sample).
+    tia_block: Option<TiaBlock<S>>,
+}
+
+/// The TIA sources over one decimation block, drawn and run at the block's start: their
+/// Gaussians in one fill and the filters a block at a time ([`Flicker`]'s `process`, the
+/// bits of a tick per sample), instead of a generator call and a chain of dependent
+/// multiply-adds per sample.
+#[derive(Clone, Debug)]
+struct TiaBlock<S> {
+    /// Each four-lane stream set's next pairs (a, b): one per sample.
+    pairs: [Vec<f64x4>; 2],
+    /// Each source's Gaussians: source 0 takes the pair's first, source 1 its second.
+    w: [Vec<S>; 2],
+    /// Each source's output.
+    y: [Vec<S>; 2],
+    /// The next sample's index.
+    pos: usize,
+}
+
+impl<S: Sample> TiaBlock<S> {
+    fn new(len: usize) -> Self {
+        Self {
+            pairs: [vec![f64x4::ZERO; 2 * len], vec![f64x4::ZERO; 2 * len]],
+            w: [vec![S::splat(0.0); len], vec![S::splat(0.0); len]],
+            y: [vec![S::splat(0.0); len], vec![S::splat(0.0); len]],
+            pos: len,
+        }
+    }
 }
 
 impl<S: Sample> FlickerSources<S> {
     /// The sources `p` asks for, lane `i` on stream `streams[i]` (lanes past the end repeat
-    /// the last); `None` when there are none.
+    /// the last); `None` when there are none. The TIA's are drawn a decimation block at a time
+    /// (the same bits as [`FlickerSources::per_sample`]).
     pub(crate) fn new(p: &BoardParams, streams: &[u64]) -> ParamResult<Option<Self>> {
+        let mut f = Self::per_sample(p, streams)?;
+        if let Some(f) = f.as_mut().filter(|f| f.tia[0].is_some()) {
+            f.tia_block = Some(TiaBlock::new(p.decimation));
+        }
+        Ok(f)
+    }
+
+    /// [`FlickerSources::new`] with the TIA's sources drawn and run one sample at a time, as
+    /// the reference board does: what the block-wise draw is checked against.
+    pub(crate) fn per_sample(p: &BoardParams, streams: &[u64]) -> ParamResult<Option<Self>> {
         let Some(n) = p.noise.filter(has_flicker) else {
             return Ok(None);
         };
@@ -111,6 +151,7 @@ impl<S: Sample> FlickerSources<S> {
                 drive_rot: [one; 2],
                 carrier_rot: one,
             },
+            tia_block: None,
         }))
     }
 
@@ -136,6 +177,19 @@ impl<S: Sample> FlickerSources<S> {
             drive_rot: [rot(phi_c + phi[0]), rot(phi_c + phi[1])],
             carrier_rot: rot(phi_c),
         };
+        // Then the block's TIA values: per sample one pair from the same streams, after the
+        // slow sources' draws, as `tia_current` draws them one sample at a time.
+        if let (Some(b), [Some(f0), Some(f1)]) = (&mut self.tia_block, &mut self.tia) {
+            let rng = &mut self.rng;
+            // Compiled for the lane type's instructions (eight lanes: AVX-512), as the
+            // sample loop is.
+            S::with_target_features(|| {
+                rng.pairs_into(&mut b.pairs, &mut b.w);
+                f0.process(&b.w[0], &mut b.y[0]);
+                f1.process(&b.w[1], &mut b.y[1]);
+            });
+            b.pos = 0;
+        }
     }
 
     /// This sample's flicker of the TIA's input-referred current, per mode (A).
@@ -143,6 +197,12 @@ impl<S: Sample> FlickerSources<S> {
     pub(crate) fn tia_current(&mut self) -> [S; 2] {
         if self.tia[0].is_none() {
             return [S::splat(0.0); 2];
+        }
+        if let Some(b) = &mut self.tia_block {
+            // `next_block` ran this block's values; the kernel takes exactly a block of them.
+            let i = b.pos;
+            b.pos += 1;
+            return [b.y[0][i], b.y[1][i]];
         }
         let (w0, w1) = self.rng.pair::<S>();
         let mut out = [S::splat(0.0); 2];
@@ -185,6 +245,26 @@ impl LaneRng {
             S::load(&v)
         };
         (join(a0, a1), join(b0, b1))
+    }
+
+    /// `w[0][n], w[1][n]` = the n-th call of [`LaneRng::pair`] for every n of `w`'s length
+    /// (the same bits), drawn through `pairs` (each stream set's pairs) in one fill per set.
+    #[inline(always)]
+    fn pairs_into<S: Sample>(&mut self, pairs: &mut [Vec<f64x4>; 2], w: &mut [Vec<S>; 2]) {
+        let n = w[0].len();
+        let sets = if S::LANES <= 4 { 1 } else { 2 };
+        for (rng, p) in self.0.iter_mut().zip(pairs.iter_mut()).take(sets) {
+            rng.fill_pairs(&mut p[..2 * n]);
+        }
+        let mut v = [0.0; 8];
+        for k in 0..n {
+            for (c, wc) in w.iter_mut().enumerate() {
+                for (set, p) in pairs.iter().enumerate().take(sets) {
+                    v[4 * set..4 * set + 4].copy_from_slice(&p[2 * k + c].to_array());
+                }
+                wc[k] = S::load(&v[..S::LANES]);
+            }
+        }
     }
 }
 

@@ -61,7 +61,7 @@ pub fn run_reference(
     let seed = p.noise.map_or(0, |n| n.seed);
     let mut rng = NoiseRng::new([stream_seed(seed, stream); 4]);
     let (sigma_force, sigma_current) = noise_sigmas(p);
-    let mut flicker = FlickerSources::<f64>::new(p, &[stream])?;
+    let mut flicker = FlickerSources::<f64>::per_sample(p, &[stream])?;
     let eps = p.phase_shifter_error_deg.to_radians();
     let (ce, se) = (eps.cos(), eps.sin());
     let n_out = n_settle + point.window.samples();

@@ -1,5 +1,5 @@
 //! The flicker source as a stage and as a seeded generator: the stage contract (blocks, reset,
-//! lanes bit for bit), lanes of a stationary f64x4 source equal to scalar sources on their
+//! lanes bit for bit; blocks for every pole count), lanes of a stationary f64x4 source equal to scalar sources on their
 //! own streams, same seed same bits, and a start drawn from the stationary law (the variance
 //! of the first sample and of a long first average against their exact values).
 
@@ -76,6 +76,29 @@ fn stage_contract_blocks_reset_and_lanes() {
             |y, l| y.lane(l),
             check::same,
         );
+    }
+}
+
+#[test]
+fn blocks_are_ticks_for_every_pole_count() {
+    // `process` runs the poles four at a time and the rest one by one: spans of 2 to 12
+    // decades give 4 to 24 poles, every remainder modulo four, each checked on blocks of
+    // every size of the contract against `tick`, in one lane and in four.
+    let mut counts = Vec::new();
+    let mut g = Gauss::new([5, 6, 7, 8]);
+    for tenth in (20..=120).step_by(5) {
+        let p = FlickerParams {
+            f_lo_hz: 0.5 * 10f64.powf(-(tenth as f64) / 10.0),
+            ..params()
+        };
+        let scalar = Flicker::<f64>::stationary(&p, || g.next().to_array()[0]).unwrap();
+        let lanes = Flicker::<f64x4>::stationary(&p, || g.next()).unwrap();
+        counts.push(scalar.design().poles());
+        check::tick_vs_process("flicker", &scalar, gaussian::<f64>, check::same);
+        check::tick_vs_process("flicker x4", &lanes, gaussian::<f64x4>, check::same);
+    }
+    for r in 0..4 {
+        assert!(counts.iter().any(|&n| n % 4 == r && n > 4), "{counts:?}");
     }
 }
 
