@@ -298,7 +298,7 @@ fn inspect_refuses_missing_or_damaged_dumps_with_exit_2() {
     assert_eq!(pngs, 0);
 }
 
-/// `bench` measures the whole chain, noiseless and with noise, in the lanes a run uses here and
+/// `bench` measures the whole chain, noiseless, with noise and with flicker too, in the lanes a run uses here and
 /// in each lane type the CPU runs, and every stage, on 1 and on all threads (the figures are
 /// timing, so only their presence and sign are checked), and refuses zero repeats.
 #[test]
@@ -326,6 +326,7 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
     let mut names = vec![
         "whole chain".to_string(),
         "whole chain with noise".to_string(),
+        "whole chain with noise and flicker".to_string(),
         "resonator (decoupled step)".to_string(),
         "low-pass bank (I1, Q1, I2, Q2)".to_string(),
         "tia".to_string(),
@@ -333,6 +334,7 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
     for t in ["f64x4", "f64x8"].iter().take(if eight { 2 } else { 1 }) {
         names.push(format!("whole chain ({t})"));
         names.push(format!("whole chain with noise ({t})"));
+        names.push(format!("whole chain with noise and flicker ({t})"));
     }
     let figures = |name: &str, threads: &str| -> Vec<f64> {
         let row = text
@@ -358,7 +360,11 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
             assert!(v[0] > 0.0 && v[1] >= v[0], "{name}: {v:?}");
         }
     }
-    for label in ["whole chain", "whole chain with noise"] {
+    for label in [
+        "whole chain",
+        "whole chain with noise",
+        "whole chain with noise and flicker",
+    ] {
         let typed = format!("{label} ({native})");
         assert_eq!(figures(label, "1"), figures(&typed, "1"), "{label}");
     }

@@ -72,6 +72,21 @@ pub fn with_noise(cfg: &Config) -> Config {
     c
 }
 
+/// [`with_noise`] plus every flicker source at the levels of the `m2tfg-selfcal` preset (the
+/// TIA voltage noise's 1 kHz corner, 1e-5 per sqrt(Hz) at 1 Hz on each drive's amplitude and
+/// phase and on the carrier's phase; the low corner by the config's rule): the chain a
+/// self-calibration study runs.
+pub fn with_flicker(cfg: &Config) -> Config {
+    let mut c = with_noise(cfg);
+    if let Some(n) = c.noise.as_mut() {
+        n.tia_voltage_flicker_corner_hz = 1000.0;
+        n.drive_amplitude_flicker_per_rthz = 1e-5;
+        n.drive_phase_flicker_rad_per_rthz = 1e-5;
+        n.carrier_phase_flicker_rad_per_rthz = 1e-5;
+    }
+    c
+}
+
 /// Runs `groups` lane groups of `n_in` input samples each, spread over the rayon pool, in the
 /// lanes this CPU runs ([`max_lanes`]); returns point-samples per second.
 pub fn chain(cfg: &Config, n_in: u64, groups: usize) -> f64 {
@@ -154,9 +169,10 @@ impl Stage for DecoupledPlant {
 }
 
 /// Every figure, each the best and the median of `repeats` runs, on 1 thread and on all
-/// threads: the chain, noiseless and with noise, in the lanes this CPU runs (rows `whole
-/// chain`, `whole chain with noise`), then in each lane type it can run (the same rows with
-/// `(f64x4)` or `(f64x8)`), then each stage.
+/// threads: the chain, noiseless, with noise and with noise and flicker, in the lanes this CPU
+/// runs (rows `whole chain`, `whole chain with noise`, `whole chain with noise and flicker`),
+/// then in each lane type it can run (the same rows with `(f64x4)` or `(f64x8)`), then each
+/// stage.
 pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     use gyroemu_am::{AmInput, AmModulator, DrivePattern};
     use gyroemu_lpf::{LowPass, LowPassBank, LowPassDesign};
@@ -177,6 +193,7 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     // The chain in every lane type this CPU runs; the rows without a lane type repeat the
     // figures of the type a run uses here ([`max_lanes`]).
     let noisy = with_noise(cfg);
+    let flickering = with_flicker(cfg);
     let native = max_lanes();
     let mut widths = vec![4];
     if native == 8 {
@@ -184,7 +201,11 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     }
     let mut typed = Vec::new();
     for &w in &widths {
-        for (label, c) in [("whole chain", cfg), ("whole chain with noise", &noisy)] {
+        for (label, c) in [
+            ("whole chain", cfg),
+            ("whole chain with noise", &noisy),
+            ("whole chain with noise and flicker", &flickering),
+        ] {
             let name = format!("{label} ({})", lane_type(w));
             typed.push(row(&name, 1, &mut || chain_in(w, c, n_in, 1)));
             if threads > 1 {
