@@ -45,31 +45,6 @@ impl F64x8 {
         Self(unsafe { core::mem::transmute::<[f64; 8], __m512d>(a) })
     }
 
-    /// The lanes where `self` is a NaN.
-    #[inline(always)]
-    fn nan_mask(self) -> __mmask8 {
-        unsafe { _mm512_cmp_pd_mask::<_CMP_UNORD_Q>(self.0, self.0) }
-    }
-
-    /// `wide`'s f64x4 `max`: `vmaxpd` (which returns `rhs` when either is a NaN), but `self`
-    /// where `rhs` is a NaN.
-    #[inline(always)]
-    fn max(self, rhs: Self) -> Self {
-        unsafe {
-            let m = _mm512_max_pd(self.0, rhs.0);
-            Self(_mm512_mask_blend_pd(rhs.nan_mask(), m, self.0))
-        }
-    }
-
-    /// `wide`'s f64x4 `min`, as [`F64x8::max`].
-    #[inline(always)]
-    fn min(self, rhs: Self) -> Self {
-        unsafe {
-            let m = _mm512_min_pd(self.0, rhs.0);
-            Self(_mm512_mask_blend_pd(rhs.nan_mask(), m, self.0))
-        }
-    }
-
     #[inline(always)]
     fn bits_and(self, rhs: Self) -> Self {
         unsafe {
@@ -178,7 +153,8 @@ impl Sample for F64x8 {
     }
     #[inline(always)]
     fn clamp_to(self, lo: Self, hi: Self) -> Self {
-        self.max(lo).min(hi)
+        // As f64x4's: `vmaxpd(lo, x)` then `vminpd(hi, .)`, the operand order f64's rule needs.
+        unsafe { Self(_mm512_min_pd(hi.0, _mm512_max_pd(lo.0, self.0))) }
     }
     #[inline(always)]
     fn round_away(self) -> Self {

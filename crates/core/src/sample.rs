@@ -145,7 +145,12 @@ impl Sample for f64x4 {
     }
     #[inline(always)]
     fn clamp_to(self, lo: Self, hi: Self) -> Self {
-        self.max(lo).min(hi)
+        // f64's rule in two instructions: `vmaxpd a, b` returns `a` only where a > b, else `b`
+        // (also where either is a NaN), so `max(lo, x)` keeps x unless x < lo and
+        // `min(hi, .)` keeps that unless it is > hi: a NaN passes through and a tie keeps x
+        // (its sign of zero), as in f64. `wide`'s NaN-aware max and min cost a compare and a
+        // blend each and turned a NaN input into `lo`.
+        hi.fast_min(lo.fast_max(self))
     }
     #[inline(always)]
     fn round_away(self) -> Self {
@@ -212,6 +217,33 @@ mod tests {
         for i in 0..4 {
             assert_eq!(r.lane(i), xs[i].round());
             assert_eq!(c.lane(i), xs[i].clamp_to(-1.0, 1.0));
+        }
+        // Clamping by the scalar rule bit for bit: a NaN passes, a tie keeps the input's
+        // sign of zero, infinities clip, the bounds themselves stay.
+        let specials = [
+            f64::NAN,
+            -0.0,
+            0.0,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            -1.0,
+            1.0,
+            5e-324,
+        ];
+        for (lo, hi) in [
+            (-1.0, 1.0),
+            (0.0, 0.0),
+            (-0.0, 0.0),
+            (0.0, 2.0),
+            (-3.0, -0.0),
+        ] {
+            for q in specials.chunks(4) {
+                let c = f64x4::load(q).clamp_to(f64x4::splat(lo), f64x4::splat(hi));
+                for (i, &x) in q.iter().enumerate() {
+                    let want = x.clamp_to(lo, hi);
+                    assert_eq!(c.lane(i).to_bits(), want.to_bits(), "{x} in [{lo}, {hi}]");
+                }
+            }
         }
         assert!(!f64x4::from_fn(|i| if i == 2 { f64::NAN } else { 0.0 }).all_finite());
     }
