@@ -14,7 +14,7 @@ use gyroemu_lpf::Window;
 use gyroemu_mixer::wrap_pi;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::sync::atomic::AtomicU64;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Noise streams of the analyses start here, apart from the sweep points' streams (0..).
 pub const ANALYSIS_STREAM_BASE: u64 = 1 << 32;
@@ -347,13 +347,15 @@ pub fn drift_analysis(
     let tracked_too = design.validate().is_ok();
     let (held, _) = resolve_lock(cfg)?;
     let n = deltas_k.len() as u64;
-    let mut out = Vec::new();
-    for (i, &dt) in deltas_k.iter().enumerate() {
+    // Progress in thousandths of each offset (two self-calibrations of two sweeps), summed
+    // over the offsets, which run side by side.
+    let parts: Vec<AtomicU64> = deltas_k.iter().map(|_| AtomicU64::new(0)).collect();
+    let one = |(i, &dt): (usize, &f64)| -> Result<DriftPoint, SweepError> {
         let open = drifted(&held, dt);
-        // Progress in thousandths: each offset is two self-calibrations of two sweeps.
         let at = |quarter: u64, d: u64, t: u64| {
+            parts[i].store(quarter * 250 + d * 250 / t.max(1), Ordering::Relaxed);
             progress(
-                i as u64 * 1000 + quarter * 250 + d * 250 / t.max(1),
+                parts.iter().map(|p| p.load(Ordering::Relaxed)).sum(),
                 n * 1000,
             )
         };
@@ -378,14 +380,17 @@ pub fn drift_analysis(
         } else {
             (None, None)
         };
-        out.push(DriftPoint {
+        Ok(DriftPoint {
             delta_t_k: dt,
             f0_hz: open.device.f0_hz,
             q: open.device.q,
             open_loop,
             pll,
             pll_lock_time_s,
-        });
-    }
-    Ok(out)
+        })
+    };
+    // Each offset's sweeps are lane groups of a few seconds: run side by side they fill the
+    // threads the longer analyses leave ([`crate::selfcal_run`]). Results keep the offsets'
+    // order and bits (a point's bits do not depend on its group or thread).
+    deltas_k.par_iter().enumerate().map(one).collect()
 }

@@ -41,18 +41,21 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
     let core = SelfcalCore::from_sweeps(&held, rotating, coriolis);
     let m = core.modes[0];
     let sc = cfg.selfcal.clone().unwrap_or_default();
-    let allan = match sc.allan_record_s {
+    // The analyses run side by side in one pool: the averaging-time run's two long lane
+    // groups, the Allan record's one group and the drift scenario's many short sweeps, so no
+    // thread waits for another analysis to end (each result has the bits it has alone).
+    let allan = || match sc.allan_record_s {
         Some(t) => {
             let p = reporter.task("allan record");
             let a = allan_analysis(&held, t, m.coriolis.slope_deg_per_dps, &|d, n| {
                 p.update(d, n)
             })?;
             p.finish(None);
-            Some(a)
+            Ok(Some(a))
         }
-        None => None,
+        None => Ok(None),
     };
-    let taus = match sc.tau_max_s {
+    let taus = || match sc.tau_max_s {
         Some(t) => {
             let p = reporter.task("averaging-time run");
             let r = tau_analysis(
@@ -64,13 +67,14 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
                 &|d, n| p.update(d, n),
             )?;
             p.finish(None);
-            Some(r)
+            Ok(Some(r))
         }
-        None => None,
+        None => Ok(None),
     };
-    let drift = if sc.drift_delta_t_k.is_empty() {
-        None
-    } else {
+    let drift = || {
+        if sc.drift_delta_t_k.is_empty() {
+            return Ok(None);
+        }
         let p = reporter.task("drift scenario");
         let d = drift_analysis(
             cfg,
@@ -79,8 +83,14 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
             &|d, n| p.update(d, n),
         )?;
         p.finish(None);
-        Some(d)
+        Ok(Some(d))
     };
+    type Done<T> = Result<Option<T>, SweepError>;
+    let (taus, (allan, drift)): (
+        Done<Vec<TauPoint>>,
+        (Done<AllanResult>, Done<Vec<DriftPoint>>),
+    ) = rayon::join(taus, || rayon::join(allan, drift));
+    let (allan, taus, drift) = (allan?, taus?, drift?);
     Ok(SelfcalReport {
         core,
         allan,
