@@ -27,7 +27,7 @@ fn ideal_noiseless_selfcal_error_is_below_1e_4_for_lambda_1_and_0_6() {
         let mut c = fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2);
         c.device.angular_gain = lambda;
         validate_selfcal(&c).unwrap();
-        let r = run_selfcal_core(&c, &quiet, &quiet).unwrap();
+        let r = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
         for m in r.modes {
             assert!(
                 m.relative_error.abs() < 1e-4,
@@ -51,11 +51,11 @@ fn drift_selfcal_tracks_the_scale_factor_and_a_stale_one_misses_by_the_q_over_f0
         q_tc_ppm_per_k: -3000.0,
         ..Default::default()
     });
-    let nominal = run_selfcal_core(&c, &quiet, &quiet).unwrap().modes[0]
+    let nominal = run_selfcal_core(&c, &quiet, &quiet, None).unwrap().modes[0]
         .coriolis
         .slope_deg_per_dps;
     let deltas = [-30.0, 40.0];
-    let d = drift_analysis(&c, &deltas, nominal, &quiet).unwrap();
+    let d = drift_analysis(&c, &deltas, nominal, None, &quiet).unwrap();
     for (p, dt) in d.iter().zip(deltas) {
         // PLL-tracked: the carrier sits on the drifted resonance.
         let pll = p.pll.as_ref().expect("the default loop fits this board");
@@ -99,17 +99,25 @@ fn drift_selfcal_tracks_the_scale_factor_and_a_stale_one_misses_by_the_q_over_f0
 #[test]
 fn averaging_time_reading_at_the_sweep_time_equals_the_sweep() {
     let c = fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2);
-    let core = run_selfcal_core(&c, &quiet, &quiet).unwrap();
+    let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
     let m = core.modes[0];
-    let t = tau_analysis(
-        &c,
-        14.4,
-        m.coriolis.slope_deg_per_dps,
-        m.theory_coriolis_deg_per_dps,
-        core.combined.coriolis.slope_deg_per_dps,
-        &quiet,
-    )
-    .unwrap();
+    let taus = |group_threads| {
+        tau_analysis(
+            &c,
+            14.4,
+            m.coriolis.slope_deg_per_dps,
+            m.theory_coriolis_deg_per_dps,
+            core.combined.coriolis.slope_deg_per_dps,
+            group_threads,
+            &quiet,
+        )
+        .unwrap()
+    };
+    let t = taus(None);
+    // Lane groups sized for one thread (selfcal runs its analyses side by side) give the
+    // same readings, bit for bit, and so do the sweeps.
+    assert_eq!(t, taus(Some(1)));
+    assert_eq!(core, run_selfcal_core(&c, &quiet, &quiet, Some(1)).unwrap());
     let at = t
         .iter()
         .find(|p| p.tau_s == 7.2)
@@ -144,7 +152,7 @@ fn noisy_selfcal_errors_scatter_as_their_reported_confidence() {
             tia_voltage_noise_v_per_rthz: 0.0,
             ..Default::default()
         });
-        let core = run_selfcal_core(&c, &quiet, &quiet).unwrap();
+        let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
         let comb = core.combined;
         comb_errs.push(comb.relative_error);
         comb_reported.push(comb.rotating.rel_std_err.hypot(comb.coriolis.rel_std_err));
@@ -180,7 +188,7 @@ fn noisy_selfcal_errors_scatter_as_their_reported_confidence() {
         tia_voltage_noise_v_per_rthz: 0.0,
         ..Default::default()
     });
-    let again = run_selfcal_core(&c, &quiet, &quiet).unwrap().modes[0].relative_error;
+    let again = run_selfcal_core(&c, &quiet, &quiet, None).unwrap().modes[0].relative_error;
     assert_eq!(again.to_bits(), errs[0].to_bits());
 }
 

@@ -81,7 +81,7 @@ fn drive_gain_and_q_mismatch_errors_are_equal_and_opposite_and_the_combination_c
     // (F2/F1, Q2/Q1): the F2/F1 = 1.2 on an ideal device, and both together.
     for (r, qr) in [(1.2, 1.0), (0.8, 1.25)] {
         let c = short(gain_and_q(r, qr));
-        let core = run_selfcal_core(&c, &quiet, &quiet).unwrap();
+        let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
         // Closed forms: rotating slope 2 Q_k / w0, Coriolis slope 2 lambda Q_other r^{+-1} / w0.
         let expected = [1.0 / (r * qr) - 1.0, r * qr - 1.0];
         for (k, (m, x)) in core.modes.iter().zip(expected).enumerate() {
@@ -118,7 +118,7 @@ fn combined_error_on_an_imperfect_device_is_the_exact_theory_of_the_same_estimat
     worse.board.phase_shifter_error_deg = 0.5;
     worse.drive.f2 = Some(0.9);
     for c in [short(preset("m2tfg-selfcal").unwrap()), short(worse)] {
-        let core = run_selfcal_core(&c, &quiet, &quiet).unwrap();
+        let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
         let (per_mode, combined) = theory_errors(&c, &RATES);
         let got = core.combined.relative_error;
         // The emulated phases sit within micro-degrees of the continuous theory (hold, TIA and

@@ -6,7 +6,9 @@
 use crate::selfcal_combined::{combined_selfcal, CombinedSelfcal};
 use gyroemu_config::{Config, ConfigError, ExperimentKind, RateTable};
 use gyroemu_experiment::fit::{fit_line, t95, LineFit};
-use gyroemu_experiment::{run_sweep, Progress, SweepError, SweepResult};
+use gyroemu_experiment::{
+    finish_sweep, run_sweep_with, Progress, SweepError, SweepOptions, SweepResult,
+};
 use serde::Serialize;
 
 /// A scale factor read from a sweep: the small-angle slope of the phase against the rate,
@@ -239,15 +241,24 @@ pub struct SelfcalCore {
     pub coriolis: SweepResult,
 }
 
-/// Runs the rotating sweep and the rate-table sweep of `cfg` and compares them.
+/// Runs the rotating sweep and the rate-table sweep of `cfg` and compares them, their lane
+/// groups sized for `group_threads` ([`SweepOptions::group_threads`]).
 pub fn run_selfcal_core(
     cfg: &Config,
     rot_progress: Progress,
     cor_progress: Progress,
+    group_threads: Option<usize>,
 ) -> Result<SelfcalCore, SweepError> {
     let (rot_cfg, cor_cfg) = sweep_configs(cfg);
-    let rotating = run_sweep(&rot_cfg, rot_progress, None)?;
-    let coriolis = run_sweep(&cor_cfg, cor_progress, None)?;
+    let sweep = |c: &Config, progress: Progress| {
+        let opts = SweepOptions {
+            group_threads,
+            ..Default::default()
+        };
+        finish_sweep(c, &run_sweep_with(c, progress, None, opts)?.lanes)
+    };
+    let rotating = sweep(&rot_cfg, rot_progress)?;
+    let coriolis = sweep(&cor_cfg, cor_progress)?;
     Ok(SelfcalCore::from_sweeps(cfg, rotating, coriolis))
 }
 

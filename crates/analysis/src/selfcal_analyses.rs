@@ -168,6 +168,7 @@ pub fn tau_analysis(
     measured_deg_per_dps: f64,
     theory_deg_per_dps: f64,
     combined_measured_deg_per_dps: f64,
+    group_threads: Option<usize>,
     progress: Progress,
 ) -> Result<Vec<TauPoint>, SweepError> {
     let (mut rot, _) = sweep_configs(cfg);
@@ -206,7 +207,8 @@ pub fn tau_analysis(
     let n_settle = rot.n_settle_out();
     let mut groups: Vec<(usize, &[Point])> = Vec::new();
     let mut first = 0;
-    for size in lane_groups(points.len(), rayon::current_num_threads(), max_lanes()) {
+    let threads = group_threads.unwrap_or_else(rayon::current_num_threads);
+    for size in lane_groups(points.len(), threads, max_lanes()) {
         groups.push((first, &points[first..first + size]));
         first += size;
     }
@@ -341,6 +343,7 @@ pub fn drift_analysis(
     cfg: &Config,
     deltas_k: &[f64],
     nominal_deg_per_dps: f64,
+    group_threads: Option<usize>,
     progress: Progress,
 ) -> Result<Vec<DriftPoint>, SweepError> {
     let design = drift_pll_design(cfg);
@@ -360,7 +363,12 @@ pub fn drift_analysis(
             )
         };
         let case = |c: &Config, q0: u64| -> Result<DriftCase, SweepError> {
-            let core = run_selfcal_core(c, &|d, t| at(q0, d, t), &|d, t| at(q0 + 1, d, t))?;
+            let core = run_selfcal_core(
+                c,
+                &|d, t| at(q0, d, t),
+                &|d, t| at(q0 + 1, d, t),
+                group_threads,
+            )?;
             let m = core.modes[0];
             Ok(DriftCase {
                 carrier_hz: c.carrier_hz(),

@@ -25,6 +25,9 @@ pub struct SelfcalReport {
     pub lock: Option<CarrierLock>,
 }
 
+/// What one analysis gives: its result, or `None` when the config does not ask for it.
+type Done<T> = Result<Option<T>, SweepError>;
+
 /// Runs the rotating sweep and the rate-table sweep of `cfg` (validated, e.g. by
 /// `validate_selfcal`), compares them, then runs each analysis the config asks for.
 pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalReport, SweepError> {
@@ -43,35 +46,39 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
     let sc = cfg.selfcal.clone().unwrap_or_default();
     // The analyses run side by side in one pool: the averaging-time run's two long lane
     // groups, the Allan record's one group and the drift scenario's many short sweeps, so no
-    // thread waits for another analysis to end (each result has the bits it has alone).
-    let allan = || match sc.allan_record_s {
-        Some(t) => {
-            let p = reporter.task("allan record");
-            let a = allan_analysis(&held, t, m.coriolis.slope_deg_per_dps, &|d, n| {
-                p.update(d, n)
-            })?;
-            p.finish(None);
-            Ok(Some(a))
-        }
-        None => Ok(None),
+    // thread waits for another analysis to end (each result has the bits it has alone). Their
+    // lane groups are sized for a third of the threads each (reproduce does the same for its
+    // experiments): as wide as the CPU runs, the most points per CPU-second.
+    let share = Some((rayon::current_num_threads() / 3).max(1));
+    let allan = || -> Done<AllanResult> {
+        let Some(t) = sc.allan_record_s else {
+            return Ok(None);
+        };
+        let p = reporter.task("allan record");
+        let a = allan_analysis(&held, t, m.coriolis.slope_deg_per_dps, &|d, n| {
+            p.update(d, n)
+        })?;
+        p.finish(None);
+        Ok(Some(a))
     };
-    let taus = || match sc.tau_max_s {
-        Some(t) => {
-            let p = reporter.task("averaging-time run");
-            let r = tau_analysis(
-                &held,
-                t,
-                m.coriolis.slope_deg_per_dps,
-                m.theory_coriolis_deg_per_dps,
-                core.combined.coriolis.slope_deg_per_dps,
-                &|d, n| p.update(d, n),
-            )?;
-            p.finish(None);
-            Ok(Some(r))
-        }
-        None => Ok(None),
+    let taus = || -> Done<Vec<TauPoint>> {
+        let Some(t) = sc.tau_max_s else {
+            return Ok(None);
+        };
+        let p = reporter.task("averaging-time run");
+        let r = tau_analysis(
+            &held,
+            t,
+            m.coriolis.slope_deg_per_dps,
+            m.theory_coriolis_deg_per_dps,
+            core.combined.coriolis.slope_deg_per_dps,
+            share,
+            &|d, n| p.update(d, n),
+        )?;
+        p.finish(None);
+        Ok(Some(r))
     };
-    let drift = || {
+    let drift = || -> Done<Vec<DriftPoint>> {
         if sc.drift_delta_t_k.is_empty() {
             return Ok(None);
         }
@@ -80,16 +87,13 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
             cfg,
             &sc.drift_delta_t_k,
             m.coriolis.slope_deg_per_dps,
+            share,
             &|d, n| p.update(d, n),
         )?;
         p.finish(None);
         Ok(Some(d))
     };
-    type Done<T> = Result<Option<T>, SweepError>;
-    let (taus, (allan, drift)): (
-        Done<Vec<TauPoint>>,
-        (Done<AllanResult>, Done<Vec<DriftPoint>>),
-    ) = rayon::join(taus, || rayon::join(allan, drift));
+    let (taus, (allan, drift)) = rayon::join(taus, || rayon::join(allan, drift));
     let (allan, taus, drift) = (allan?, taus?, drift?);
     Ok(SelfcalReport {
         core,
