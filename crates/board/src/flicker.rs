@@ -58,8 +58,9 @@ pub(crate) struct FlickerSources<S: Sample> {
     tia_block: Option<TiaBlock<S>>,
 }
 
-/// The TIA sources over one decimation block, drawn and run at the block's start: their
-/// Gaussians in one fill and the filters a block at a time ([`Flicker`]'s `process`, the
+/// The TIA sources drawn and run ahead, up to [`TIA_CHUNK`] samples at a time and never past
+/// the decimation block (the slow sources draw from the same streams at each block's start):
+/// their Gaussians in one fill and the filters over the chunk ([`Flicker`]'s `process`, the
 /// bits of a tick per sample), instead of a generator call and a chain of dependent
 /// multiply-adds per sample.
 #[derive(Clone, Debug)]
@@ -70,18 +71,52 @@ struct TiaBlock<S> {
     w: [Vec<S>; 2],
     /// Each source's output.
     y: [Vec<S>; 2],
-    /// The next sample's index.
+    /// The next sample's index in the chunk, and the chunk's length.
     pos: usize,
+    len: usize,
+    /// The decimation block's length, and how many of its samples are not yet drawn.
+    block: usize,
+    left: usize,
 }
 
+/// Samples of TIA flicker drawn at a time: the buffers stay a few tens of kB whatever the
+/// decimation (a chunk as long as a block of 10^6 samples would take hundreds of MB).
+const TIA_CHUNK: usize = 256;
+
 impl<S: Sample> TiaBlock<S> {
-    fn new(len: usize) -> Self {
+    fn new(block: usize) -> Self {
+        let cap = block.min(TIA_CHUNK);
         Self {
-            pairs: [vec![f64x4::ZERO; 2 * len], vec![f64x4::ZERO; 2 * len]],
-            w: [vec![S::splat(0.0); len], vec![S::splat(0.0); len]],
-            y: [vec![S::splat(0.0); len], vec![S::splat(0.0); len]],
-            pos: len,
+            pairs: [vec![f64x4::ZERO; 2 * cap], vec![f64x4::ZERO; 2 * cap]],
+            w: [vec![S::splat(0.0); cap], vec![S::splat(0.0); cap]],
+            y: [vec![S::splat(0.0); cap], vec![S::splat(0.0); cap]],
+            pos: 0,
+            len: 0,
+            block,
+            left: 0,
         }
+    }
+
+    /// Draws and runs the next chunk of the block (at most what is left of it).
+    #[inline(never)]
+    fn refill(&mut self, rng: &mut LaneRng, f: [&mut Flicker<S>; 2]) {
+        let n = self.left.min(self.w[0].len());
+        assert!(
+            n > 0,
+            "the kernel takes one decimation block per next_block"
+        );
+        let [f0, f1] = f;
+        let (pairs, w, y) = (&mut self.pairs, &mut self.w, &mut self.y);
+        // Compiled for the lane type's instructions (eight lanes: AVX-512), as the sample
+        // loop is.
+        S::with_target_features(|| {
+            rng.pairs_into(n, pairs, w);
+            f0.process(&w[0][..n], &mut y[0][..n]);
+            f1.process(&w[1][..n], &mut y[1][..n]);
+        });
+        self.pos = 0;
+        self.len = n;
+        self.left -= n;
     }
 }
 
@@ -177,18 +212,11 @@ impl<S: Sample> FlickerSources<S> {
             drive_rot: [rot(phi_c + phi[0]), rot(phi_c + phi[1])],
             carrier_rot: rot(phi_c),
         };
-        // Then the block's TIA values: per sample one pair from the same streams, after the
-        // slow sources' draws, as `tia_current` draws them one sample at a time.
+        // Then the block's first TIA values: per sample one pair from the same streams,
+        // after the slow sources' draws, as `tia_current` draws them one sample at a time.
         if let (Some(b), [Some(f0), Some(f1)]) = (&mut self.tia_block, &mut self.tia) {
-            let rng = &mut self.rng;
-            // Compiled for the lane type's instructions (eight lanes: AVX-512), as the
-            // sample loop is.
-            S::with_target_features(|| {
-                rng.pairs_into(&mut b.pairs, &mut b.w);
-                f0.process(&b.w[0], &mut b.y[0]);
-                f1.process(&b.w[1], &mut b.y[1]);
-            });
-            b.pos = 0;
+            b.left = b.block;
+            b.refill(&mut self.rng, [f0, f1]);
         }
     }
 
@@ -198,8 +226,11 @@ impl<S: Sample> FlickerSources<S> {
         if self.tia[0].is_none() {
             return [S::splat(0.0); 2];
         }
-        if let Some(b) = &mut self.tia_block {
-            // `next_block` ran this block's values; the kernel takes exactly a block of them.
+        if let (Some(b), [Some(f0), Some(f1)]) = (&mut self.tia_block, &mut self.tia) {
+            // `next_block` ran the block's first chunk; the kernel takes exactly a block.
+            if b.pos == b.len {
+                b.refill(&mut self.rng, [f0, f1]);
+            }
             let i = b.pos;
             b.pos += 1;
             return [b.y[0][i], b.y[1][i]];
@@ -247,11 +278,15 @@ impl LaneRng {
         (join(a0, a1), join(b0, b1))
     }
 
-    /// `w[0][n], w[1][n]` = the n-th call of [`LaneRng::pair`] for every n of `w`'s length
-    /// (the same bits), drawn through `pairs` (each stream set's pairs) in one fill per set.
+    /// `w[0][k], w[1][k]` = the k-th call of [`LaneRng::pair`] for every k < `n` (the same
+    /// bits), drawn through `pairs` (each stream set's pairs) in one fill per set.
     #[inline(always)]
-    fn pairs_into<S: Sample>(&mut self, pairs: &mut [Vec<f64x4>; 2], w: &mut [Vec<S>; 2]) {
-        let n = w[0].len();
+    fn pairs_into<S: Sample>(
+        &mut self,
+        n: usize,
+        pairs: &mut [Vec<f64x4>; 2],
+        w: &mut [Vec<S>; 2],
+    ) {
         let sets = if S::LANES <= 4 { 1 } else { 2 };
         for (rng, p) in self.0.iter_mut().zip(pairs.iter_mut()).take(sets) {
             rng.fill_pairs(&mut p[..2 * n]);

@@ -1,7 +1,7 @@
 //! The fused kernel against the reference board (every stage through its own `Stage::tick`,
 //! none of the kernel's shortcuts), bit for bit: every experiment shape, with and without
-//! noise and converters, an imperfect device, decimation 1 and 100, each lane of a group, in
-//! groups of four lanes and (on a CPU with AVX-512) of eight.
+//! noise, flicker and converters, an imperfect device, decimation 1, 100, 256 and 600, each
+//! lane of a group, in groups of four lanes and (on a CPU with AVX-512) of eight.
 
 mod common;
 
@@ -115,6 +115,41 @@ fn fused_equals_reference_without_decimation_and_at_rest() {
             point(120.0, 1990),
         ];
         check(&format!("{shape:?} M = 1 noisy"), &noisy(p, 3), &pts, 500);
+        check(
+            &format!("{shape:?} M = 1 flicker"),
+            &flickering(p, 4),
+            &pts,
+            500,
+        );
+    }
+}
+
+#[test]
+fn fused_equals_reference_with_flicker_over_long_blocks() {
+    // The TIA's flicker is drawn ahead at most 256 samples at a time and never past a
+    // decimation block: M = 600 takes chunks of 256, 256 and 88, M = 256 one whole chunk.
+    for m in [600, 256] {
+        for shape in SHAPES {
+            let mut p = m2tfg(shape);
+            p.decimation = m;
+            p.lowpass = gyroemu_lpf::LowPassDesign::Butterworth {
+                order: 2,
+                cutoff_hz: 60.0,
+            };
+            let pts = [
+                point(25.0, 12),
+                point(-100.0, 9),
+                point(60.0, 11),
+                point(175.0, 10),
+                point(0.0, 12),
+            ];
+            check(
+                &format!("{shape:?} M = {m} flicker"),
+                &flickering(p, 6),
+                &pts,
+                6,
+            );
+        }
     }
 }
 
