@@ -53,8 +53,7 @@ fn board() -> impl Strategy<Value = BoardDraw> {
         proptest::option::of(0.1f64..0.95),
         1e3f64..1e7,
         any::<bool>(),
-        // Converters fine enough for the drive ratio and signal levels drawn (coarser ones
-        // would put out all-zero channels, which validation refuses).
+        // Converter bits, raised where the levels drawn need more (`build`).
         proptest::option::of(6u32..=32),
         proptest::option::of(6u32..=32),
         -10.0f64..10.0,
@@ -98,14 +97,19 @@ fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
     c.board.tia_pole_hz = pole.map(|p| p * 0.5 * c.fs_hz());
     c.board.tia_gain_ohm = gain;
     c.board.tia_inverting = inverting;
-    c.board.dac_bits = dac;
+    // Converters at least fine enough for the drawn ratio of the two channels' levels (with
+    // four bits to spare): coarser ones would put out an all-zero channel, which validation
+    // refuses, so such a draw is not a valid config.
+    let bits_for = |ratio: f64| (ratio.log2().ceil() as u32 + 4).min(32);
+    c.board.dac_bits = dac.map(|b| b.max(bits_for(1.5 * f1.max(f2) / f1.min(f2))));
     c.board.dac_full_scale = 1.5 * f1.max(f2);
-    c.board.adc_bits = adc;
     // The ADC's full scale at twice the TIA output at resonance (the larger mode).
     let amp = |f: f64, w: f64, q: f64| f * q / w * c.device.transduction_a_s_per_m * gain;
     let q2v = q2.unwrap_or(q);
     let w2 = std::f64::consts::TAU * c.f0_mode2_hz();
-    c.board.adc_full_scale_v = 2.0 * amp(f1, w0, q).max(amp(f2, w2, q2v));
+    let (a1, a2) = (amp(f1, w0, q), amp(f2, w2, q2v));
+    c.board.adc_bits = adc.map(|b| b.max(bits_for(2.0 * a1.max(a2) / a1.min(a2))));
+    c.board.adc_full_scale_v = 2.0 * a1.max(a2);
     c.board.phase_shifter_error_deg = shift;
 
     let (kind, rates, avg_mult, hann, settle, noise, selfcal) = e;
