@@ -266,16 +266,10 @@ impl LaneRng {
     fn pair<S: Sample>(&mut self) -> (S, S) {
         let (a0, b0) = self.0[0].normal_pair();
         if S::LANES <= 4 {
-            return (S::load(&a0.to_array()), S::load(&b0.to_array()));
+            return (lanes(a0, a0), lanes(b0, b0));
         }
         let (a1, b1) = self.0[1].normal_pair();
-        let join = |x: f64x4, y: f64x4| {
-            let mut v = [0.0; 8];
-            v[..4].copy_from_slice(&x.to_array());
-            v[4..].copy_from_slice(&y.to_array());
-            S::load(&v)
-        };
-        (join(a0, a1), join(b0, b1))
+        (lanes(a0, a1), lanes(b0, b1))
     }
 
     /// `w[0][k], w[1][k]` = the k-th call of [`LaneRng::pair`] for every k < `n` (the same
@@ -291,16 +285,23 @@ impl LaneRng {
         for (rng, p) in self.0.iter_mut().zip(pairs.iter_mut()).take(sets) {
             rng.fill_pairs(&mut p[..2 * n]);
         }
-        let mut v = [0.0; 8];
+        let [lo, hi] = pairs;
         for k in 0..n {
             for (c, wc) in w.iter_mut().enumerate() {
-                for (set, p) in pairs.iter().enumerate().take(sets) {
-                    v[4 * set..4 * set + 4].copy_from_slice(&p[2 * k + c].to_array());
-                }
-                wc[k] = S::load(&v[..S::LANES]);
+                wc[k] = lanes(lo[2 * k + c], hi[2 * k + c]);
             }
         }
     }
+}
+
+/// The lanes of `S` from the four-lane sets `lo` (lanes 0-3) and `hi` (lanes 4-7, read only
+/// by lane types wider than four).
+#[inline(always)]
+fn lanes<S: Sample>(lo: f64x4, hi: f64x4) -> S {
+    let mut v = [0.0; 8];
+    v[..4].copy_from_slice(&lo.to_array());
+    v[4..].copy_from_slice(&hi.to_array());
+    S::load(&v[..S::LANES])
 }
 
 /// `(re, im)` of the carrier phasor `c` turned by `(cos, sin)` of an angle, per lane.

@@ -72,17 +72,19 @@ pub fn with_noise(cfg: &Config) -> Config {
     c
 }
 
-/// [`with_noise`] plus every flicker source at the levels of the `m2tfg-selfcal` preset (the
-/// TIA voltage noise's 1 kHz corner, 1e-5 per sqrt(Hz) at 1 Hz on each drive's amplitude and
-/// phase and on the carrier's phase; the low corner by the config's rule): the chain a
-/// self-calibration study runs.
+/// [`with_noise`] plus every flicker source at the levels of the `m2tfg-selfcal` preset (read
+/// from it; the low corner by the config's rule): the chain a self-calibration study runs.
 pub fn with_flicker(cfg: &Config) -> Config {
     let mut c = with_noise(cfg);
+    let sc = gyroemu_config::presets::preset("m2tfg-selfcal")
+        .expect("the embedded preset parses")
+        .noise
+        .expect("the selfcal preset has noise");
     if let Some(n) = c.noise.as_mut() {
-        n.tia_voltage_flicker_corner_hz = 1000.0;
-        n.drive_amplitude_flicker_per_rthz = 1e-5;
-        n.drive_phase_flicker_rad_per_rthz = 1e-5;
-        n.carrier_phase_flicker_rad_per_rthz = 1e-5;
+        n.tia_voltage_flicker_corner_hz = sc.tia_voltage_flicker_corner_hz;
+        n.drive_amplitude_flicker_per_rthz = sc.drive_amplitude_flicker_per_rthz;
+        n.drive_phase_flicker_rad_per_rthz = sc.drive_phase_flicker_rad_per_rthz;
+        n.carrier_phase_flicker_rad_per_rthz = sc.carrier_phase_flicker_rad_per_rthz;
     }
     c
 }
