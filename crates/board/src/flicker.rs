@@ -56,6 +56,9 @@ pub(crate) struct FlickerSources<S: Sample> {
     pub(crate) block: BlockFlicker<S>,
     /// The TIA sources' values over the block running now, or nothing (drawn per sample).
     tia_block: Option<TiaBlock<S>>,
+    /// The slow sources' Gaussians drawn in one fill per stream set (else one `pair` per
+    /// source, as the reference board draws them: the same bits).
+    batch_slow: bool,
 }
 
 /// The TIA sources drawn and run ahead, up to [`TIA_CHUNK`] samples at a time and never past
@@ -77,6 +80,32 @@ struct TiaBlock<S> {
     /// The decimation block's length, and how many of its samples are not yet drawn.
     block: usize,
     left: usize,
+}
+
+/// The slow sources: two drive amplitudes, two drive phases, the carrier's phase.
+const SLOW: usize = 5;
+
+/// Source `s`'s next value from `w[*k]` (then `*k` moves on), or 0 when it is off (it
+/// takes nothing).
+#[inline(always)]
+fn tick_next<S: Sample>(s: &mut Source<S>, w: &[S; SLOW], k: &mut usize) -> S {
+    match s {
+        Some(f) => {
+            *k += 1;
+            f.tick(w[*k - 1])
+        }
+        None => S::splat(0.0),
+    }
+}
+
+/// `(cos, sin)` of `x` in each lane (one `sin_cos` per lane).
+#[inline(always)]
+fn rot<S: Sample>(x: S) -> (S, S) {
+    let (mut co, mut si) = ([0.0; 8], [0.0; 8]);
+    for l in 0..S::LANES {
+        (si[l], co[l]) = sin_cos(x.lane(l));
+    }
+    (S::load(&co[..S::LANES]), S::load(&si[..S::LANES]))
 }
 
 /// Samples of TIA flicker drawn at a time: the buffers stay a few tens of kB whatever the
@@ -109,11 +138,14 @@ impl<S: Sample> TiaBlock<S> {
         let (pairs, w, y) = (&mut self.pairs, &mut self.w, &mut self.y);
         // Compiled for the lane type's instructions (eight lanes: AVX-512), as the sample
         // loop is.
-        S::with_target_features(|| {
-            rng.pairs_into(n, pairs, w);
-            f0.process(&w[0][..n], &mut y[0][..n]);
-            f1.process(&w[1][..n], &mut y[1][..n]);
-        });
+        S::with_target_features(
+            #[inline(always)]
+            || {
+                rng.pairs_into(n, pairs, w);
+                f0.process(&w[0][..n], &mut y[0][..n]);
+                f1.process(&w[1][..n], &mut y[1][..n]);
+            },
+        );
         self.pos = 0;
         self.len = n;
         self.left -= n;
@@ -126,14 +158,18 @@ impl<S: Sample> FlickerSources<S> {
     /// (the same bits as [`FlickerSources::per_sample`]).
     pub(crate) fn new(p: &BoardParams, streams: &[u64]) -> ParamResult<Option<Self>> {
         let mut f = Self::per_sample(p, streams)?;
-        if let Some(f) = f.as_mut().filter(|f| f.tia[0].is_some()) {
-            f.tia_block = Some(TiaBlock::new(p.decimation));
+        if let Some(f) = f.as_mut() {
+            f.batch_slow = true;
+            if f.tia[0].is_some() {
+                f.tia_block = Some(TiaBlock::new(p.decimation));
+            }
         }
         Ok(f)
     }
 
-    /// [`FlickerSources::new`] with the TIA's sources drawn and run one sample at a time, as
-    /// the reference board does: what the block-wise draw is checked against.
+    /// [`FlickerSources::new`] with the TIA's sources drawn and run one sample at a time and
+    /// the slow sources' Gaussians one `pair` each, as the reference board does: what the
+    /// block-wise draws are checked against.
     pub(crate) fn per_sample(p: &BoardParams, streams: &[u64]) -> ParamResult<Option<Self>> {
         let Some(n) = p.noise.filter(has_flicker) else {
             return Ok(None);
@@ -187,26 +223,50 @@ impl<S: Sample> FlickerSources<S> {
                 carrier_rot: one,
             },
             tia_block: None,
+            batch_slow: false,
         }))
     }
 
     /// Draws the slow sources' next values (at the start of a decimation block), in a fixed
     /// order: amplitude 1, 2, phase 1, 2, carrier phase (a source that is off draws nothing).
+    /// Compiled for the lane type's instructions, as the sample loop is (eight lanes: the
+    /// filters' multiply-adds inline), with the block's Gaussians in one fill per stream set.
     pub(crate) fn next_block(&mut self) {
-        let rng = &mut self.rng;
-        let mut draw = |s: &mut Source<S>| match s {
-            Some(f) => f.tick(rng.pair::<S>().0),
-            None => S::splat(0.0),
-        };
-        let a = [draw(&mut self.amplitude[0]), draw(&mut self.amplitude[1])];
-        let phi = [draw(&mut self.phase[0]), draw(&mut self.phase[1])];
-        let phi_c = draw(&mut self.carrier);
-        let rot = |x: S| {
-            (
-                S::from_fn(|l| sin_cos(x.lane(l)).1),
-                S::from_fn(|l| sin_cos(x.lane(l)).0),
-            )
-        };
+        S::with_target_features(
+            #[inline(always)]
+            || self.next_block_here(),
+        );
+    }
+
+    #[inline(always)]
+    fn next_block_here(&mut self) {
+        let mut w = [S::splat(0.0); SLOW];
+        let on = self.slow().map(Option::is_some);
+        if self.batch_slow {
+            self.rng
+                .firsts_into(&mut w[..on.iter().filter(|&&o| o).count()]);
+        } else {
+            // The reference: one pair per source that is on, in the drawing order.
+            let mut k = 0;
+            for o in on {
+                if o {
+                    w[k] = self.rng.pair::<S>().0;
+                    k += 1;
+                }
+            }
+        }
+        // Helpers, not closures: a closure the inliner leaves out of line loses the lane
+        // type's instructions (each multiply-add of an eight-lane filter became a call).
+        let mut k = 0;
+        let a = [
+            tick_next(&mut self.amplitude[0], &w, &mut k),
+            tick_next(&mut self.amplitude[1], &w, &mut k),
+        ];
+        let phi = [
+            tick_next(&mut self.phase[0], &w, &mut k),
+            tick_next(&mut self.phase[1], &w, &mut k),
+        ];
+        let phi_c = tick_next(&mut self.carrier, &w, &mut k);
         self.block = BlockFlicker {
             amplitude: [S::splat(1.0) + a[0], S::splat(1.0) + a[1]],
             drive_rot: [rot(phi_c + phi[0]), rot(phi_c + phi[1])],
@@ -218,6 +278,14 @@ impl<S: Sample> FlickerSources<S> {
             b.left = b.block;
             b.refill(&mut self.rng, [f0, f1]);
         }
+    }
+
+    /// The slow sources in their drawing order.
+    #[inline(always)]
+    fn slow(&self) -> [&Source<S>; SLOW] {
+        let [a0, a1] = &self.amplitude;
+        let [p0, p1] = &self.phase;
+        [a0, a1, p0, p1, &self.carrier]
     }
 
     /// This sample's flicker of the TIA's input-referred current, per mode (A).
@@ -270,6 +338,28 @@ impl LaneRng {
         }
         let (a1, b1) = self.0[1].normal_pair();
         (lanes(a0, a1), lanes(b0, b1))
+    }
+
+    /// `w[k]` = the first of the k-th call of [`LaneRng::pair`] for every k (the same bits:
+    /// each stream set's pairs in one fill, their second normals left unused as `pair`'s
+    /// callers leave them).
+    #[inline(always)]
+    fn firsts_into<S: Sample>(&mut self, w: &mut [S]) {
+        let mut pairs = [[f64x4::ZERO; 2 * SLOW]; 2];
+        let n = w.len();
+        assert!(n <= SLOW, "at most {SLOW} slow sources");
+        if n == 0 {
+            return;
+        }
+        let sets = if S::LANES <= 4 { 1 } else { 2 };
+        for (rng, p) in self.0.iter_mut().zip(pairs.iter_mut()).take(sets) {
+            rng.fill_pairs(&mut p[..2 * n]);
+        }
+        let [lo, hi] = &pairs;
+        let hi = if sets == 1 { lo } else { hi };
+        for (k, wk) in w.iter_mut().enumerate() {
+            *wk = lanes(lo[2 * k], hi[2 * k]);
+        }
     }
 
     /// `w[0][k], w[1][k]` = the k-th call of [`LaneRng::pair`] for every k < `n` (the same

@@ -154,6 +154,32 @@ fn fused_equals_reference_with_flicker_over_long_blocks() {
 }
 
 #[test]
+fn fused_equals_reference_with_some_slow_flicker_sources_off() {
+    // The fused boards draw the slow sources' Gaussians in one fill per block, the reference
+    // one pair per source that is on: every subset must take the same draws in the same order.
+    let subsets: [(f64, f64, f64, f64); 4] = [
+        (1e-3, 0.0, 0.0, 0.0),
+        (0.0, 2e-3, 3e-3, 0.0),
+        (0.0, 0.0, 3e-3, 5e4),
+        (1e-3, 0.0, 3e-3, 0.0),
+    ];
+    for (amp, phase, carrier, tia_corner) in subsets {
+        for shape in [Shape::Rotating, Shape::Coriolis] {
+            let mut p = flickering(m2tfg(shape), 8);
+            if let Some(n) = &mut p.noise {
+                n.drive_amplitude_flicker_per_rthz = amp;
+                n.drive_phase_flicker_rad_per_rthz = phase;
+                n.carrier_phase_flicker_rad_per_rthz = carrier;
+                n.tia_voltage_flicker_corner_hz = tia_corner;
+            }
+            let pts = [point(25.0, 12), point(-100.0, 9), point(60.0, 11)];
+            let name = format!("{shape:?} slow flicker {amp} {phase} {carrier} {tia_corner}");
+            check(&name, &p, &pts, 6);
+        }
+    }
+}
+
+#[test]
 fn the_shortcuts_under_test_are_taken() {
     // A rotating run without coupling, and a Coriolis run at rest, take the decoupled plant
     // step (so the reference comparison covers it); rotation or coupling keep the full step.
