@@ -499,20 +499,23 @@ impl<S: Sample> Board<S> {
         };
         let mut board = (**pristine).clone();
         let mut probe = Probe::finite_check(self.lanes);
-        S::with_target_features(|| {
-            for k in 0..=k_bad {
-                board.replay_block(k * m, &mut probe);
-                if let Some((stage, sample, lane)) = probe.fault() {
-                    return NonFinite {
-                        stage,
-                        sample,
-                        time_s: sample as f64 / self.fs_hz,
-                        rate_dps: rate_dps(lane),
-                    };
+        S::with_target_features(
+            #[inline(always)]
+            || {
+                for k in 0..=k_bad {
+                    board.replay_block(k * m, &mut probe);
+                    if let Some((stage, sample, lane)) = probe.fault() {
+                        return NonFinite {
+                            stage,
+                            sample,
+                            time_s: sample as f64 / self.fs_hz,
+                            rate_dps: rate_dps(lane),
+                        };
+                    }
                 }
-            }
-            fallback
-        })
+                fallback
+            },
+        )
     }
 }
 
