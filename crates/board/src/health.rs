@@ -55,7 +55,16 @@ pub(crate) const ADC_ZERO: usize = 8;
 pub(crate) struct Counters<S>(pub(crate) [S; 10]);
 
 impl<S: Sample> Counters<S> {
-    /// Adds lane `lane` of every count to `h` and returns to zero counts.
+    /// Adds `block`'s counts in the lanes where `active` is 1 (0 elsewhere): a lane's running
+    /// totals, exact while below 2^53, drained once at the end instead of every block.
+    #[inline(always)]
+    pub(crate) fn add_where(&mut self, block: &Self, active: S) {
+        for (t, b) in self.0.iter_mut().zip(&block.0) {
+            *t += *b * active;
+        }
+    }
+
+    /// Adds lane `lane` of every count to `h`.
     pub(crate) fn drain_into(&self, lane: usize, h: &mut Health) {
         let c = |i: usize| self.0[i].lane(lane) as u64;
         for k in 0..2 {

@@ -148,6 +148,14 @@ impl<S: Sample> Board<S> {
             })
             .collect();
         let mut counts = Counters::<S>::default();
+        // Each lane's totals, and 1 in the lanes still counting (until the next lane's end).
+        let mut totals = Counters::<S>::default();
+        let counting = |k: u64| {
+            let active = S::from_fn(|i| f64::from(u8::from(i < lanes && k < lane_end[i])));
+            let until = lane_end.iter().copied().filter(|&e| e > k).min();
+            (active, until.unwrap_or(u64::MAX))
+        };
+        let (mut active, mut recount_at) = counting(0);
         // The decimated sample a cancel stopped the run at (its block not averaged).
         let mut stopped_at = None;
         for k in 0..n_out {
@@ -160,11 +168,10 @@ impl<S: Sample> Board<S> {
                 _ => self.block::<K, NOISY, DECOUPLED>(n0, None, &mut counts),
             };
             if NOISY {
-                for (i, h) in health.iter_mut().enumerate() {
-                    if k < lane_end[i] {
-                        counts.drain_into(i, h);
-                    }
+                if k >= recount_at {
+                    (active, recount_at) = counting(k);
                 }
+                totals.add_where(&counts, active);
                 counts = Counters::default();
             }
             // Each on its own: a sum of large finite values could overflow and false-alarm.
@@ -252,6 +259,9 @@ impl<S: Sample> Board<S> {
             }
         }
         progress(n_out * m);
+        for (i, h) in health.iter_mut().enumerate() {
+            totals.drain_into(i, h);
+        }
         // A lane is complete when its window (and its counts) ended before the stop: every
         // later sample has weight zero, and adding 0 leaves a compensated sum's value as it
         // is, so the lane holds the bits an uninterrupted run returns.
