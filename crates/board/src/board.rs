@@ -354,4 +354,11 @@ impl<S: Sample> Board<S> {
             _ => self.plant.decoupled(),
         }
     }
+
+    /// The TIA's two flicker sources run as one of eight lanes (a four-lane board where the
+    /// process runs eight): public, like [`Board::plant_decoupled`], so tests can check
+    /// which path the reference comparison covered.
+    pub fn tia_flicker_joined(&self) -> bool {
+        self.flicker.as_ref().is_some_and(|f| f.tia_joined())
+    }
 }

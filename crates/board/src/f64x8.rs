@@ -39,6 +39,14 @@ impl F64x8 {
         unsafe { core::mem::transmute::<__m512d, [f64; 8]>(self.0) }
     }
 
+    /// The lanes in memory, read without an AVX-512 instruction (so code compiled without
+    /// it, such as a four-lane loop, may read an eight-lane buffer).
+    #[inline(always)]
+    pub(crate) fn as_array(&self) -> &[f64; 8] {
+        // SAFETY: __m512d is eight f64, and [f64; 8] needs less alignment.
+        unsafe { &*(self as *const Self).cast::<[f64; 8]>() }
+    }
+
     #[inline(always)]
     fn from_array(a: [f64; 8]) -> Self {
         // SAFETY: as above.

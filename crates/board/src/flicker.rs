@@ -13,6 +13,8 @@
 //! the white noise, so a lane gives the bits of that point alone.
 
 use crate::board::lane_set_rng;
+#[cfg(target_arch = "x86_64")]
+use crate::f64x8::F64x8;
 use crate::params::{BoardParams, NoiseParams};
 use gyroemu_core::detmath::sin_cos;
 use gyroemu_core::flicker::{Flicker, FlickerParams};
@@ -74,12 +76,28 @@ struct TiaBlock<S> {
     w: [Vec<S>; 2],
     /// Each source's output.
     y: [Vec<S>; 2],
+    /// The two sources as one of eight lanes, on a board of four where the CPU has AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    joined: Option<Joined>,
     /// The next sample's index in the chunk, and the chunk's length.
     pos: usize,
     len: usize,
     /// The decimation block's length, and how many of its samples are not yet drawn.
     block: usize,
     left: usize,
+}
+
+/// Both TIA sources of a four-lane board in one eight-lane source (they share their design):
+/// half the multiply-adds of two four-lane ones, the same bits lane by lane
+/// ([`Flicker::from_parts`]). Source 0 in lanes 0-3, source 1 in lanes 4-7.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Debug)]
+struct Joined {
+    f: Flicker<F64x8>,
+    /// Sample k's Gaussians: the k-th pair (a, b) of the four lanes' stream set, whose a
+    /// source 0 takes and b source 1, so the pair's eight values in order are the input.
+    w: Vec<F64x8>,
+    y: Vec<F64x8>,
 }
 
 /// The slow sources: two drive amplitudes, two drive phases, the carrier's phase.
@@ -113,12 +131,24 @@ fn rot<S: Sample>(x: S) -> (S, S) {
 const TIA_CHUNK: usize = 256;
 
 impl<S: Sample> TiaBlock<S> {
-    fn new(block: usize) -> Self {
+    /// `f`: the two sources, joined in eight lanes when the board has four and the process
+    /// runs eight ([`crate::max_lanes`]; `--lanes 4` keeps four-lane code throughout).
+    fn new(block: usize, f: [&Flicker<S>; 2]) -> Self {
         let cap = block.min(TIA_CHUNK);
+        #[cfg(target_arch = "x86_64")]
+        let joined = (S::LANES == 4 && crate::max_lanes() == 8).then(|| Joined {
+            f: Flicker::from_parts(&f),
+            w: vec![F64x8::default(); cap],
+            y: vec![F64x8::default(); cap],
+        });
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = f;
         Self {
             pairs: [vec![f64x4::ZERO; 2 * cap], vec![f64x4::ZERO; 2 * cap]],
             w: [vec![S::splat(0.0); cap], vec![S::splat(0.0); cap]],
             y: [vec![S::splat(0.0); cap], vec![S::splat(0.0); cap]],
+            #[cfg(target_arch = "x86_64")]
+            joined,
             pos: 0,
             len: 0,
             block,
@@ -134,6 +164,25 @@ impl<S: Sample> TiaBlock<S> {
             n > 0,
             "the kernel takes one decimation block per next_block"
         );
+        self.pos = 0;
+        self.len = n;
+        self.left -= n;
+        #[cfg(target_arch = "x86_64")]
+        if let Some(j) = &mut self.joined {
+            let Joined { f, w, y } = j;
+            F64x8::with_target_features(
+                #[inline(always)]
+                || {
+                    // SAFETY: an F64x8 is eight f64 (any bits valid), 64-byte aligned, so
+                    // its slice is twice as many f64x4 (32-byte aligned) in the same memory.
+                    let pairs: &mut [f64x4] =
+                        unsafe { core::slice::from_raw_parts_mut(w.as_mut_ptr().cast(), 2 * n) };
+                    rng.0[0].fill_pairs(pairs);
+                    f.process(&w[..n], &mut y[..n]);
+                },
+            );
+            return;
+        }
         let [f0, f1] = f;
         let (pairs, w, y) = (&mut self.pairs, &mut self.w, &mut self.y);
         // Compiled for the lane type's instructions (eight lanes: AVX-512), as the sample
@@ -146,9 +195,17 @@ impl<S: Sample> TiaBlock<S> {
                 f1.process(&w[1][..n], &mut y[1][..n]);
             },
         );
-        self.pos = 0;
-        self.len = n;
-        self.left -= n;
+    }
+
+    /// The two sources' values at chunk index `i`.
+    #[inline(always)]
+    fn at(&self, i: usize) -> [S; 2] {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(j) = &self.joined {
+            let v = j.y[i].as_array();
+            return [S::load(&v[..4]), S::load(&v[4..])];
+        }
+        [self.y[0][i], self.y[1][i]]
     }
 }
 
@@ -160,8 +217,8 @@ impl<S: Sample> FlickerSources<S> {
         let mut f = Self::per_sample(p, streams)?;
         if let Some(f) = f.as_mut() {
             f.batch_slow = true;
-            if f.tia[0].is_some() {
-                f.tia_block = Some(TiaBlock::new(p.decimation));
+            if let [Some(f0), Some(f1)] = &f.tia {
+                f.tia_block = Some(TiaBlock::new(p.decimation, [f0, f1]));
             }
         }
         Ok(f)
@@ -288,6 +345,18 @@ impl<S: Sample> FlickerSources<S> {
         [a0, a1, p0, p1, &self.carrier]
     }
 
+    /// The TIA's sources run joined in eight lanes (see [`Joined`]).
+    pub(crate) fn tia_joined(&self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        {
+            self.tia_block.as_ref().is_some_and(|b| b.joined.is_some())
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            false
+        }
+    }
+
     /// This sample's flicker of the TIA's input-referred current, per mode (A).
     #[inline(always)]
     pub(crate) fn tia_current(&mut self) -> [S; 2] {
@@ -301,7 +370,7 @@ impl<S: Sample> FlickerSources<S> {
             }
             let i = b.pos;
             b.pos += 1;
-            return [b.y[0][i], b.y[1][i]];
+            return b.at(i);
         }
         let (w0, w1) = self.rng.pair::<S>();
         let mut out = [S::splat(0.0); 2];

@@ -5,11 +5,9 @@
 
 mod common;
 
+use common::check::check;
 use common::{flickering, imperfect, m2tfg, noisy, point};
-use gyroemu_board::reference::run_reference;
-use gyroemu_board::{
-    eight_lanes_available, Board, BoardParams, GroupBoard, Point, RunOptions, Shape,
-};
+use gyroemu_board::{eight_lanes_available, Board, BoardParams, GroupBoard, Shape};
 use gyroemu_core::f64x4;
 
 const SHAPES: [Shape; 3] = [
@@ -17,51 +15,6 @@ const SHAPES: [Shape; 3] = [
     Shape::RateTable { freq_hz: 20.0 },
     Shape::Rotating,
 ];
-
-/// The lane widths this CPU runs.
-fn widths() -> Vec<usize> {
-    if eight_lanes_available() {
-        vec![4, 8]
-    } else {
-        eprintln!("no AVX-512 on this CPU: only groups of four lanes are checked");
-        vec![4]
-    }
-}
-
-/// The group's lanes (up to its width of `points`) against the reference board, one point
-/// at a time, in every lane width.
-fn check(name: &str, p: &BoardParams, points: &[Point], n_settle: u64) {
-    for width in widths() {
-        check_width(
-            &format!("{name} in {width} lanes"),
-            width,
-            p,
-            points,
-            n_settle,
-        );
-    }
-}
-
-fn check_width(name: &str, width: usize, p: &BoardParams, points: &[Point], n_settle: u64) {
-    let points = &points[..points.len().min(width)];
-    let streams: Vec<u64> = (0..points.len() as u64).map(|i| 3 * i + 1).collect();
-    let rates: Vec<f64> = points.iter().map(|q| q.rate_rad_s).collect();
-    let fused = GroupBoard::with_width(width, p, &rates, &streams)
-        .unwrap()
-        .run(n_settle, points, RunOptions::default(), &|_| {})
-        .unwrap()
-        .lanes;
-    for (i, q) in points.iter().enumerate() {
-        let want = run_reference(p, q.rate_rad_s, streams[i], n_settle, q).unwrap();
-        assert_eq!(fused[i], want, "{name}: lane {i}");
-        let finite = [want.z, want.c, want.s]
-            .iter()
-            .flatten()
-            .chain(want.table_z.iter().flatten())
-            .all(|v| v.re.is_finite() && v.im.is_finite());
-        assert!(finite, "{name}: lane {i}: {want:?}");
-    }
-}
 
 #[test]
 fn fused_lanes_equal_the_reference_board_for_every_shape() {
@@ -199,6 +152,11 @@ fn the_shortcuts_under_test_are_taken() {
         .plant_decoupled());
     // A rate table on a device without coupling takes the step split by mode; with the
     // imperfect device's quadrature coupling, the full time-varying step.
+    // A four-lane board with the TIA's flicker runs its two sources as one of eight lanes
+    // where the CPU has AVX-512 (the comparisons above cover that path then; the four-lane
+    // path is checked under `--lanes 4` in `four_lane_code.rs`).
+    let f = Board::<f64x4>::new(&flickering(m2tfg(Shape::Rotating), 1), &[0.0], &[0]).unwrap();
+    assert_eq!(f.tia_flicker_joined(), eight_lanes_available());
     let table = m2tfg(Shape::RateTable { freq_hz: 2.0 });
     assert!(Board::<f64x4>::new(&table, &[0.0, 1.0], &[0, 1])
         .unwrap()

@@ -103,6 +103,61 @@ fn blocks_are_ticks_for_every_pole_count() {
 }
 
 #[test]
+fn sources_side_by_side_keep_their_bits_from_their_current_state() {
+    // Four scalar sources, advanced apart first, joined as the four lanes of one source: each
+    // lane continues its own source bit for bit (tick and process), and reset goes back to
+    // the parts' start states.
+    let p = params();
+    let mut g = Gauss::new([1, 2, 3, 4]);
+    let mut parts: Vec<Flicker<f64>> = (0..4)
+        .map(|_| Flicker::<f64>::stationary(&p, || g.next().to_array()[0]).unwrap())
+        .collect();
+    for (j, f) in parts.iter_mut().enumerate() {
+        for n in 0..(10 + 7 * j) {
+            f.tick((n as f64 * 0.37).sin());
+        }
+    }
+    let refs: Vec<&Flicker<f64>> = parts.iter().collect();
+    let mut joined = Flicker::<f64x4>::from_parts(&refs);
+    let mut fresh = joined.clone();
+    fresh.reset();
+    let input: Vec<f64x4> = (0..300).map(|_| g.next()).collect();
+    let mut out = vec![f64x4::ZERO; input.len()];
+    joined.process(&input, &mut out);
+    for (j, f) in parts.iter_mut().enumerate() {
+        let mut start = f.clone();
+        start.reset();
+        for (n, (x, y)) in input.iter().zip(&out).enumerate() {
+            let want = f.tick(x.to_array()[j]);
+            assert_eq!(
+                y.to_array()[j].to_bits(),
+                want.to_bits(),
+                "lane {j} sample {n}"
+            );
+        }
+        let x = input[0];
+        assert_eq!(
+            fresh.clone().tick(x).to_array()[j].to_bits(),
+            start.tick(x.to_array()[j]).to_bits(),
+            "lane {j} after reset"
+        );
+    }
+}
+
+#[test]
+#[should_panic(expected = "one design")]
+fn sources_of_different_designs_are_not_joined() {
+    let mut g = Gauss::new([1, 2, 3, 4]);
+    let a = Flicker::<f64>::stationary(&params(), || g.next().to_array()[0]).unwrap();
+    let other = FlickerParams {
+        f_lo_hz: 1e-4,
+        ..params()
+    };
+    let b = Flicker::<f64>::stationary(&other, || g.next().to_array()[0]).unwrap();
+    let _ = Flicker::<f64x4>::from_parts(&[&a, &a, &b, &a]);
+}
+
+#[test]
 fn lanes_are_the_scalar_streams_and_seeds_decide_the_bits() {
     // Lane l of a source fed a 4-stream NoiseRng equals a scalar source fed that lane's seed
     // alone (NoiseRng lane 0 of [seed; 4]), start state included.

@@ -2,6 +2,8 @@
 //! and their variants: noise, converters, an imperfect device.
 #![allow(dead_code)]
 
+pub mod check;
+
 use gyroemu_board::{BoardParams, Converter, NoiseParams, Point, Shape};
 use gyroemu_lpf::{LowPassDesign, Window};
 use gyroemu_resonator::{ModeParams, ResonatorParams};

@@ -59,6 +59,34 @@ impl<S: Sample> Flicker<S> {
         Ok(f)
     }
 
+    /// One source whose lanes are those of `parts` side by side (part `j` in lanes
+    /// `j * U::LANES ..`): sources of one design in a wider lane type, each lane keeping its
+    /// state, so it gives the bits the parts give. Why: two sources of four lanes run as one
+    /// of eight where the CPU has the wider registers.
+    ///
+    /// # Panics
+    /// If the parts do not fill `S`'s lanes exactly or their designs differ (a caller's bug).
+    pub fn from_parts<U: Sample>(parts: &[&Flicker<U>]) -> Self {
+        assert_eq!(parts.len() * U::LANES, S::LANES, "the parts fill the lanes");
+        let design = parts[0].design.clone();
+        assert!(
+            parts.iter().all(|p| p.design == design),
+            "the parts share one design"
+        );
+        let join = |v: fn(&Flicker<U>) -> &Vec<U>, k: usize| {
+            S::from_fn(|l| v(parts[l / U::LANES])[k].lane(l % U::LANES))
+        };
+        let n = design.poles();
+        Self {
+            a: design.pole_radii().iter().map(|&v| S::splat(v)).collect(),
+            rho: design.residues().iter().map(|&v| S::splat(v)).collect(),
+            direct: S::splat(design.direct()),
+            state: (0..n).map(|k| join(|f| &f.state, k)).collect(),
+            start: (0..n).map(|k| join(|f| &f.start, k)).collect(),
+            design,
+        }
+    }
+
     /// The design (exact spectrum, variance, poles).
     pub fn design(&self) -> &FlickerDesign {
         &self.design
