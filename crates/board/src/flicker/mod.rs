@@ -12,14 +12,15 @@
 //! Every source is a seeded [`Flicker`] started in its stationary state, lane-parallel like
 //! the white noise, so a lane gives the bits of that point alone.
 
-use crate::board::lane_set_rng;
-#[cfg(target_arch = "x86_64")]
-use crate::f64x8::F64x8;
+mod lane_rng;
+mod tia;
+
 use crate::params::{BoardParams, NoiseParams};
 use gyroemu_core::detmath::sin_cos;
 use gyroemu_core::flicker::{Flicker, FlickerParams};
-use gyroemu_core::noise::NoiseRng;
-use gyroemu_core::{f64x4, ParamResult, Sample, Stage};
+use gyroemu_core::{ParamResult, Sample, Stage};
+use lane_rng::LaneRng;
+use tia::TiaBlock;
 
 /// Salt of the flicker streams' seeds (apart from the white noise's).
 const FLICKER_SALT: u64 = 0xF11C_4E25_0000_0001;
@@ -63,45 +64,8 @@ pub(crate) struct FlickerSources<S: Sample> {
     batch_slow: bool,
 }
 
-/// The TIA sources drawn and run ahead, up to [`TIA_CHUNK`] samples at a time and never past
-/// the decimation block (the slow sources draw from the same streams at each block's start):
-/// their Gaussians in one fill and the filters over the chunk ([`Flicker`]'s `process`, the
-/// bits of a tick per sample), instead of a generator call and a chain of dependent
-/// multiply-adds per sample.
-#[derive(Clone, Debug)]
-struct TiaBlock<S> {
-    /// Each four-lane stream set's next pairs (a, b): one per sample.
-    pairs: [Vec<f64x4>; 2],
-    /// Each source's Gaussians: source 0 takes the pair's first, source 1 its second.
-    w: [Vec<S>; 2],
-    /// Each source's output.
-    y: [Vec<S>; 2],
-    /// The two sources as one of eight lanes, on a board of four where the CPU has AVX-512.
-    #[cfg(target_arch = "x86_64")]
-    joined: Option<Joined>,
-    /// The next sample's index in the chunk, and the chunk's length.
-    pos: usize,
-    len: usize,
-    /// The decimation block's length, and how many of its samples are not yet drawn.
-    block: usize,
-    left: usize,
-}
-
-/// Both TIA sources of a four-lane board in one eight-lane source (they share their design):
-/// half the multiply-adds of two four-lane ones, the same bits lane by lane
-/// ([`Flicker::from_parts`]). Source 0 in lanes 0-3, source 1 in lanes 4-7.
-#[cfg(target_arch = "x86_64")]
-#[derive(Clone, Debug)]
-struct Joined {
-    f: Flicker<F64x8>,
-    /// Sample k's Gaussians: the k-th pair (a, b) of the four lanes' stream set, whose a
-    /// source 0 takes and b source 1, so the pair's eight values in order are the input.
-    w: Vec<F64x8>,
-    y: Vec<F64x8>,
-}
-
 /// The slow sources: two drive amplitudes, two drive phases, the carrier's phase.
-const SLOW: usize = 5;
+pub(super) const SLOW: usize = 5;
 
 /// Source `s`'s next value from `w[*k]` (then `*k` moves on), or 0 when it is off (it
 /// takes nothing).
@@ -124,89 +88,6 @@ fn rot<S: Sample>(x: S) -> (S, S) {
         (si[l], co[l]) = sin_cos(x.lane(l));
     }
     (S::load(&co[..S::LANES]), S::load(&si[..S::LANES]))
-}
-
-/// Samples of TIA flicker drawn at a time: the buffers stay a few tens of kB whatever the
-/// decimation (a chunk as long as a block of 10^6 samples would take hundreds of MB).
-const TIA_CHUNK: usize = 256;
-
-impl<S: Sample> TiaBlock<S> {
-    /// `f`: the two sources, joined in eight lanes when the board has four and the process
-    /// runs eight ([`crate::max_lanes`]; `--lanes 4` keeps four-lane code throughout).
-    fn new(block: usize, f: [&Flicker<S>; 2]) -> Self {
-        let cap = block.min(TIA_CHUNK);
-        #[cfg(target_arch = "x86_64")]
-        let joined = (S::LANES == 4 && crate::max_lanes() == 8).then(|| Joined {
-            f: Flicker::from_parts(&f),
-            w: vec![F64x8::default(); cap],
-            y: vec![F64x8::default(); cap],
-        });
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = f;
-        Self {
-            pairs: [vec![f64x4::ZERO; 2 * cap], vec![f64x4::ZERO; 2 * cap]],
-            w: [vec![S::splat(0.0); cap], vec![S::splat(0.0); cap]],
-            y: [vec![S::splat(0.0); cap], vec![S::splat(0.0); cap]],
-            #[cfg(target_arch = "x86_64")]
-            joined,
-            pos: 0,
-            len: 0,
-            block,
-            left: 0,
-        }
-    }
-
-    /// Draws and runs the next chunk of the block (at most what is left of it).
-    #[inline(never)]
-    fn refill(&mut self, rng: &mut LaneRng, f: [&mut Flicker<S>; 2]) {
-        let n = self.left.min(self.w[0].len());
-        assert!(
-            n > 0,
-            "the kernel takes one decimation block per next_block"
-        );
-        self.pos = 0;
-        self.len = n;
-        self.left -= n;
-        #[cfg(target_arch = "x86_64")]
-        if let Some(j) = &mut self.joined {
-            let Joined { f, w, y } = j;
-            F64x8::with_target_features(
-                #[inline(always)]
-                || {
-                    // SAFETY: an F64x8 is eight f64 (any bits valid), 64-byte aligned, so
-                    // its slice is twice as many f64x4 (32-byte aligned) in the same memory.
-                    let pairs: &mut [f64x4] =
-                        unsafe { core::slice::from_raw_parts_mut(w.as_mut_ptr().cast(), 2 * n) };
-                    rng.0[0].fill_pairs(pairs);
-                    f.process(&w[..n], &mut y[..n]);
-                },
-            );
-            return;
-        }
-        let [f0, f1] = f;
-        let (pairs, w, y) = (&mut self.pairs, &mut self.w, &mut self.y);
-        // Compiled for the lane type's instructions (eight lanes: AVX-512), as the sample
-        // loop is.
-        S::with_target_features(
-            #[inline(always)]
-            || {
-                rng.pairs_into(n, pairs, w);
-                f0.process(&w[0][..n], &mut y[0][..n]);
-                f1.process(&w[1][..n], &mut y[1][..n]);
-            },
-        );
-    }
-
-    /// The two sources' values at chunk index `i`.
-    #[inline(always)]
-    fn at(&self, i: usize) -> [S; 2] {
-        #[cfg(target_arch = "x86_64")]
-        if let Some(j) = &self.joined {
-            let v = j.y[i].as_array();
-            return [S::load(&v[..4]), S::load(&v[4..])];
-        }
-        [self.y[0][i], self.y[1][i]]
-    }
 }
 
 impl<S: Sample> FlickerSources<S> {
@@ -345,16 +226,9 @@ impl<S: Sample> FlickerSources<S> {
         [a0, a1, p0, p1, &self.carrier]
     }
 
-    /// The TIA's sources run joined in eight lanes (see [`Joined`]).
+    /// The TIA's sources run joined in eight lanes (`tia::Joined`).
     pub(crate) fn tia_joined(&self) -> bool {
-        #[cfg(target_arch = "x86_64")]
-        {
-            self.tia_block.as_ref().is_some_and(|b| b.joined.is_some())
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            false
-        }
+        self.tia_block.as_ref().is_some_and(TiaBlock::joined)
     }
 
     /// This sample's flicker of the TIA's input-referred current, per mode (A).
@@ -381,86 +255,6 @@ impl<S: Sample> FlickerSources<S> {
         }
         out
     }
-}
-
-/// The flicker streams of up to eight lanes, in four-lane sets as the white noise's
-/// ([`lane_set_rng`]), so a point draws the same normals in a group of four or of eight.
-#[derive(Clone, Debug)]
-struct LaneRng([NoiseRng; 2]);
-
-impl LaneRng {
-    /// Lane `i` on stream `streams[i]` (lanes past the end repeat the last).
-    fn new(seed: u64, streams: &[u64]) -> Self {
-        Self([
-            lane_set_rng(seed, streams, 0),
-            lane_set_rng(seed, streams, 1),
-        ])
-    }
-
-    /// The next pair of standard normals in every lane of `S` (the second generator only
-    /// draws for lane types wider than four).
-    #[inline(always)]
-    fn pair<S: Sample>(&mut self) -> (S, S) {
-        let (a0, b0) = self.0[0].normal_pair();
-        if S::LANES <= 4 {
-            return (lanes(a0, a0), lanes(b0, b0));
-        }
-        let (a1, b1) = self.0[1].normal_pair();
-        (lanes(a0, a1), lanes(b0, b1))
-    }
-
-    /// `w[k]` = the first of the k-th call of [`LaneRng::pair`] for every k (the same bits:
-    /// each stream set's pairs in one fill, their second normals left unused as `pair`'s
-    /// callers leave them).
-    #[inline(always)]
-    fn firsts_into<S: Sample>(&mut self, w: &mut [S]) {
-        let mut pairs = [[f64x4::ZERO; 2 * SLOW]; 2];
-        let n = w.len();
-        assert!(n <= SLOW, "at most {SLOW} slow sources");
-        if n == 0 {
-            return;
-        }
-        let sets = if S::LANES <= 4 { 1 } else { 2 };
-        for (rng, p) in self.0.iter_mut().zip(pairs.iter_mut()).take(sets) {
-            rng.fill_pairs(&mut p[..2 * n]);
-        }
-        let [lo, hi] = &pairs;
-        let hi = if sets == 1 { lo } else { hi };
-        for (k, wk) in w.iter_mut().enumerate() {
-            *wk = lanes(lo[2 * k], hi[2 * k]);
-        }
-    }
-
-    /// `w[0][k], w[1][k]` = the k-th call of [`LaneRng::pair`] for every k < `n` (the same
-    /// bits), drawn through `pairs` (each stream set's pairs) in one fill per set.
-    #[inline(always)]
-    fn pairs_into<S: Sample>(
-        &mut self,
-        n: usize,
-        pairs: &mut [Vec<f64x4>; 2],
-        w: &mut [Vec<S>; 2],
-    ) {
-        let sets = if S::LANES <= 4 { 1 } else { 2 };
-        for (rng, p) in self.0.iter_mut().zip(pairs.iter_mut()).take(sets) {
-            rng.fill_pairs(&mut p[..2 * n]);
-        }
-        let [lo, hi] = pairs;
-        for k in 0..n {
-            for (c, wc) in w.iter_mut().enumerate() {
-                wc[k] = lanes(lo[2 * k + c], hi[2 * k + c]);
-            }
-        }
-    }
-}
-
-/// The lanes of `S` from the four-lane sets `lo` (lanes 0-3) and `hi` (lanes 4-7, read only
-/// by lane types wider than four).
-#[inline(always)]
-fn lanes<S: Sample>(lo: f64x4, hi: f64x4) -> S {
-    let mut v = [0.0; 8];
-    v[..4].copy_from_slice(&lo.to_array());
-    v[4..].copy_from_slice(&hi.to_array());
-    S::load(&v[..S::LANES])
 }
 
 /// `(re, im)` of the carrier phasor `c` turned by `(cos, sin)` of an angle, per lane.
