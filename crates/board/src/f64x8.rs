@@ -3,8 +3,10 @@
 //! `f64` and `f64x4` lane by lane (the same rounding, `mul_add` fused alike, the same
 //! min/max and NaN rules as `wide`'s f64x4), so a point gets the same bits in every lane type.
 //!
-//! A value exists only inside a board built by [`crate::GroupBoard`] after checking the CPU
-//! ([`available`]), which is what makes the intrinsics below sound; the type is private to
+//! A value exists only inside a board built after checking the CPU ([`available`]): an
+//! eight-lane board of [`crate::GroupBoard`], or the joined TIA flicker sources of a four-lane
+//! board, made only when [`crate::max_lanes`] is 8. That is what makes the intrinsics below
+//! sound; the type is private to
 //! this crate so nothing else can make one. The sample loop enters through
 //! [`Sample::with_target_features`], which compiles it, with every operation inlined, for
 //! AVX-512.
