@@ -8,7 +8,7 @@ use crate::selfcal_combined::combined_slope;
 use gyroemu_board::{lane_groups, max_lanes, GroupBoard, LaneResult, Point, RunOptions};
 use gyroemu_config::{Config, PllConfig};
 use gyroemu_experiment::post_process;
-use gyroemu_experiment::sweep::{add_group_progress, canonical_work};
+use gyroemu_experiment::sweep::{add_group_progress, group_samples};
 use gyroemu_experiment::{lock_config_carrier, resolve_lock, Progress, SweepError};
 use gyroemu_lpf::Window;
 use gyroemu_mixer::wrap_pi;
@@ -212,7 +212,9 @@ pub fn tau_analysis(
         groups.push((first, &points[first..first + size]));
         first += size;
     }
-    let (total, _) = canonical_work(&rot, &points);
+    // Progress counts the groups that run (one of eight where the CPU has AVX-512), not the
+    // canonical four-lane grouping the results report, so it ends at 100 %.
+    let total: u64 = groups.iter().map(|(_, g)| group_samples(&rot, g)).sum();
     let done = AtomicU64::new(0);
     let params = rot.board_params();
     let mut boards = Vec::new();
