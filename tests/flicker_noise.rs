@@ -35,6 +35,36 @@ fn flicker_cfg(f: impl Fn(&mut NoiseConfig)) -> Config {
     c
 }
 
+/// The full-rate dump of `nodes` over `dur_s` from `start_s`, recorded by a one-point zero-rate
+/// board run just past the window, written and read back as a user would.
+fn full_rate_dump(c: &Config, nodes: &[&str], start_s: f64, dur_s: f64) -> gyroemu_io::Dump {
+    let nodes: Vec<String> = nodes.iter().map(|n| n.to_string()).collect();
+    let mut probe = Probe::new(&nodes, c.fs_hz(), c.decimation(), start_s, dur_s, 0);
+    let n_out = ((start_s + dur_s) * c.fs_out_hz()).ceil() as u64 + 2;
+    let point = Point {
+        rate_rad_s: 0.0,
+        window: Window::Boxcar {
+            n: n_out,
+            frac: 0.0,
+        },
+    };
+    Board::<f64>::new(&c.board_params(), &[0.0], &[0])
+        .unwrap()
+        .run(
+            0,
+            &[point],
+            RunOptions {
+                probe: Some(&mut probe),
+                ..Default::default()
+            },
+            &|_| {},
+        )
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    probe.write(dir.path(), "d").unwrap();
+    gyroemu_io::read_dump(&dir.path().join("d_fullrate")).unwrap()
+}
+
 /// The Allan deviation of the zero-rate mode-1 phase, rad, at taus in `[lo, hi]` s.
 fn phase_adev(c: &Config, record_s: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
     let a = allan_analysis(c, record_s, 1.0, &quiet).unwrap();
@@ -183,32 +213,7 @@ fn tia_voltage_flicker_has_its_corner_in_the_tia_output() {
     c.drive.f1 = 1e-30;
     c.drive.f2 = Some(1e-30);
     let fs = c.fs_hz();
-    let (start_s, dur_s) = (0.05, 2.0);
-    let nodes = vec!["tia".to_string()];
-    let mut probe = Probe::new(&nodes, fs, c.decimation(), start_s, dur_s, 0);
-    let n_out = ((start_s + dur_s) * c.fs_out_hz()).ceil() as u64 + 2;
-    let point = Point {
-        rate_rad_s: 0.0,
-        window: Window::Boxcar {
-            n: n_out,
-            frac: 0.0,
-        },
-    };
-    Board::<f64>::new(&c.board_params(), &[0.0], &[0])
-        .unwrap()
-        .run(
-            0,
-            &[point],
-            RunOptions {
-                probe: Some(&mut probe),
-                ..Default::default()
-            },
-            &|_| {},
-        )
-        .unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    probe.write(dir.path(), "t").unwrap();
-    let d = gyroemu_io::read_dump(&dir.path().join("t_fullrate")).unwrap();
+    let d = full_rate_dump(&c, &["tia"], 0.05, 2.0);
     let y = d.channel("tia1_v").unwrap().to_vec();
     let psd = gyroemu_spectrum::welch(&y, fs, Some(1 << 16)).unwrap();
     let density = psd.density();
@@ -244,27 +249,7 @@ fn flicker_draws_from_its_own_streams() {
             n.tia_voltage_flicker_corner_hz = corner;
             n.flicker_f_lo_hz = Some(0.1);
         });
-        let nodes = vec!["drive".to_string(), "tia".to_string()];
-        let mut probe = Probe::new(&nodes, c.fs_hz(), c.decimation(), 0.0, 0.01, 0);
-        let point = Point {
-            rate_rad_s: 0.0,
-            window: Window::Boxcar { n: 10, frac: 0.0 },
-        };
-        Board::<f64>::new(&c.board_params(), &[0.0], &[0])
-            .unwrap()
-            .run(
-                0,
-                &[point],
-                RunOptions {
-                    probe: Some(&mut probe),
-                    ..Default::default()
-                },
-                &|_| {},
-            )
-            .unwrap();
-        let dir = tempfile::tempdir().unwrap();
-        probe.write(dir.path(), "d").unwrap();
-        let d = gyroemu_io::read_dump(&dir.path().join("d_fullrate")).unwrap();
+        let d = full_rate_dump(&c, &["drive", "tia"], 0.0, 0.01);
         let bits = |name: &str| -> Vec<u64> {
             d.channel(name)
                 .unwrap()
