@@ -70,6 +70,35 @@ pub struct NoiseParams {
     pub flicker_f_lo_hz: f64,
 }
 
+impl NoiseParams {
+    /// The four flicker sources' levels, each with its config key (0: the source is off).
+    pub fn flicker_levels(&self) -> [(&'static str, f64); 4] {
+        [
+            (
+                "noise.tia_voltage_flicker_corner_hz",
+                self.tia_voltage_flicker_corner_hz,
+            ),
+            (
+                "noise.drive_amplitude_flicker_per_rthz",
+                self.drive_amplitude_flicker_per_rthz,
+            ),
+            (
+                "noise.drive_phase_flicker_rad_per_rthz",
+                self.drive_phase_flicker_rad_per_rthz,
+            ),
+            (
+                "noise.carrier_phase_flicker_rad_per_rthz",
+                self.carrier_phase_flicker_rad_per_rthz,
+            ),
+        ]
+    }
+
+    /// Whether any flicker source is on.
+    pub fn has_flicker(&self) -> bool {
+        self.flicker_levels().iter().any(|&(_, v)| v > 0.0)
+    }
+}
+
 /// The whole board: plant, drive, converters, front end, read-out and the experiment shape.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoardParams {
@@ -160,27 +189,10 @@ impl BoardParams {
                 "noise.tia_voltage_noise_v_per_rthz",
                 n.tia_voltage_noise_v_per_rthz,
             )?;
-            for (key, v) in [
-                (
-                    "noise.tia_voltage_flicker_corner_hz",
-                    n.tia_voltage_flicker_corner_hz,
-                ),
-                (
-                    "noise.drive_amplitude_flicker_per_rthz",
-                    n.drive_amplitude_flicker_per_rthz,
-                ),
-                (
-                    "noise.drive_phase_flicker_rad_per_rthz",
-                    n.drive_phase_flicker_rad_per_rthz,
-                ),
-                (
-                    "noise.carrier_phase_flicker_rad_per_rthz",
-                    n.carrier_phase_flicker_rad_per_rthz,
-                ),
-            ] {
+            for (key, v) in n.flicker_levels() {
                 non_negative(STAGE, key, v)?;
             }
-            if crate::flicker::has_flicker(n) {
+            if n.has_flicker() {
                 positive(STAGE, "noise.flicker_f_lo_hz", n.flicker_f_lo_hz)?;
             }
         }

@@ -1,7 +1,7 @@
 //! What a config implies before anything runs: its experiment shape, the board it describes,
 //! the operating points it emulates and their settling and averaging windows.
 
-use crate::config::{Config, ExperimentKind, RateTable, Spacing, WindowKind};
+use crate::config::{Config, ExperimentKind, NoiseConfig, RateTable, Spacing, WindowKind};
 use gyroemu_board::{BoardParams, Converter, NoiseParams, Point, Shape};
 use gyroemu_lpf::{LowPassDesign, Window};
 use gyroemu_mixer::MAX_TABLE_HARMONIC;
@@ -149,18 +149,10 @@ impl Config {
             }),
             lowpass: self.lowpass_design(),
             decimation: self.decimation(),
-            noise: self.noise.as_ref().map(|n| NoiseParams {
-                seed: n.seed,
-                temperature_k: n.temperature_k,
-                effective_mass_kg: n.effective_mass_kg,
-                tia_current_noise_a_per_rthz: n.tia_current_noise_a_per_rthz,
-                tia_voltage_noise_v_per_rthz: n.tia_voltage_noise_v_per_rthz,
-                tia_voltage_flicker_corner_hz: n.tia_voltage_flicker_corner_hz,
-                drive_amplitude_flicker_per_rthz: n.drive_amplitude_flicker_per_rthz,
-                drive_phase_flicker_rad_per_rthz: n.drive_phase_flicker_rad_per_rthz,
-                carrier_phase_flicker_rad_per_rthz: n.carrier_phase_flicker_rad_per_rthz,
-                flicker_f_lo_hz: self.flicker_f_lo_hz(),
-            }),
+            noise: self
+                .noise
+                .as_ref()
+                .map(|n| noise_params(n, self.flicker_f_lo_hz())),
             shape: self.shape(),
             table_harmonics: self.table_harmonics(),
         }
@@ -294,4 +286,21 @@ pub fn sweep_grid(
     f[0] = start_hz;
     f[points - 1] = stop_hz;
     f
+}
+
+/// The board's noise parameters from a `[noise]` section, with the flicker sources' low corner
+/// (resolved by [`Config::flicker_f_lo_hz`]).
+pub(crate) fn noise_params(n: &NoiseConfig, flicker_f_lo_hz: f64) -> NoiseParams {
+    NoiseParams {
+        seed: n.seed,
+        temperature_k: n.temperature_k,
+        effective_mass_kg: n.effective_mass_kg,
+        tia_current_noise_a_per_rthz: n.tia_current_noise_a_per_rthz,
+        tia_voltage_noise_v_per_rthz: n.tia_voltage_noise_v_per_rthz,
+        tia_voltage_flicker_corner_hz: n.tia_voltage_flicker_corner_hz,
+        drive_amplitude_flicker_per_rthz: n.drive_amplitude_flicker_per_rthz,
+        drive_phase_flicker_rad_per_rthz: n.drive_phase_flicker_rad_per_rthz,
+        carrier_phase_flicker_rad_per_rthz: n.carrier_phase_flicker_rad_per_rthz,
+        flicker_f_lo_hz,
+    }
 }

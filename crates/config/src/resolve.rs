@@ -426,12 +426,9 @@ impl Config {
 impl Config {
     /// Whether `[noise]` asks for any flicker source.
     pub fn has_flicker(&self) -> bool {
-        self.noise.as_ref().is_some_and(|n| {
-            n.tia_voltage_flicker_corner_hz > 0.0
-                || n.drive_amplitude_flicker_per_rthz > 0.0
-                || n.drive_phase_flicker_rad_per_rthz > 0.0
-                || n.carrier_phase_flicker_rad_per_rthz > 0.0
-        })
+        self.noise
+            .as_ref()
+            .is_some_and(|n| crate::plan::noise_params(n, 0.0).has_flicker())
     }
 
     /// The longest record a run of this config makes, s: settling plus the longest of the

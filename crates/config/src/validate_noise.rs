@@ -31,24 +31,8 @@ impl Config {
                 "noise.tia_voltage_noise_v_per_rthz",
                 n.tia_voltage_noise_v_per_rthz,
             );
-            for (key, v) in [
-                (
-                    "noise.tia_voltage_flicker_corner_hz",
-                    n.tia_voltage_flicker_corner_hz,
-                ),
-                (
-                    "noise.drive_amplitude_flicker_per_rthz",
-                    n.drive_amplitude_flicker_per_rthz,
-                ),
-                (
-                    "noise.drive_phase_flicker_rad_per_rthz",
-                    n.drive_phase_flicker_rad_per_rthz,
-                ),
-                (
-                    "noise.carrier_phase_flicker_rad_per_rthz",
-                    n.carrier_phase_flicker_rad_per_rthz,
-                ),
-            ] {
+            // The levels as the board reads them (the low corner does not matter here).
+            for (key, v) in crate::plan::noise_params(n, 0.0).flicker_levels() {
                 p.non_negative(key, v);
             }
             if n.tia_voltage_flicker_corner_hz > 0.0 && n.tia_voltage_noise_v_per_rthz == 0.0 {

@@ -893,6 +893,36 @@ fn cases() -> Vec<Case> {
             set(&noise, "noise", "tia_voltage_noise_v_per_rthz", "nan"),
             &["noise.tia_voltage_noise_v_per_rthz", "NaN", ">= 0"],
         ),
+        // Each flicker level by its own key (one list serves the config and the board).
+        invalid(
+            "tia flicker corner negative",
+            set(&noise, "noise", "tia_voltage_flicker_corner_hz", "-1.0"),
+            &["noise.tia_voltage_flicker_corner_hz", "= -1", ">= 0"],
+        ),
+        invalid(
+            "drive amplitude flicker negative",
+            set(&noise, "noise", "drive_amplitude_flicker_per_rthz", "-2e-5"),
+            &["noise.drive_amplitude_flicker_per_rthz", "-0.00002", ">= 0"],
+        ),
+        invalid(
+            "drive phase flicker nan",
+            set(&noise, "noise", "drive_phase_flicker_rad_per_rthz", "nan"),
+            &["noise.drive_phase_flicker_rad_per_rthz", "NaN", ">= 0"],
+        ),
+        invalid(
+            "carrier phase flicker negative",
+            set(
+                &noise,
+                "noise",
+                "carrier_phase_flicker_rad_per_rthz",
+                "-3e-5",
+            ),
+            &[
+                "noise.carrier_phase_flicker_rad_per_rthz",
+                "-0.00003",
+                ">= 0",
+            ],
+        ),
         case(
             "noise section with no source warns",
             with(c.clone(), "\n[noise]\nseed = 3\n"),

@@ -25,14 +25,6 @@ use tia::TiaBlock;
 /// Salt of the flicker streams' seeds (apart from the white noise's).
 const FLICKER_SALT: u64 = 0xF11C_4E25_0000_0001;
 
-/// Whether a noise section asks for any flicker source.
-pub(crate) fn has_flicker(n: &NoiseParams) -> bool {
-    n.tia_voltage_flicker_corner_hz > 0.0
-        || n.drive_amplitude_flicker_per_rthz > 0.0
-        || n.drive_phase_flicker_rad_per_rthz > 0.0
-        || n.carrier_phase_flicker_rad_per_rthz > 0.0
-}
-
 /// One source: its generator, or nothing when its level is 0.
 type Source<S> = Option<Flicker<S>>;
 
@@ -109,7 +101,7 @@ impl<S: Sample> FlickerSources<S> {
     /// the slow sources' Gaussians one `pair` each, as the reference board does: what the
     /// block-wise draws are checked against.
     pub(crate) fn per_sample(p: &BoardParams, streams: &[u64]) -> ParamResult<Option<Self>> {
-        let Some(n) = p.noise.filter(has_flicker) else {
+        let Some(n) = p.noise.filter(NoiseParams::has_flicker) else {
             return Ok(None);
         };
         let mut rng = LaneRng::new(n.seed ^ FLICKER_SALT, streams);
