@@ -23,6 +23,8 @@ pub(super) struct TiaBlock<S> {
     /// The two sources as one of eight lanes, on a board of four where the CPU has AVX-512.
     #[cfg(target_arch = "x86_64")]
     joined: Option<Joined>,
+    /// The longest chunk: the buffers' length (the unjoined ones are empty when joined).
+    cap: usize,
     /// The next sample's index in the chunk, and the chunk's length.
     pub(super) pos: usize,
     pub(super) len: usize,
@@ -60,13 +62,15 @@ impl<S: Sample> TiaBlock<S> {
             y: vec![F64x8::default(); cap],
         });
         #[cfg(not(target_arch = "x86_64"))]
-        let _ = f;
+        let (_, joined) = (f, None::<()>);
+        let own = if joined.is_some() { 0 } else { cap };
         Self {
-            pairs: [vec![f64x4::ZERO; 2 * cap], vec![f64x4::ZERO; 2 * cap]],
-            w: [vec![S::splat(0.0); cap], vec![S::splat(0.0); cap]],
-            y: [vec![S::splat(0.0); cap], vec![S::splat(0.0); cap]],
+            pairs: [vec![f64x4::ZERO; 2 * own], vec![f64x4::ZERO; 2 * own]],
+            w: [vec![S::splat(0.0); own], vec![S::splat(0.0); own]],
+            y: [vec![S::splat(0.0); own], vec![S::splat(0.0); own]],
             #[cfg(target_arch = "x86_64")]
             joined,
+            cap,
             pos: 0,
             len: 0,
             block,
@@ -77,7 +81,7 @@ impl<S: Sample> TiaBlock<S> {
     /// Draws and runs the next chunk of the block (at most what is left of it).
     #[inline(never)]
     pub(super) fn refill(&mut self, rng: &mut LaneRng, f: [&mut Flicker<S>; 2]) {
-        let n = self.left.min(self.w[0].len());
+        let n = self.left.min(self.cap);
         assert!(
             n > 0,
             "the kernel takes one decimation block per next_block"
