@@ -15,7 +15,19 @@ pub struct Quantizer<S> {
     step: S,
     code_lo: S,
     code_hi: S,
+    /// For [`Quantizer::quantize_counting_fast`]: the rounded reciprocal of the step, the
+    /// smallest `|x / step|` it takes (`1/2 + MARGIN`) and the largest distance to its code
+    /// (`1/2 - MARGIN`).
+    inv_step: S,
+    fast_lo: S,
+    tie_lo: S,
+    tie_hi: S,
 }
+
+/// How far from a half-integer [`Quantizer::quantize_counting_fast`] keeps its product:
+/// 2^-16, far above the 2^-20 by which the product and the rounded quotient can differ below
+/// 2^31 (its proof).
+const MARGIN: f64 = 1.0 / 65536.0;
 
 impl<S: Sample> Quantizer<S> {
     /// `bits` in `2..=32`, `full_scale` finite and > 0 (in the signal's unit).
@@ -26,12 +38,23 @@ impl<S: Sample> Quantizer<S> {
         let fs = error::positive(STAGE, "full_scale", full_scale)?;
         let half_codes = (1u64 << (bits - 1)) as f64;
         let step = fs / half_codes; // exact: division by a power of two
+        let inv = 1.0 / step;
         Ok(Self {
             bits,
             step_f64: step,
             step: S::splat(step),
             code_lo: S::splat(-half_codes),
             code_hi: S::splat(half_codes - 1.0),
+            inv_step: S::splat(inv),
+            // Off (no |p| is >= inf) where the reciprocal is not normal (a step beyond
+            // 2^1022 or a tiny one): the proof needs its relative error <= 2^-53.
+            fast_lo: S::splat(if inv.is_normal() {
+                0.5 + MARGIN
+            } else {
+                f64::INFINITY
+            }),
+            tie_lo: S::splat(-(0.5 - MARGIN)),
+            tie_hi: S::splat(0.5 - MARGIN),
         })
     }
 
@@ -65,6 +88,41 @@ impl<S: Sample> Quantizer<S> {
         let y = kept * self.step;
         *zeros += y.flag_eq(S::splat(0.0));
         y
+    }
+
+    /// [`Quantizer::quantize_counting`]'s bits and counts without its division where it can:
+    /// `p = x * (1/step)` rounded to its code `c` is the answer when every lane has
+    /// `1/2 + m <= |p| <= hi` (`hi` the top code) and `|p - c| <= 1/2 - m` (m = 2^-16);
+    /// any other lane (a zero or clipped code, a near-tie, a NaN) sends the whole group
+    /// through the division, whose counts are then added.
+    ///
+    /// Why that is exact: with `u = 2^-53`, `p = q (1 + a)(1 + b)` and the division's
+    /// `d = q (1 + e)` for `q = x / step` (`|a|, |b|, |e| <= u`; both normal, as
+    /// `|p| >= 1/2`), so `|p - d| <= 3.01 u |q| < 2^-20` for `|p| < 2^31`. `p` lies at least
+    /// `m` from every half-integer (the nearest are `c +- 1/2`), so `d`, within 2^-20 of it,
+    /// rounds to the same `c`. `1 <= |c| <= hi`: inside the end codes (the clamp keeps it)
+    /// and not zero (`c * step` is not 0: `|c * step| >= step`), so both counts add 0.
+    /// `p - c` is exact (Sterbenz: `c/2 <= p <= 2c`).
+    #[inline(always)]
+    pub fn quantize_counting_fast(&self, x: S, clipped: &mut S, zeros: &mut S) -> S {
+        match self.quantize_by_product(x) {
+            Some(y) => y,
+            None => {
+                core::hint::cold_path();
+                self.quantize_counting(x, clipped, zeros)
+            }
+        }
+    }
+
+    /// The fast path of [`Quantizer::quantize_counting_fast`]: the output when every lane is
+    /// clear of the zero code, the end codes and a tie, else `None`.
+    #[inline(always)]
+    pub fn quantize_by_product(&self, x: S) -> Option<S> {
+        let p = x * self.inv_step;
+        let code = p.round_away();
+        (p.abs().all_within(self.fast_lo, self.code_hi)
+            && (p - code).all_within(self.tie_lo, self.tie_hi))
+        .then(|| code * self.step)
     }
 }
 

@@ -180,6 +180,18 @@ impl Sample for F64x8 {
         unsafe { _mm512_fpclass_pd_mask::<0x99>(self.0) == 0 }
     }
     #[inline(always)]
+    fn abs(self) -> Self {
+        Self(unsafe { _mm512_abs_pd(self.0) })
+    }
+    #[inline(always)]
+    fn all_within(self, lo: Self, hi: Self) -> bool {
+        // Ordered comparisons (false in a NaN lane), the second under the first's mask.
+        unsafe {
+            let ge = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(self.0, lo.0);
+            _mm512_mask_cmp_pd_mask::<_CMP_LE_OQ>(ge, self.0, hi.0) == 0xFF
+        }
+    }
+    #[inline(always)]
     fn flag_eq(self, other: Self) -> Self {
         unsafe {
             let eq = _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(self.0, other.0);
@@ -254,7 +266,7 @@ mod tests {
             let four = |x: &[f64; 8], h: usize| f64x4::new(x[4 * h..4 * h + 4].try_into().unwrap());
             for h in 0..2 {
                 let (fa, fb, fc) = (four(&a, h), four(&b, h), four(&c, h));
-                let pairs: [(F64x8, f64x4); 12] = [
+                let pairs: [(F64x8, f64x4); 13] = [
                     (va + vb, fa + fb),
                     (va - vb, fa - fb),
                     (va * vb, fa * fb),
@@ -267,6 +279,7 @@ mod tests {
                     (va.flag_ne(vb), fa.flag_ne(fb)),
                     (va.flag_eq(va), fa.flag_eq(fa)),
                     (F64x8::load(&a), f64x4::load(&a[4 * h..])),
+                    (va.abs(), fa.abs()),
                 ];
                 for (k, (x8, x4)) in pairs.iter().enumerate() {
                     for l in 0..4 {
@@ -281,6 +294,11 @@ mod tests {
             }
             let finite = a.iter().all(|x| x.is_finite());
             assert_eq!(va.all_finite(), finite, "{a:?}");
+            let within = (0..8).all(|i| b[i] <= a[i] && a[i] <= c[i]);
+            assert_eq!(va.all_within(vb, vc), within, "{a:?} in [{b:?}, {c:?}]");
+            // Within its own bounds unless a lane is a NaN.
+            let numbers = a.iter().all(|x| !x.is_nan());
+            assert_eq!(va.all_within(va, va), numbers, "{a:?}");
         }
         assert!(F64x8::splat(1.5).all_finite());
         assert_eq!(F64x8::splat(-4.0).to_array(), [-4.0; 8]);

@@ -359,7 +359,11 @@ impl<S: Sample> Board<S> {
                         // The same bits as the DAC's tick, with its clipped and zero samples counted.
                         Some(q) if NOISY => {
                             let (clip, zeros) = counts.0.split_at_mut(DAC_ZERO);
-                            q.quantize_counting(drive[md], &mut clip[DAC_CLIP + md], &mut zeros[md])
+                            q.quantize_counting_fast(
+                                drive[md],
+                                &mut clip[DAC_CLIP + md],
+                                &mut zeros[md],
+                            )
                         }
                         _ => self.dac[md].tick(drive[md]),
                     };
@@ -417,7 +421,7 @@ impl<S: Sample> Board<S> {
                     if let Some(adc) = &self.adc {
                         let (clip, zeros) = c.split_at_mut(ADC_ZERO);
                         for md in 0..2 {
-                            y[md] = adc[md].quantize_counting(
+                            y[md] = adc[md].quantize_counting_fast(
                                 y[md],
                                 &mut clip[ADC_CLIP + md],
                                 &mut zeros[md],

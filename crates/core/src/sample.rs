@@ -38,6 +38,11 @@ pub trait Sample:
     fn round_away(self) -> Self;
     /// True when every lane is finite.
     fn all_finite(self) -> bool;
+    /// Lane-wise `|x|` (the sign bit cleared; a NaN stays a NaN).
+    fn abs(self) -> Self;
+    /// True when every lane lies in `[lo, hi]` (a NaN lane does not): a whole-group test
+    /// that keeps a rare case out of the per-sample path with one branch.
+    fn all_within(self, lo: Self, hi: Self) -> bool;
     /// 1.0 in the lanes where `self == other`, 0.0 elsewhere: a count a lane-parallel loop
     /// can add up without a branch (how often a converter clips, or outputs exact zeros).
     fn flag_eq(self, other: Self) -> Self;
@@ -98,6 +103,14 @@ impl Sample for f64 {
     #[inline(always)]
     fn all_finite(self) -> bool {
         self.is_finite()
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    #[inline(always)]
+    fn all_within(self, lo: Self, hi: Self) -> bool {
+        lo <= self && self <= hi
     }
     #[inline(always)]
     fn flag_eq(self, other: Self) -> Self {
@@ -167,6 +180,15 @@ impl Sample for f64x4 {
     #[inline(always)]
     fn all_finite(self) -> bool {
         self.is_finite().all()
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f64x4::abs(self)
+    }
+    #[inline(always)]
+    fn all_within(self, lo: Self, hi: Self) -> bool {
+        // Ordered comparisons: false in a NaN lane.
+        (self.simd_ge(lo) & self.simd_le(hi)).all()
     }
     #[inline(always)]
     fn flag_eq(self, other: Self) -> Self {
@@ -262,6 +284,44 @@ mod tests {
             assert_eq!(a[i].flag_eq(b[i]), want_eq[i], "scalar {i}");
             assert_eq!(a[i].flag_ne(b[i]), 1.0 - want_eq[i], "scalar {i}");
         }
+    }
+
+    #[test]
+    fn abs_and_all_within_match_scalar_lane_by_lane() {
+        let xs = [
+            0.0,
+            -0.0,
+            1.5,
+            -2.0,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            0.5,
+        ];
+        for rot in 0..8 {
+            let a: [f64; 4] = core::array::from_fn(|i| xs[(i + rot) % 8]);
+            let va = f64x4::from_fn(|i| a[i]);
+            for i in 0..4 {
+                assert_eq!(Sample::abs(va).lane(i).to_bits(), a[i].abs().to_bits());
+            }
+            for (lo, hi) in [
+                (-2.0, 1.5),
+                (0.0, 0.0),
+                (-0.0, 0.5),
+                (f64::NEG_INFINITY, f64::INFINITY),
+            ] {
+                let scalar = a.iter().all(|&x| x.all_within(lo, hi));
+                assert_eq!(scalar, a.iter().all(|&x| lo <= x && x <= hi));
+                assert_eq!(
+                    va.all_within(f64x4::splat(lo), f64x4::splat(hi)),
+                    scalar,
+                    "{a:?}"
+                );
+            }
+        }
+        // A NaN lies in no interval, not even the whole line.
+        assert!(!f64::NAN.all_within(f64::NEG_INFINITY, f64::INFINITY));
+        assert!((-0.0f64).all_within(0.0, 0.0));
     }
 
     #[test]
