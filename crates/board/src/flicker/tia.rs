@@ -61,9 +61,14 @@ impl<S: Sample> TiaBlock<S> {
             w: vec![F64x8::default(); cap],
             y: vec![F64x8::default(); cap],
         });
+        #[cfg(target_arch = "x86_64")]
+        let is_joined = joined.is_some();
         #[cfg(not(target_arch = "x86_64"))]
-        let (_, joined) = (f, None::<()>);
-        let own = if joined.is_some() { 0 } else { cap };
+        let is_joined = {
+            let _ = f;
+            false
+        };
+        let own = if is_joined { 0 } else { cap };
         Self {
             pairs: [vec![f64x4::ZERO; 2 * own], vec![f64x4::ZERO; 2 * own]],
             w: [vec![S::splat(0.0); own], vec![S::splat(0.0); own]],
