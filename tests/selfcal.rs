@@ -139,10 +139,12 @@ fn averaging_time_progress_ends_at_its_total_whatever_the_lane_groups() {
     // Five points on one thread: one lane group of eight where the CPU has AVX-512, two of
     // four elsewhere; the canonical grouping the results report is two of four either way.
     // Progress must count the groups that run: never past its total, and ending on it.
-    let c = fast_cfg(&[25.0, 50.0, 100.0, 150.0, 175.0], 0.4);
+    let c = fast_cfg(&[25.0, 50.0, 100.0, 150.0, 175.0], 2.0);
     let seen = std::sync::Mutex::new(Vec::new());
     let record = |d: u64, t: u64| seen.lock().unwrap().push((d, t));
-    tau_analysis(&c, 0.4, 1.0, 1.0, 1.0, Some(1), &record).unwrap();
+    // 2 s: the shortest averaging-time run validation lets through.
+    let taus = tau_analysis(&c, 2.0, 1.0, 1.0, 1.0, Some(1), &record).unwrap();
+    assert_eq!(taus.len(), 2, "read at 1 and 2 s: {taus:?}");
     let seen = seen.into_inner().unwrap();
     let &(last, total) = seen.last().expect("the run reports progress");
     assert!(seen.iter().all(|&(d, t)| t == total && d <= t), "{seen:?}");
