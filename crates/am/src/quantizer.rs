@@ -91,7 +91,8 @@ impl<S: Sample> Quantizer<S> {
     }
 
     /// [`Quantizer::quantize_counting`]'s bits and counts without its division where it can:
-    /// `p = x * (1/step)` rounded to its code `c` is the answer when every lane has
+    /// `p = x * (1/step)` rounded to its code `c` (to nearest, one instruction: a lane it
+    /// keeps is never near a tie, so how ties go does not matter) is the answer when every lane has
     /// `1/2 + m <= |p| <= hi` (`hi` the top code) and `|p - c| <= 1/2 - m` (m = 2^-16);
     /// any other lane (a zero or clipped code, a near-tie, a NaN) sends the whole group
     /// through the division, whose counts are then added.
@@ -119,7 +120,7 @@ impl<S: Sample> Quantizer<S> {
     #[inline(always)]
     pub fn quantize_by_product(&self, x: S) -> Option<S> {
         let p = x * self.inv_step;
-        let code = p.round_away();
+        let code = p.round_even();
         (p.abs().all_within(self.fast_lo, self.code_hi)
             && (p - code).all_within(self.tie_lo, self.tie_hi))
         .then(|| code * self.step)

@@ -174,6 +174,12 @@ impl Sample for F64x8 {
         Self(unsafe { _mm512_roundscale_pd::<{ _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC }>(s.0) })
     }
     #[inline(always)]
+    fn round_even(self) -> Self {
+        Self(unsafe {
+            _mm512_roundscale_pd::<{ _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC }>(self.0)
+        })
+    }
+    #[inline(always)]
     fn all_finite(self) -> bool {
         // The lanes classed as a NaN (quiet 0x01, signalling 0x80) or an infinity (+ 0x08,
         // - 0x10).
@@ -266,7 +272,7 @@ mod tests {
             let four = |x: &[f64; 8], h: usize| f64x4::new(x[4 * h..4 * h + 4].try_into().unwrap());
             for h in 0..2 {
                 let (fa, fb, fc) = (four(&a, h), four(&b, h), four(&c, h));
-                let pairs: [(F64x8, f64x4); 13] = [
+                let pairs: [(F64x8, f64x4); 14] = [
                     (va + vb, fa + fb),
                     (va - vb, fa - fb),
                     (va * vb, fa * fb),
@@ -275,6 +281,7 @@ mod tests {
                     (va.mul_add(vb, vc), fa.mul_add(fb, fc)),
                     (va.clamp_to(vb, vc), fa.clamp_to(fb, fc)),
                     (va.round_away(), fa.round_away()),
+                    (va.round_even(), fa.round_even()),
                     (va.flag_eq(vb), fa.flag_eq(fb)),
                     (va.flag_ne(vb), fa.flag_ne(fb)),
                     (va.flag_eq(va), fa.flag_eq(fa)),
@@ -305,10 +312,11 @@ mod tests {
         assert_eq!(F64x8::default().to_array().map(bits), [0; 8]);
     }
 
-    /// The round-half-away rule against `f64::round` on a seeded sweep of halves, near-halves
-    /// and wide magnitudes (the edge cases are in the test above).
+    /// The round-half-away rule against `f64::round`, and round-to-even against
+    /// `f64::round_ties_even`, on a seeded sweep of halves, near-halves and wide magnitudes
+    /// (the edge cases are in the test above).
     #[test]
-    fn round_away_is_f64_round_on_a_seeded_sweep() {
+    fn roundings_are_f64_round_and_round_ties_even_on_a_seeded_sweep() {
         if !available() {
             eprintln!("no AVX-512 on this CPU: the eight-lane type is not used here");
             return;
@@ -326,9 +334,12 @@ mod tests {
                 (u * scale).trunc() + 0.5 * u.signum()
             };
             if k % 8 == 7 {
-                let r = F64x8::from_array(xs).round_away();
+                let v = F64x8::from_array(xs);
+                let (r, e) = (v.round_away(), v.round_even());
                 for (l, x) in xs.iter().enumerate() {
                     assert_eq!(r.lane(l).to_bits(), x.round().to_bits(), "x = {x:e}");
+                    let even = x.round_ties_even().to_bits();
+                    assert_eq!(e.lane(l).to_bits(), even, "x = {x:e}");
                 }
             }
         }

@@ -80,6 +80,9 @@ fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
             _mm512_slli_epi64::<4>(_mm512_and_si512(w, k.index)),
         )
     };
+    // Through memory: read back as eight scalar loads rather than the extracts LLVM makes of
+    // the register (two of each lane's three operations were shuffles).
+    let off = core::hint::black_box(off);
     let base = FAST.0.as_ptr() as *const u8;
     // SAFETY: every offset is below 16 N, inside the table of N pairs.
     let p = |k: usize| unsafe { _mm_loadu_pd(base.add(off[k] as usize).cast()) };
@@ -94,7 +97,9 @@ fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
         _mm512_and_si512(w, k.sign_bit),
         _mm_cvtsi32_si128(SIGN_SHIFT as i32),
     );
-    let x = _mm512_mul_pd(_mm512_sub_pd(b, _mm512_set1_pd(1.0)), width);
+    // b * width - width with one rounding is (b - 1) * width rounded (b - 1 is exact): the
+    // portable path's bits in one instruction.
+    let x = _mm512_fmsub_pd(b, width, width);
     let x = _mm512_castsi512_pd(_mm512_or_si512(_mm512_castpd_si512(x), sign));
     let core = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(b, bound);
     assert!(pair.len() == 2);

@@ -36,6 +36,9 @@ pub trait Sample:
     fn clamp_to(self, lo: Self, hi: Self) -> Self;
     /// Lane-wise round half away from zero.
     fn round_away(self) -> Self;
+    /// Lane-wise round to nearest, ties to even: one instruction where the caller has
+    /// already kept every lane off a tie (then it equals [`Sample::round_away`]).
+    fn round_even(self) -> Self;
     /// True when every lane is finite.
     fn all_finite(self) -> bool;
     /// Lane-wise `|x|` (the sign bit cleared; a NaN stays a NaN).
@@ -99,6 +102,10 @@ impl Sample for f64 {
     #[inline(always)]
     fn round_away(self) -> Self {
         self.round()
+    }
+    #[inline(always)]
+    fn round_even(self) -> Self {
+        self.round_ties_even()
     }
     #[inline(always)]
     fn all_finite(self) -> bool {
@@ -167,8 +174,8 @@ impl Sample for f64x4 {
     }
     #[inline(always)]
     fn round_away(self) -> Self {
-        // f64x4::round rounds half to even; match f64::round (half away from zero) without a
-        // libm call per lane: trunc(x + copysign(1/2 - 2^-54, x)). The addend just below 1/2
+        // f64::round (half away from zero) in four vector operations, without a libm call
+        // per lane: trunc(x + copysign(1/2 - 2^-54, x)). The addend just below 1/2
         // makes the sum reach the next integer exactly when |x| has a fraction of 1/2 or more
         // (a sum that lands within half an ulp of it rounds there), never below (so
         // 0.49999999999999994 stays 0). From 2^52 up every f64 is an integer and the addend is
@@ -176,6 +183,10 @@ impl Sample for f64x4 {
         // gives -0.0 as f64::round does). LLVM lowers f64::round itself this way.
         let half = f64x4::splat(0.499_999_999_999_999_94) | (self & f64x4::splat(-0.0));
         (self + half).trunc()
+    }
+    #[inline(always)]
+    fn round_even(self) -> Self {
+        f64x4::round_ties_even(self)
     }
     #[inline(always)]
     fn all_finite(self) -> bool {
@@ -325,7 +336,7 @@ mod tests {
     }
 
     #[test]
-    fn vector_round_away_is_f64_round_on_ties_edges_and_a_seeded_sweep() {
+    fn vector_roundings_are_f64_round_and_round_ties_even_on_ties_edges_and_a_seeded_sweep() {
         let mut xs = vec![
             0.5,
             -0.5,
@@ -358,14 +369,24 @@ mod tests {
         }
         for c in xs.chunks(4) {
             let v = f64x4::from_fn(|i| c[i % c.len()]);
-            let r = v.round_away();
+            let (r, e) = (v.round_away(), v.round_even());
             for i in 0..4 {
                 let x = c[i % c.len()];
                 assert_eq!(r.lane(i).to_bits(), x.round().to_bits(), "x = {x:e}");
+                let even = x.round_ties_even();
+                assert_eq!(e.lane(i).to_bits(), even.to_bits(), "x = {x:e}");
+                assert_eq!(Sample::round_even(x).to_bits(), even.to_bits(), "x = {x:e}");
             }
         }
+        // The two rules part only at a tie: 2.5 goes to 2 by one, to 3 by the other.
+        assert_eq!(f64x4::splat(2.5).round_even().lane(0), 2.0);
+        assert_eq!(
+            f64x4::splat(-0.5).round_even().lane(0).to_bits(),
+            (-0.0f64).to_bits()
+        );
         let n = f64x4::splat(f64::NAN).round_away();
         assert!(n.lane(0).is_nan());
+        assert!(f64x4::splat(f64::NAN).round_even().lane(0).is_nan());
     }
 
     #[test]
