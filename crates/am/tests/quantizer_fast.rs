@@ -137,15 +137,21 @@ fn fast_path_equals_the_division_in_scalar_and_four_lanes() {
 }
 
 #[test]
-fn the_product_serves_clear_inputs_and_leaves_edges_to_the_division() {
+fn the_product_serves_clear_inputs_and_zeros_and_leaves_edges_to_the_division() {
     let q = Quantizer::<f64>::new(16, 1.5).unwrap();
     let step = q.step();
-    // 0.3 V is code 4369.07: clear of every edge.
-    assert_eq!(q.quantize_by_product(0.3), Some(q.quantize(0.3)));
+    // 0.3 V is code 4369.07: clear of every edge, not zero.
+    assert_eq!(q.quantize_by_product(0.3), Some((q.quantize(0.3), 0.0)));
+    // The zero code stays on the product, flagged, with the sign of zero the division gives.
+    for zero in [0.0, -0.0, 0.25 * step, -0.25 * step, 1e-310, -5e-324] {
+        let (y, flag) = q.quantize_by_product(zero).expect("a zero code");
+        assert_eq!(y.to_bits(), q.quantize(zero).to_bits(), "x = {zero:e}");
+        assert_eq!(flag, 1.0, "x = {zero:e}");
+    }
+    // Ties (of the zero code too), clipped codes and a NaN go to the division.
     for edge in [
-        0.0,
-        -0.0,
-        0.25 * step,
+        0.5 * step,
+        -0.5 * step,
         100.5 * step,
         -7.5 * step,
         2.0,
@@ -154,8 +160,8 @@ fn the_product_serves_clear_inputs_and_leaves_edges_to_the_division() {
     ] {
         assert_eq!(q.quantize_by_product(edge), None, "x = {edge:e}");
     }
-    // Almost every input of a 16-bit converter's range takes the product (zero code 2^-16,
-    // near-ties 2^-15 of them).
+    // Almost every input of a 16-bit converter's range takes the product (near-ties 2^-15
+    // of them).
     let mut s = 7;
     let n = 100_000;
     let fast = (0..n)
@@ -165,15 +171,18 @@ fn the_product_serves_clear_inputs_and_leaves_edges_to_the_division() {
         })
         .count();
     assert!(fast > n * 999 / 1000, "{fast} of {n}");
-    // One lane at an edge sends its group to the division.
+    // A zero lane is flagged in its own lane; one lane at an edge sends its group to the
+    // division.
     let q4 = Quantizer::<f64x4>::new(16, 1.5).unwrap();
-    assert!(q4
-        .quantize_by_product(f64x4::new([0.3, -0.7, 0.9, 0.11]))
-        .is_some());
-    assert!(q4
+    let (_, flags) = q4
         .quantize_by_product(f64x4::new([0.3, -0.7, 0.0, 0.11]))
+        .expect("clear and zero lanes");
+    assert_eq!(flags.to_array(), [0.0, 0.0, 1.0, 0.0]);
+    assert!(q4
+        .quantize_by_product(f64x4::new([0.3, -0.7, 7.5 * step, 0.11]))
         .is_none());
     // A step whose reciprocal is not normal turns the product off.
     let wide = Quantizer::<f64>::new(2, 1.7e308).unwrap();
     assert_eq!(wide.quantize_by_product(1e308), None);
+    assert_eq!(wide.quantize_by_product(0.0), None);
 }
