@@ -20,7 +20,6 @@ pub struct Quantizer<S> {
     /// (`1/2 - MARGIN`).
     inv_step: S,
     fast_hi: S,
-    tie_lo: S,
     tie_hi: S,
 }
 
@@ -53,7 +52,6 @@ impl<S: Sample> Quantizer<S> {
             } else {
                 -1.0
             }),
-            tie_lo: S::splat(-(0.5 - MARGIN)),
             tie_hi: S::splat(0.5 - MARGIN),
         })
     }
@@ -131,9 +129,8 @@ impl<S: Sample> Quantizer<S> {
     pub fn quantize_by_product(&self, x: S) -> Option<(S, S)> {
         let p = x * self.inv_step;
         let code = p.round_even();
-        ((p - code).all_within(self.tie_lo, self.tie_hi)
-            && p.abs().all_within(S::splat(0.0), self.fast_hi))
-        .then(|| {
+        // `&`, not `&&`: both tests, then one branch.
+        ((p - code).abs().all_le(self.tie_hi) & p.abs().all_le(self.fast_hi)).then(|| {
             let y = code * self.step;
             (y, y.flag_eq(S::splat(0.0)))
         })
