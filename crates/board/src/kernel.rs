@@ -416,7 +416,9 @@ impl<S: Sample> Board<S> {
                 if NOISY {
                     let c = &mut counts.0;
                     for md in 0..2 {
-                        c[TIA_RAIL + md] += self.tia[md].rail_flags(y[md]);
+                        if self.tia[md].has_rails() {
+                            c[TIA_RAIL + md] += self.tia[md].rail_flags(y[md]);
+                        }
                     }
                     if let Some(adc) = &self.adc {
                         let (clip, zeros) = c.split_at_mut(ADC_ZERO);

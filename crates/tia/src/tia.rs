@@ -108,6 +108,12 @@ impl Tia<f64> {
 }
 
 impl<S: Sample> Tia<S> {
+    /// The TIA has output rails (else its rail count stays 0, and a loop can skip it).
+    #[inline(always)]
+    pub fn has_rails(&self) -> bool {
+        self.has_rails
+    }
+
     /// 1.0 in the lanes where the output `y` of [`Stage::tick`] sits on a rail (clamped), 0.0
     /// elsewhere and always without rails: a count of saturated samples.
     #[inline(always)]
