@@ -98,16 +98,16 @@ impl<S: Sample> Quantizer<S> {
     /// board samples its carrier at the carrier's exact zeros (2 samples in 16 at
     /// fs = 16 f0), so an AM drive hands the DAC an exact 0 that often.
     ///
-    /// Why that is exact: with `u = 2^-53`, `p = q (1 + a)(1 + b)` and the division's
-    /// `d = q (1 + e)` for `q = x / step` (`|a|, |b|, |e| <= u`; both normal, as
-    /// `|p| >= 1/2`), so `|p - d| <= 3.01 u |q| < 2^-20` for `|p| < 2^31`. `p` lies at least
-    /// `m` from every half-integer (the nearest are `c +- 1/2`), so `d`, within 2^-20 of it,
-    /// rounds to the same `c`. `1 <= |c| <= hi`: inside the end codes (the clamp keeps it)
-    /// and not zero (`c * step` is not 0: `|c * step| >= step`), so both counts add 0.
-    /// `p - c` is exact (Sterbenz: `c/2 <= p <= 2c`). A lane with `c = 0` has
-    /// `|p| <= 1/2 - m`, so `|d| < 1/2` (by the bound above, or by an absolute error below
-    /// 2^-1074 where either is subnormal): the division's code is 0 as well, of the same sign
-    /// (both keep the sign of `x`), so both give `+-0 * step` and count one zero.
+    /// Why that is exact, for a lane with `c != 0`: with `u = 2^-53`, `p = q (1 + a)(1 + b)`
+    /// and the division's `d = q (1 + e)` for `q = x / step` (`|a|, |b|, |e| <= u`; both
+    /// normal, as `|p| >= 1/2`), so `|p - d| <= 3.01 u |q| < 2^-20` for `|p| < 2^31`. `p` lies
+    /// at least `m` from every half-integer (the nearest are `c +- 1/2`), so `d`, within
+    /// 2^-20 of it, rounds to the same `c`. `1 <= |c| <= hi`: inside the end codes (the clamp
+    /// keeps it) and not zero (`|c * step| >= step`), so both count nothing. `p - c` is exact
+    /// (Sterbenz: `c/2 <= p <= 2c`). For a lane with `c = 0`: `|p| <= 1/2 - m`, so
+    /// `|d| < 1/2` (by the same bound, or by an absolute error below 2^-1074 where either is
+    /// subnormal), and the division's code is 0 too, with the same sign (both keep the sign
+    /// of `x`): both give `+-0 * step`, and both count one zero.
     #[inline(always)]
     pub fn quantize_counting_fast(&self, x: S, clipped: &mut S, zeros: &mut S) -> S {
         match self.quantize_by_product(x) {

@@ -80,8 +80,8 @@ fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
             _mm512_slli_epi64::<4>(_mm512_and_si512(w, k.index)),
         )
     };
-    // Through memory: read back as eight scalar loads rather than the extracts LLVM makes of
-    // the register (two of each lane's three operations were shuffles).
+    // Through memory: read back as eight scalar loads. Without the barrier LLVM pulls the
+    // offsets out of the register with eleven extract instructions instead.
     let off = core::hint::black_box(off);
     let base = FAST.0.as_ptr() as *const u8;
     // SAFETY: every offset is below 16 N, inside the table of N pairs.
