@@ -36,7 +36,7 @@ impl<S: Sample> Quantizer<S> {
         }
         let fs = error::positive(STAGE, "full_scale", full_scale)?;
         let half_codes = (1u64 << (bits - 1)) as f64;
-        let step = fs / half_codes; // exact: division by a power of two
+        let step = fs / half_codes; // exact (a power of two) unless the step is subnormal
         let inv = 1.0 / step;
         Ok(Self {
             bits,
@@ -89,11 +89,13 @@ impl<S: Sample> Quantizer<S> {
     }
 
     /// [`Quantizer::quantize_counting`]'s bits and counts without its division where it can:
-    /// `p = x * (1/step)` rounded to its code `c` (to nearest, one instruction: a lane it
-    /// keeps is never near a tie, so how ties go does not matter) is the answer when every
-    /// lane has `|p - c| <= 1/2 - m` (m = 2^-16) and `|p| <= hi` (`hi` the top code); the
-    /// lanes whose output is zero are counted. Any other lane (a clipped code, a near-tie, a
-    /// NaN) sends the whole group through the division, whose counts are then added. Zero
+    /// `p = x * (1/step)` rounded to its code `c` (to nearest, ties to even: one instruction
+    /// in the x86-64-v3 build, and a lane it keeps is never near a tie) is the answer when
+    /// every lane has `|p - c| <= 1/2 - m` (m = 2^-16) and `|p| <= hi` (`hi` the top code);
+    /// the lanes whose output is zero are counted. Any other lane (a near-tie, a NaN, `|p|`
+    /// beyond the top code, which takes the bottom code and every clipped one) sends the
+    /// whole group through the division, whose counts are then added, as does every lane
+    /// where `1/step` is not normal. Zero
     /// codes stay on the product, counted without a branch, because they are common: a
     /// board samples its carrier at the carrier's exact zeros (2 samples in 16 at
     /// fs = 16 f0), so an AM drive hands the DAC an exact 0 that often.

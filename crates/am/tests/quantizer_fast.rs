@@ -68,7 +68,19 @@ fn inputs(q: &Quantizer<f64>, seed: u64) -> Vec<f64> {
         nudged(&mut v, (k + 0.5) * step);
         nudged(&mut v, k * step);
     }
-    for edge in [half - 1.0, half - 0.5, half, -half, -half - 0.5, 0.5, -0.5] {
+    // ... and the fast path's own bounds: its tie margin around the zero code.
+    let margin = 0.5 - 1.0 / 65536.0;
+    for edge in [
+        half - 1.0,
+        half - 0.5,
+        half,
+        -half,
+        -half - 0.5,
+        0.5,
+        -0.5,
+        margin,
+        -margin,
+    ] {
         nudged(&mut v, edge * step);
     }
     v.extend([
@@ -181,8 +193,12 @@ fn the_product_serves_clear_inputs_and_zeros_and_leaves_edges_to_the_division() 
     assert!(q4
         .quantize_by_product(f64x4::new([0.3, -0.7, 7.5 * step, 0.11]))
         .is_none());
-    // A step whose reciprocal is not normal turns the product off.
+    // A step whose reciprocal is not normal (subnormal, or infinite) turns the product off.
     let wide = Quantizer::<f64>::new(2, 1.7e308).unwrap();
     assert_eq!(wide.quantize_by_product(1e308), None);
     assert_eq!(wide.quantize_by_product(0.0), None);
+    let tiny = Quantizer::<f64>::new(32, 1e-300).unwrap();
+    assert!(tiny.step() < f64::MIN_POSITIVE && (1.0 / tiny.step()).is_infinite());
+    assert_eq!(tiny.quantize_by_product(1e-305), None);
+    assert_eq!(tiny.quantize_by_product(0.0), None);
 }

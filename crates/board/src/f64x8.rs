@@ -352,4 +352,69 @@ mod tests {
         let v = F64x8::with_target_features(|| (F64x8::splat(3.0) * F64x8::splat(0.5)).lane(7));
         assert_eq!(v, 1.5);
     }
+
+    /// The quantiser's product path in eight lanes against its division, lane by lane and
+    /// count by count, on groups that mix clear lanes with zeros, near-ties, end codes and
+    /// special values (the four-lane and scalar paths: `crates/am/tests/quantizer_fast.rs`).
+    #[test]
+    fn the_quantiser_fast_path_in_eight_lanes_is_the_division() {
+        use gyroemu_am::Quantizer;
+        if !available() {
+            eprintln!("no AVX-512 on this CPU: the eight-lane type is not used here");
+            return;
+        }
+        let mut s = 0x5eed_0f8a_11e5_u64;
+        let mut next = move || {
+            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let z = (s ^ (s >> 31)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z ^ (z >> 29)
+        };
+        for (bits, fs) in [(16, 1.5), (16, 0.05), (3, 1.0), (24, 3.3), (32, 1e-300)] {
+            let q8 = Quantizer::<F64x8>::new(bits, fs).unwrap();
+            let q1 = Quantizer::<f64>::new(bits, fs).unwrap();
+            let (step, half) = (q1.step(), (1u64 << (bits - 1)) as f64);
+            let edges = [0.0, -0.0, 0.5, -0.5, half - 0.5, half, -half, f64::NAN];
+            let [mut c_fast, mut z_fast, mut c_div, mut z_div] = [F64x8::splat(0.0); 4];
+            for _ in 0..20_000 {
+                let x: [f64; 8] = core::array::from_fn(|_| {
+                    let r = next();
+                    let ulps = (r >> 60) as i64 - 8;
+                    let code = match r % 8 {
+                        // A clear lane, most of the time.
+                        0..=4 => ((r >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * half,
+                        5 => ((r >> 20) % 7) as f64 - 3.0 + 0.5,
+                        _ => edges[((r >> 20) % 8) as usize],
+                    };
+                    let x = code * step;
+                    let moved = f64::from_bits((x.to_bits() as i64 + ulps) as u64);
+                    if x == 0.0 || !x.is_finite() {
+                        x
+                    } else {
+                        moved
+                    }
+                });
+                let v = F64x8::from_array(x);
+                let fast = q8.quantize_counting_fast(v, &mut c_fast, &mut z_fast);
+                let div = q8.quantize_counting(v, &mut c_div, &mut z_div);
+                for l in 0..8 {
+                    assert_eq!(fast.lane(l).to_bits(), div.lane(l).to_bits(), "{x:?}");
+                    assert_eq!(div.lane(l).to_bits(), q1.quantize(x[l]).to_bits(), "{x:?}");
+                }
+            }
+            assert_eq!(
+                c_fast.to_array(),
+                c_div.to_array(),
+                "{bits} bits: clip counts"
+            );
+            assert_eq!(
+                z_fast.to_array(),
+                z_div.to_array(),
+                "{bits} bits: zero counts"
+            );
+            assert!(
+                z_div.to_array().iter().all(|&z| z > 100.0),
+                "zeros are exercised"
+            );
+        }
+    }
 }

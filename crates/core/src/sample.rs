@@ -36,8 +36,9 @@ pub trait Sample:
     fn clamp_to(self, lo: Self, hi: Self) -> Self;
     /// Lane-wise round half away from zero.
     fn round_away(self) -> Self;
-    /// Lane-wise round to nearest, ties to even: one instruction where the caller has
-    /// already kept every lane off a tie (then it equals [`Sample::round_away`]).
+    /// Lane-wise round to nearest, ties to even: one instruction in the x86-64-v3 build
+    /// (SSE4.1 and AVX), for a caller that has kept every lane off a tie (where it equals
+    /// [`Sample::round_away`]).
     fn round_even(self) -> Self;
     /// True when every lane is finite.
     fn all_finite(self) -> bool;
