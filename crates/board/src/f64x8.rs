@@ -228,6 +228,15 @@ mod tests {
     use super::*;
     use gyroemu_core::f64x4;
 
+    /// True (and says so) on a CPU without AVX-512, where the eight-lane type is not used.
+    fn skip_without_avx512() -> bool {
+        if available() {
+            return false;
+        }
+        eprintln!("no AVX-512 on this CPU: the eight-lane type is not used here");
+        true
+    }
+
     /// Values that exercise every rule: ties, signed zeros, NaN, infinities, subnormals,
     /// huge and tiny magnitudes.
     const XS: [f64; 16] = [
@@ -252,8 +261,7 @@ mod tests {
     /// Each lane of every operation against f64x4's lane (itself tested against f64).
     #[test]
     fn every_operation_has_the_bits_of_f64x4_in_every_lane() {
-        if !available() {
-            eprintln!("no AVX-512 on this CPU: the eight-lane type is not used here");
+        if skip_without_avx512() {
             return;
         }
         let bits = |v: f64| v.to_bits();
@@ -314,8 +322,7 @@ mod tests {
     /// (the edge cases are in the test above).
     #[test]
     fn roundings_are_f64_round_and_round_ties_even_on_a_seeded_sweep() {
-        if !available() {
-            eprintln!("no AVX-512 on this CPU: the eight-lane type is not used here");
+        if skip_without_avx512() {
             return;
         }
         let mut s = 0x0123_4567_89ab_cdefu64;
@@ -345,8 +352,7 @@ mod tests {
     /// The loop entry runs its closure compiled for AVX-512 and returns its value.
     #[test]
     fn the_loop_entry_runs_its_closure() {
-        if !available() {
-            eprintln!("no AVX-512 on this CPU: the eight-lane type is not used here");
+        if skip_without_avx512() {
             return;
         }
         let v = F64x8::with_target_features(|| (F64x8::splat(3.0) * F64x8::splat(0.5)).lane(7));
@@ -359,8 +365,7 @@ mod tests {
     #[test]
     fn the_quantiser_fast_path_in_eight_lanes_is_the_division() {
         use gyroemu_am::Quantizer;
-        if !available() {
-            eprintln!("no AVX-512 on this CPU: the eight-lane type is not used here");
+        if skip_without_avx512() {
             return;
         }
         let mut s = 0x5eed_0f8a_11e5_u64;
