@@ -48,7 +48,6 @@ impl LaneRng {
             rng.fill_pairs(&mut p[..2 * n]);
         }
         let [lo, hi] = &pairs;
-        let hi = if sets == 1 { lo } else { hi };
         for (k, wk) in w.iter_mut().enumerate() {
             *wk = lanes(lo[2 * k], hi[2 * k]);
         }
