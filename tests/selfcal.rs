@@ -55,7 +55,15 @@ fn drift_selfcal_tracks_the_scale_factor_and_a_stale_one_misses_by_the_q_over_f0
         .coriolis
         .slope_deg_per_dps;
     let deltas = [-30.0, 40.0];
-    let d = drift_analysis(&c, &deltas, nominal, None, &quiet).unwrap();
+    let seen = std::sync::Mutex::new(Vec::new());
+    let record = |d: u64, t: u64| seen.lock().unwrap().push((d, t));
+    let d = drift_analysis(&c, &deltas, nominal, None, &record).unwrap();
+    // The offsets and their four sweeps run side by side: progress still never passes its
+    // total and ends on it.
+    let seen = seen.into_inner().unwrap();
+    let &(last, total) = seen.iter().max().expect("the scenario reports progress");
+    assert!(seen.iter().all(|&(d, t)| t == total && d <= t), "{seen:?}");
+    assert_eq!(last, total, "the scenario ended at {last} of {total}");
     for (p, dt) in d.iter().zip(deltas) {
         // PLL-tracked: the carrier sits on the drifted resonance.
         let pll = p.pll.as_ref().expect("the default loop fits this board");

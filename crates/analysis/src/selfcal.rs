@@ -257,9 +257,13 @@ pub fn run_selfcal_core(
         };
         finish_sweep(c, &run_sweep_with(c, progress, None, opts)?.lanes)
     };
-    let rotating = sweep(&rot_cfg, rot_progress)?;
-    let coriolis = sweep(&cor_cfg, cor_progress)?;
-    Ok(SelfcalCore::from_sweeps(cfg, rotating, coriolis))
+    // Side by side: each sweep may be a single lane group (one thread), and neither needs
+    // the other. A rotating failure is reported first, as in sequence.
+    let (rotating, coriolis) = rayon::join(
+        || sweep(&rot_cfg, rot_progress),
+        || sweep(&cor_cfg, cor_progress),
+    );
+    Ok(SelfcalCore::from_sweeps(cfg, rotating?, coriolis?))
 }
 
 impl SelfcalCore {

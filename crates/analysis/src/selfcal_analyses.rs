@@ -226,6 +226,7 @@ pub fn tau_analysis(
     let results: Vec<Result<Vec<Vec<LaneResult>>, SweepError>> = boards
         .into_par_iter()
         .zip(groups.par_iter())
+        .with_max_len(1)
         .map(|(mut board, (first, g))| {
             let early_reads = (0..g.len())
                 .map(|i| {
@@ -351,20 +352,23 @@ pub fn drift_analysis(
     let design = drift_pll_design(cfg);
     let tracked_too = design.validate().is_ok();
     let (held, _) = resolve_lock(cfg)?;
-    let n = deltas_k.len() as u64;
-    // Progress in thousandths of each offset (two self-calibrations of two sweeps), summed
-    // over the offsets, which run side by side.
-    let parts: Vec<AtomicU64> = deltas_k.iter().map(|_| AtomicU64::new(0)).collect();
+    // Progress in thousandths of each offset (two self-calibrations of two sweeps, a quarter
+    // each; the tracked half only when a loop fits), summed over the offsets and quarters,
+    // which all run side by side.
+    let total = deltas_k.len() as u64 * if tracked_too { 1000 } else { 500 };
+    let parts: Vec<[AtomicU64; 4]> = deltas_k.iter().map(|_| Default::default()).collect();
     let one = |(i, &dt): (usize, &f64)| -> Result<DriftPoint, SweepError> {
         let open = drifted(&held, dt);
-        let at = |quarter: u64, d: u64, t: u64| {
-            parts[i].store(quarter * 250 + d * 250 / t.max(1), Ordering::Relaxed);
-            progress(
-                parts.iter().map(|p| p.load(Ordering::Relaxed)).sum(),
-                n * 1000,
-            )
+        let at = |quarter: usize, d: u64, t: u64| {
+            parts[i][quarter].store(d * 250 / t.max(1), Ordering::Relaxed);
+            let sum = parts
+                .iter()
+                .flatten()
+                .map(|p| p.load(Ordering::Relaxed))
+                .sum();
+            progress(sum, total)
         };
-        let case = |c: &Config, q0: u64| -> Result<DriftCase, SweepError> {
+        let case = |c: &Config, q0: usize| -> Result<DriftCase, SweepError> {
             let core = run_selfcal_core(
                 c,
                 &|d, t| at(q0, d, t),
@@ -381,15 +385,19 @@ pub fn drift_analysis(
                 combined_selfcal_relative_error: core.combined.relative_error,
             })
         };
-        let open_loop = case(&open, 0)?;
-        let (pll, pll_lock_time_s) = if tracked_too {
+        // The tracked case needs the lock, not the open-loop case: the two run side by side.
+        let tracked = || -> Result<(Option<DriftCase>, Option<f64>), SweepError> {
+            if !tracked_too {
+                return Ok((None, None));
+            }
             let lock = lock_config_carrier(&open, &design)?.expect("the design has a [pll]");
             let mut tracked = open.clone();
             tracked.drive.carrier_hz = Some(lock.carrier_hz);
-            (Some(case(&tracked, 2)?), lock.lock_time_s)
-        } else {
-            (None, None)
+            Ok((Some(case(&tracked, 2)?), lock.lock_time_s))
         };
+        let (open_loop, tracked) = rayon::join(|| case(&open, 0), tracked);
+        let open_loop = open_loop?;
+        let (pll, pll_lock_time_s) = tracked?;
         Ok(DriftPoint {
             delta_t_k: dt,
             f0_hz: open.device.f0_hz,
@@ -400,7 +408,14 @@ pub fn drift_analysis(
         })
     };
     // Each offset's sweeps are lane groups of a few seconds: run side by side they fill the
-    // threads the longer analyses leave ([`crate::selfcal_run`]). Results keep the offsets'
-    // order and bits (a point's bits do not depend on its group or thread).
-    deltas_k.par_iter().enumerate().map(one).collect()
+    // threads the longer analyses leave ([`crate::selfcal_run`]). One offset per task: rayon
+    // would otherwise hand a thread busy since the start several offsets as one task, which
+    // the other thread, once free, cannot take from it. Results keep the offsets' order and
+    // bits (a point's bits do not depend on its group or thread).
+    deltas_k
+        .par_iter()
+        .with_max_len(1)
+        .enumerate()
+        .map(one)
+        .collect()
 }

@@ -108,6 +108,7 @@ pub fn run_stepped_sine(cfg: &Config, progress: Progress) -> Result<SteppedSine,
     let jobs: Vec<(usize, usize)> = (0..freqs.len()).flat_map(|i| [(i, 0), (i, 1)]).collect();
     let runs: Vec<(Complex64, [Complex64; 2], Health, f64)> = jobs
         .par_iter()
+        .with_max_len(1)
         .map(|&(i, m)| {
             let f = Nco::new(freqs[i], fs, 0.0)?.f_hz();
             let p = run_board(cfg, f, m);

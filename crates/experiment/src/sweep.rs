@@ -232,6 +232,8 @@ pub fn run_sweep_with(
     let outcomes: Vec<Outcome> = boards
         .into_par_iter()
         .zip(groups.par_iter())
+        // A group per task, so a thread freed by other work can take any group not started.
+        .with_max_len(1)
         .map(|(mut board, g)| {
             if user_cancel() {
                 stop.store(true, Ordering::Relaxed);

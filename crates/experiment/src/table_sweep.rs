@@ -120,6 +120,7 @@ fn run_table_lanes(
     }
     let done: Vec<Result<Vec<Finished>, SweepError>> = groups
         .into_par_iter()
+        .with_max_len(1)
         .map(|(mut board, g, n_settle)| {
             let points: Vec<_> = g.iter().map(|j| j.point).collect();
             let out = board.run(n_settle, &points, RunOptions::default(), &|_| {})?;

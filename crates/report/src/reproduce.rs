@@ -162,6 +162,7 @@ pub fn reproduce(
         || {
             let mut swept: Vec<(usize, Result<_, ReportError>)> = order
                 .par_iter()
+                .with_max_len(1)
                 .map(|&i| {
                     let job = &jobs[i];
                     // The dump only records: the results are those of a run without it.

@@ -120,6 +120,7 @@ pub fn run_lot(
     };
     let outcomes: Vec<Result<u64, RunError>> = todo
         .par_iter()
+        .with_max_len(1)
         .map(|&i| {
             copy_cancel();
             if stop.load(Ordering::Relaxed) {
