@@ -100,14 +100,14 @@ fn next_normal(s: &mut [u64x4; 4]) -> f64x4 {
 /// by value: the caller's copy stays in registers on the common path.
 #[cold]
 #[inline(never)]
-pub(crate) fn rare(mut st: [u64x4; 4], w: u64x4, x: f64x4, core: u32) -> ([u64x4; 4], f64x4) {
+fn rare(mut st: [u64x4; 4], w: u64x4, x: f64x4, core: u32) -> ([u64x4; 4], f64x4) {
     let w = w.to_array();
     let mut out = x.to_array();
     let mut pending = !core & 0xF;
     while pending != 0 {
         let l = pending.trailing_zeros() as usize;
         pending &= pending - 1;
-        out[l] = lane_normal(&mut st, l, w[l]);
+        out[l] = lane_normal(&mut || lane_draw(&mut st, l), w[l]);
     }
     (st, f64x4::new(out))
 }
@@ -126,10 +126,10 @@ fn lane_draw(s: &mut [u64x4; 4], lane: usize) -> u64 {
     w.as_array()[lane]
 }
 
-/// The scalar ziggurat on lane `lane`, starting from draw `w` (already taken from that lane's
-/// stream); further draws come from the same stream.
+/// The scalar ziggurat on one lane, starting from draw `w` (already taken from that lane's
+/// stream); `draw` gives the same stream's further draws.
 #[inline(always)]
-fn lane_normal(s: &mut [u64x4; 4], lane: usize, mut w: u64) -> f64 {
+pub(crate) fn lane_normal(draw: &mut impl FnMut() -> u64, mut w: u64) -> f64 {
     loop {
         let (i, sign, b) = split(w);
         let [width, bound] = FAST.0[i];
@@ -137,13 +137,13 @@ fn lane_normal(s: &mut [u64x4; 4], lane: usize, mut w: u64) -> f64 {
         let x = if b < bound {
             Some(x)
         } else if i == 0 {
-            Some(tail(s, lane))
+            Some(tail(draw))
         } else {
             // A uniform height across layer i's wedge, from f(X[i]) at its right edge up to
             // f(X[i+1]); the point is kept where it lies under the curve. The chord between
             // the wedge's corners, with the tabled bounds on f minus it, decides all but a
             // thin band around the curve without exp.
-            let y = F[i] + closed0(lane_draw(s, lane)) * (F[i + 1] - F[i]);
+            let y = F[i] + closed0(draw()) * (F[i + 1] - F[i]);
             let [slope, lo, hi] = WEDGE[i];
             let c = F[i] + (width - x) * slope;
             let under = if y < c + lo {
@@ -158,17 +158,17 @@ fn lane_normal(s: &mut [u64x4; 4], lane: usize, mut w: u64) -> f64 {
         if let Some(x) = x {
             return f64::from_bits(x.to_bits() | sign);
         }
-        w = lane_draw(s, lane);
+        w = draw();
     }
 }
 
 /// A normal conditioned on x > r (Marsaglia 1964): x = r + a with a exponential of rate r,
 /// kept with probability exp(-a^2 / 2).
 #[inline(never)]
-fn tail(s: &mut [u64x4; 4], lane: usize) -> f64 {
+fn tail(draw: &mut impl FnMut() -> u64) -> f64 {
     loop {
-        let a = -ln(open0(lane_draw(s, lane))) / R;
-        let c = -ln(open0(lane_draw(s, lane)));
+        let a = -ln(open0(draw())) / R;
+        let c = -ln(open0(draw()));
         if c + c > a * a {
             return R + a;
         }

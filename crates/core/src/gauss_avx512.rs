@@ -1,11 +1,12 @@
 //! The fast path of `gauss` with AVX-512F, chosen at run time (the build targets x86-64-v3):
 //! one 512-bit register holds two sets of four streams (stream a and stream b of four lanes,
-//! or stream a of eight lanes), so each step, table look-up and test serves eight normals. The operations are the portable path's (integer
-//! steps, the same table entries, one exact subtraction and one rounded product per normal,
-//! exact comparisons), and draws that miss their piece's core finish in the portable code, so
-//! the bits are the same on either path (tested).
+//! or stream a of eight lanes), so each step, table look-up and test serves eight normals.
+//! The operations are the portable path's (integer steps, the same table entries, one exact
+//! subtraction and one rounded product per normal, exact comparisons), and draws that miss their piece's core finish in the portable code's
+//! scalar ziggurat, each lane's further draws stepped in the register, so the bits are the
+//! same on either path (tested).
 
-use crate::gauss::{rare, ONE_BITS, SIGN_BIT, SIGN_SHIFT};
+use crate::gauss::{lane_normal, ONE_BITS, SIGN_BIT, SIGN_SHIFT};
 use crate::gauss_tables::{FAST, N};
 use core::arch::x86_64::*;
 use wide::{f64x4, u64x4};
@@ -55,14 +56,11 @@ impl Consts {
     }
 }
 
-/// The next normal of the eight streams in `st` (two sets of four joined) into `pair` (two
-/// f64x4: the low set's lanes, then the high set's); returns the streams' new state. By value
-/// in and out, so the caller's state stays in registers.
+/// xoshiro256++ of all eight streams (`crate::noise::step`): their draws and new state.
 #[inline]
 #[target_feature(enable = "avx512f")]
-fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
+fn step(st: [__m512i; 4]) -> (__m512i, [__m512i; 4]) {
     let [mut s0, mut s1, mut s2, mut s3] = st;
-    // xoshiro256++ of all eight streams.
     let w = _mm512_add_epi64(_mm512_rol_epi64::<23>(_mm512_add_epi64(s0, s3)), s0);
     let t = _mm512_slli_epi64::<17>(s1);
     s2 = _mm512_xor_si512(s2, s0);
@@ -71,6 +69,17 @@ fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
     s0 = _mm512_xor_si512(s0, s3);
     s2 = _mm512_xor_si512(s2, t);
     s3 = _mm512_rol_epi64::<45>(s3);
+    (w, [s0, s1, s2, s3])
+}
+
+/// The next normal of the eight streams in `st` (two sets of four joined) into `pair` (two
+/// f64x4: the low set's lanes, then the high set's); returns the streams' new state. By value
+/// in and out, so the caller's state stays in registers.
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
+    // Taken apart, so that the state stays in registers on the common path.
+    let (w, [s0, s1, s2, s3]) = step(st);
     // Each stream's piece: [width, bound] pairs, 16 bytes apart.
     let mut off = [0u64; 8];
     // SAFETY: `off` is 64 bytes.
@@ -151,22 +160,38 @@ pub(crate) unsafe fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4]) {
     }
 }
 
-/// The streams whose draw missed its piece's core, finished by the portable code on their
-/// own state. The state goes in and out by value, so the caller keeps its copy in registers.
+/// The streams whose draw missed its piece's core, finished one by one by the portable
+/// code's scalar ziggurat (`gauss::lane_normal`), each drawing from its own stream in the
+/// register: all eight step, only that one keeps its step. The state stays in registers
+/// (splitting it into four-lane halves and back cost about as much as the ziggurat itself).
 #[cold]
 #[inline(never)]
 #[target_feature(enable = "avx512f")]
-fn finish(st: [__m512i; 4], w: __m512i, pair: &mut [f64x4], core: u32) -> [__m512i; 4] {
-    let mut ab: [[u64x4; 4]; 2] = [[u64x4::ZERO; 4]; 2];
-    for (k, v) in st.iter().enumerate() {
-        [ab[0][k], ab[1][k]] = halves(*v);
+fn finish(mut st: [__m512i; 4], w: __m512i, pair: &mut [f64x4], core: u32) -> [__m512i; 4] {
+    let mut ws = [0u64; 8];
+    let mut out = [0.0f64; 8];
+    // SAFETY: `ws` and `out` are 64 bytes, as is `pair` (two adjacent f64x4, checked by the
+    // caller).
+    unsafe {
+        _mm512_storeu_si512(ws.as_mut_ptr().cast(), w);
+        _mm512_storeu_pd(out.as_mut_ptr(), _mm512_loadu_pd(pair.as_ptr().cast()));
     }
-    let w = halves(w);
-    for h in 0..2 {
-        let core_h = (core >> (4 * h)) & 0xF;
-        if core_h != 0xF {
-            (ab[h], pair[h]) = rare(ab[h], w[h], pair[h], core_h);
-        }
+    let mut pending = !core & 0xFF;
+    while pending != 0 {
+        let l = pending.trailing_zeros() as usize;
+        pending &= pending - 1;
+        let keep: __mmask8 = 1 << l;
+        let mut draw = || {
+            let (w, t) = step(st);
+            st = core::array::from_fn(|k| _mm512_mask_mov_epi64(st[k], keep, t[k]));
+            let mut a = [0u64; 8];
+            // SAFETY: `a` is 64 bytes.
+            unsafe { _mm512_storeu_si512(a.as_mut_ptr().cast(), w) };
+            a[l]
+        };
+        out[l] = lane_normal(&mut draw, ws[l]);
     }
-    core::array::from_fn(|k| join(ab[0][k], ab[1][k]))
+    // SAFETY: as above.
+    unsafe { _mm512_storeu_pd(pair.as_mut_ptr().cast(), _mm512_loadu_pd(out.as_ptr())) };
+    st
 }
