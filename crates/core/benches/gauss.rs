@@ -1,0 +1,43 @@
+//! divan benchmark of the exact normal generator (`cargo bench -p gyroemu-core`): blocks of
+//! normals as the fused board reads them, four rows of four or eight lanes per input sample.
+//! Throughput is in normals; at f GHz, cycles per normal are f / (normals per ns). The
+//! eight-lane block takes the AVX-512 path where the CPU has it.
+
+use divan::counter::ItemsCount;
+use divan::Bencher;
+use gyroemu_core::gauss::NormalBlock;
+use gyroemu_core::noise::NoiseRng;
+
+/// Input samples drawn per run (four normals per lane each).
+const SAMPLES: u64 = 1 << 20;
+
+fn main() {
+    divan::main();
+}
+
+/// Draws every row of `SAMPLES` samples from `block`, as the board's loop does.
+fn drain(block: &mut NormalBlock) -> f64 {
+    let width = block.width();
+    let mut left = SAMPLES;
+    let mut acc = 0.0;
+    while left > 0 {
+        let run = block.ready(left);
+        acc += block.row(block.pos(), width)[0];
+        block.advance(run);
+        left -= run;
+    }
+    acc
+}
+
+#[divan::bench(args = [4, 8])]
+fn block_of_lanes(bencher: Bencher, lanes: usize) {
+    let rng = |seed: u64| NoiseRng::new(core::array::from_fn(|l| seed + l as u64));
+    let mut block = if lanes == 8 {
+        NormalBlock::wide(rng(1), rng(5))
+    } else {
+        NormalBlock::new(rng(1))
+    };
+    bencher
+        .counter(ItemsCount::new(SAMPLES * 4 * lanes as u64))
+        .bench_local(|| drain(&mut block));
+}
