@@ -258,7 +258,8 @@ pub fn run_selfcal_core(
         finish_sweep(c, &run_sweep_with(c, progress, None, opts)?.lanes)
     };
     // Side by side: each sweep may be a single lane group (one thread), and neither needs
-    // the other. A rotating failure is reported first, as in sequence.
+    // the other. When one fails the other still runs to its end; a rotating failure is the
+    // one reported, as in sequence.
     let (rotating, coriolis) = rayon::join(
         || sweep(&rot_cfg, rot_progress),
         || sweep(&cor_cfg, cor_progress),

@@ -356,17 +356,22 @@ pub fn drift_analysis(
     // each; the tracked half only when a loop fits), summed over the offsets and quarters,
     // which all run side by side.
     let total = deltas_k.len() as u64 * if tracked_too { 1000 } else { 500 };
+    // A quarter's reports can arrive out of order (its lane groups run side by side): each
+    // quarter only moves up, and only its increase is added to the shared count, so the count
+    // never passes the total and exactly one report gives it.
     let parts: Vec<[AtomicU64; 4]> = deltas_k.iter().map(|_| Default::default()).collect();
+    let done = AtomicU64::new(0);
     let one = |(i, &dt): (usize, &f64)| -> Result<DriftPoint, SweepError> {
         let open = drifted(&held, dt);
         let at = |quarter: usize, d: u64, t: u64| {
-            parts[i][quarter].store(d * 250 / t.max(1), Ordering::Relaxed);
-            let sum = parts
-                .iter()
-                .flatten()
-                .map(|p| p.load(Ordering::Relaxed))
-                .sum();
-            progress(sum, total)
+            let v = d.min(t) * 250 / t.max(1);
+            let prev = parts[i][quarter].fetch_max(v, Ordering::Relaxed);
+            if v > prev {
+                progress(
+                    done.fetch_add(v - prev, Ordering::Relaxed) + v - prev,
+                    total,
+                )
+            }
         };
         let case = |c: &Config, q0: usize| -> Result<DriftCase, SweepError> {
             let core = run_selfcal_core(
@@ -385,7 +390,8 @@ pub fn drift_analysis(
                 combined_selfcal_relative_error: core.combined.relative_error,
             })
         };
-        // The tracked case needs the lock, not the open-loop case: the two run side by side.
+        // The tracked case needs the lock, not the open-loop case: the two run side by side
+        // (when one fails the other still runs to its end; the open-loop error comes first).
         let tracked = || -> Result<(Option<DriftCase>, Option<f64>), SweepError> {
             if !tracked_too {
                 return Ok((None, None));

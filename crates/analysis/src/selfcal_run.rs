@@ -3,7 +3,8 @@
 
 use crate::selfcal::{sweep_configs, SelfcalCore};
 use crate::selfcal_analyses::{
-    allan_analysis, drift_analysis, tau_analysis, AllanResult, DriftPoint, TauPoint,
+    allan_analysis, drift_analysis, drift_pll_design, tau_analysis, AllanResult, DriftPoint,
+    TauPoint,
 };
 use gyroemu_config::Config;
 use gyroemu_experiment::{
@@ -105,7 +106,9 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
 }
 
 /// What `selfcal` on `cfg` will emulate: both sweeps, then the Allan record (four streams),
-/// the averaging-time run and two sweeps per drift temperature.
+/// the averaging-time run and, per drift temperature, both sweeps open loop and, when the
+/// drift loop fits the board, both again PLL-tracked (the same windows at another carrier;
+/// the lock runs themselves are not counted).
 pub fn selfcal_work(cfg: &Config) -> Work {
     let (rot, cor) = sweep_configs(cfg);
     let mut w = sweep_work(&rot).plus(sweep_work(&cor));
@@ -123,9 +126,16 @@ pub fn selfcal_work(cfg: &Config) -> Work {
         r.experiment.average_s = t;
         w = w.plus(sweep_work(&r));
     }
+    let cases = if drift_pll_design(cfg).validate().is_ok() {
+        2
+    } else {
+        1
+    };
     for &dt in &sc.drift_delta_t_k {
         let (r, c) = sweep_configs(&crate::selfcal::drifted(cfg, dt));
-        w = w.plus(sweep_work(&r)).plus(sweep_work(&c));
+        for _ in 0..cases {
+            w = w.plus(sweep_work(&r)).plus(sweep_work(&c));
+        }
     }
     w
 }

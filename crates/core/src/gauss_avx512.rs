@@ -2,9 +2,9 @@
 //! one 512-bit register holds two sets of four streams (stream a and stream b of four lanes,
 //! or stream a of eight lanes), so each step, table look-up and test serves eight normals.
 //! The operations are the portable path's (integer steps, the same table entries, one exact
-//! subtraction and one rounded product per normal, exact comparisons), and draws that miss their piece's core finish in the portable code's
-//! scalar ziggurat, each lane's further draws stepped in the register, so the bits are the
-//! same on either path (tested).
+//! subtraction and one rounded product per normal, exact comparisons), and draws that miss
+//! their piece's core finish in the portable code's scalar ziggurat, each lane's further
+//! draws stepped in the register, so the bits are the same on either path (tested).
 
 use crate::gauss::{lane_normal, ONE_BITS, SIGN_BIT, SIGN_SHIFT};
 use crate::gauss_tables::{FAST, N};
@@ -81,7 +81,8 @@ fn step(st: [__m512i; 4]) -> (__m512i, [__m512i; 4]) {
 #[inline]
 #[target_feature(enable = "avx512f")]
 fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
-    // Taken apart, so that the state stays in registers on the common path.
+    // Taken apart and rebuilt below: with the array passed on whole, LLVM kept the state in
+    // memory on the common path (a fifth slower).
     let (w, [s0, s1, s2, s3]) = step(st);
     // Each stream's piece: the byte offset of its [width, bound] pair, as eight 16-bit words
     // in one register, then in two general registers. A store and eight reloads instead
@@ -93,7 +94,8 @@ fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
     ];
     let base = FAST.0.as_ptr() as *const u8;
     let at = |k: usize| ((words[k / 4] >> (16 * (k % 4))) & 0xFFFF) as usize;
-    // SAFETY: every offset is below 16 N, inside the table of N pairs.
+    // SAFETY: every offset is 16 times an index below N (the mask, then the shift; it fits
+    // the 16-bit word, asserted above), so each 16-byte read lies inside the table.
     let p = |k: usize| unsafe { _mm_loadu_pd(base.add(at(k)).cast()) };
     let lo = |k: usize, j: usize| _mm256_insertf128_pd::<1>(_mm256_castpd128_pd256(p(k)), p(j));
     // Pieces of streams 0, 2, 4, 6 and of 1, 3, 5, 7, then width and bound of all eight.
@@ -168,10 +170,10 @@ pub(crate) unsafe fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4]) {
 #[inline(never)]
 #[target_feature(enable = "avx512f")]
 fn finish(mut st: [__m512i; 4], w: __m512i, pair: &mut [f64x4], core: u32) -> [__m512i; 4] {
+    assert!(pair.len() == 2);
     let mut ws = [0u64; 8];
     let mut out = [0.0f64; 8];
-    // SAFETY: `ws` and `out` are 64 bytes, as is `pair` (two adjacent f64x4, checked by the
-    // caller).
+    // SAFETY: `ws` and `out` are 64 bytes, as is `pair` (two adjacent f64x4, just checked).
     unsafe {
         _mm512_storeu_si512(ws.as_mut_ptr().cast(), w);
         _mm512_storeu_pd(out.as_mut_ptr(), _mm512_loadu_pd(pair.as_ptr().cast()));
@@ -181,15 +183,15 @@ fn finish(mut st: [__m512i; 4], w: __m512i, pair: &mut [f64x4], core: u32) -> [_
         let l = pending.trailing_zeros() as usize;
         pending &= pending - 1;
         let keep: __mmask8 = 1 << l;
-        let mut draw = || {
-            let (w, t) = step(st);
+        let mut next = || {
+            let (drawn, t) = step(st);
             st = core::array::from_fn(|k| _mm512_mask_mov_epi64(st[k], keep, t[k]));
             let mut a = [0u64; 8];
             // SAFETY: `a` is 64 bytes.
-            unsafe { _mm512_storeu_si512(a.as_mut_ptr().cast(), w) };
+            unsafe { _mm512_storeu_si512(a.as_mut_ptr().cast(), drawn) };
             a[l]
         };
-        out[l] = lane_normal(&mut draw, ws[l]);
+        out[l] = lane_normal(&mut next, ws[l]);
     }
     // SAFETY: as above.
     unsafe { _mm512_storeu_pd(pair.as_mut_ptr().cast(), _mm512_loadu_pd(out.as_ptr())) };
