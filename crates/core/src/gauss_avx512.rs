@@ -165,7 +165,7 @@ pub(crate) unsafe fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4]) {
 /// The streams whose draw missed its piece's core, finished one by one by the portable
 /// code's scalar ziggurat (`gauss::lane_normal`), each drawing from its own stream in the
 /// register: all eight step, only that one keeps its step. The state stays in registers
-/// (splitting it into four-lane halves and back cost about as much as the ziggurat itself).
+/// (splitting it into four-lane halves and back made the whole generator 5 % slower).
 #[cold]
 #[inline(never)]
 #[target_feature(enable = "avx512f")]
