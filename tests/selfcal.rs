@@ -159,7 +159,7 @@ fn averaging_time_reading_at_the_sweep_time_equals_the_sweep() {
 fn averaging_time_progress_ends_at_its_total_whatever_the_lane_groups() {
     // Five points on one thread: one lane group of eight where the CPU has AVX-512, two of
     // four elsewhere; the canonical grouping the results report is two of four either way.
-    // Progress must count the groups that run: never past its total, and ending on it.
+    // Progress must count the groups that run: never past its total, and reaching it.
     let c = fast_cfg(&[25.0, 50.0, 100.0, 150.0, 175.0], 2.0);
     let seen = std::sync::Mutex::new(Vec::new());
     let record = |d: u64, t: u64| seen.lock().unwrap().push((d, t));

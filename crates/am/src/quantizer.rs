@@ -95,10 +95,10 @@ impl<S: Sample> Quantizer<S> {
     /// the lanes whose output is zero are counted. Any other lane (a near-tie, a NaN, `|p|`
     /// beyond the top code, which takes the bottom code and every clipped one) sends the
     /// whole group through the division, whose counts are then added, as does every lane
-    /// where `1/step` is not normal. Zero
-    /// codes stay on the product, counted without a branch, because they are common: a
-    /// board samples its carrier at the carrier's exact zeros (2 samples in 16 at
-    /// fs = 16 f0), so an AM drive hands the DAC an exact 0 that often.
+    /// where `1/step` is not normal. Zero codes stay on the product, counted without a
+    /// branch, because they are common: a board samples its carrier at the carrier's exact
+    /// zeros (2 samples in 16 at fs = 16 f0), so an AM drive hands the DAC an exact 0 that
+    /// often.
     ///
     /// Why that is exact, for a lane with `c != 0`: with `u = 2^-53`, `p = q (1 + a)(1 + b)`
     /// and the division's `d = q (1 + e)` for `q = x / step` (`|a|, |b|, |e| <= u`; both

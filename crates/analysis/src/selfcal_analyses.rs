@@ -336,6 +336,13 @@ pub fn drift_pll_design(cfg: &Config) -> Config {
     d
 }
 
+/// [`drift_pll_design`] when its loop fits the board: the drift scenario then runs its
+/// PLL-tracked half too (else that half is left out, and validation says so).
+pub fn drift_tracking_design(cfg: &Config) -> Option<Config> {
+    let d = drift_pll_design(cfg);
+    d.validate().is_ok().then_some(d)
+}
+
 /// Re-runs both sweeps on the drifted device at each temperature offset, twice: with the
 /// carrier open loop at the nominal one (`cfg`'s, or where a `[pll]` locked it at the
 /// nominal temperature), and with the carrier locked by the PLL at that temperature (the
@@ -349,8 +356,8 @@ pub fn drift_analysis(
     group_threads: Option<usize>,
     progress: Progress,
 ) -> Result<Vec<DriftPoint>, SweepError> {
-    let design = drift_pll_design(cfg);
-    let tracked_too = design.validate().is_ok();
+    let design = drift_tracking_design(cfg);
+    let tracked_too = design.is_some();
     let (held, _) = resolve_lock(cfg)?;
     // Progress in thousandths of each offset (two self-calibrations of two sweeps, a quarter
     // each; the tracked half only when a loop fits), summed over the offsets and quarters,
@@ -393,10 +400,10 @@ pub fn drift_analysis(
         // The tracked case needs the lock, not the open-loop case: the two run side by side
         // (when one fails the other still runs to its end; the open-loop error comes first).
         let tracked = || -> Result<(Option<DriftCase>, Option<f64>), SweepError> {
-            if !tracked_too {
+            let Some(design) = &design else {
                 return Ok((None, None));
-            }
-            let lock = lock_config_carrier(&open, &design)?.expect("the design has a [pll]");
+            };
+            let lock = lock_config_carrier(&open, design)?.expect("the design has a [pll]");
             let mut tracked = open.clone();
             tracked.drive.carrier_hz = Some(lock.carrier_hz);
             Ok((Some(case(&tracked, 2)?), lock.lock_time_s))

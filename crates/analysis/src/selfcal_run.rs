@@ -3,7 +3,7 @@
 
 use crate::selfcal::{sweep_configs, SelfcalCore};
 use crate::selfcal_analyses::{
-    allan_analysis, drift_analysis, drift_pll_design, tau_analysis, AllanResult, DriftPoint,
+    allan_analysis, drift_analysis, drift_tracking_design, tau_analysis, AllanResult, DriftPoint,
     TauPoint,
 };
 use gyroemu_config::Config;
@@ -126,15 +126,16 @@ pub fn selfcal_work(cfg: &Config) -> Work {
         r.experiment.average_s = t;
         w = w.plus(sweep_work(&r));
     }
-    let cases = if drift_pll_design(cfg).validate().is_ok() {
+    let cases = if drift_tracking_design(cfg).is_some() {
         2
     } else {
         1
     };
     for &dt in &sc.drift_delta_t_k {
         let (r, c) = sweep_configs(&crate::selfcal::drifted(cfg, dt));
+        let pair = sweep_work(&r).plus(sweep_work(&c));
         for _ in 0..cases {
-            w = w.plus(sweep_work(&r)).plus(sweep_work(&c));
+            w = w.plus(pair);
         }
     }
     w
