@@ -113,14 +113,15 @@ fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
     let x = _mm512_fmsub_pd(b, width, width);
     let x = _mm512_castsi512_pd(_mm512_or_si512(_mm512_castpd_si512(x), sign));
     let core = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(b, bound);
+    let (st, x) = if core != 0xFF {
+        finish([s0, s1, s2, s3], w, x, core as u32)
+    } else {
+        ([s0, s1, s2, s3], x)
+    };
     assert!(pair.len() == 2);
     // SAFETY: `pair` is two adjacent f64x4, 64 bytes.
     unsafe { _mm512_storeu_pd(pair.as_mut_ptr().cast(), x) };
-    if core != 0xFF {
-        finish([s0, s1, s2, s3], w, pair, core as u32)
-    } else {
-        [s0, s1, s2, s3]
-    }
+    st
 }
 
 /// [`crate::gauss::fill_one_portable`] with AVX-512F: stream a and stream b of the four lanes
@@ -162,38 +163,32 @@ pub(crate) unsafe fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4]) {
     }
 }
 
-/// The streams whose draw missed its piece's core, finished one by one by the portable
-/// code's scalar ziggurat (`gauss::lane_normal`), each drawing from its own stream in the
-/// register: all eight step, only that one keeps its step. The state stays in registers
-/// (splitting it into four-lane halves and back made the whole generator 5 % slower).
+/// The streams whose draw missed its piece's core (bit clear in `core`), finished one by
+/// one by the portable code's scalar ziggurat (`gauss::lane_normal`), each drawing from its
+/// own stream in the register: all eight step, only that one keeps its step. Returns the
+/// state and `x` with those lanes replaced. Lanes move between the vector and general
+/// registers by permutes: through memory, each 8-byte read of a 64-byte store stalled on
+/// store-to-load forwarding, and this path took 6 % of a noisy run.
 #[cold]
 #[inline(never)]
 #[target_feature(enable = "avx512f")]
-fn finish(mut st: [__m512i; 4], w: __m512i, pair: &mut [f64x4], core: u32) -> [__m512i; 4] {
-    assert!(pair.len() == 2);
-    let mut ws = [0u64; 8];
-    let mut out = [0.0f64; 8];
-    // SAFETY: `ws` and `out` are 64 bytes, as is `pair` (two adjacent f64x4, just checked).
-    unsafe {
-        _mm512_storeu_si512(ws.as_mut_ptr().cast(), w);
-        _mm512_storeu_pd(out.as_mut_ptr(), _mm512_loadu_pd(pair.as_ptr().cast()));
-    }
+fn finish(mut st: [__m512i; 4], w: __m512i, mut x: __m512d, core: u32) -> ([__m512i; 4], __m512d) {
     let mut pending = !core & 0xFF;
     while pending != 0 {
-        let l = pending.trailing_zeros() as usize;
+        let l = pending.trailing_zeros();
         pending &= pending - 1;
         let keep: __mmask8 = 1 << l;
+        let at = _mm512_set1_epi64(l as i64);
+        let lane = |v: __m512i| {
+            _mm_cvtsi128_si64(_mm512_castsi512_si128(_mm512_permutexvar_epi64(at, v))) as u64
+        };
         let mut next = || {
             let (drawn, t) = step(st);
             st = core::array::from_fn(|k| _mm512_mask_mov_epi64(st[k], keep, t[k]));
-            let mut a = [0u64; 8];
-            // SAFETY: `a` is 64 bytes.
-            unsafe { _mm512_storeu_si512(a.as_mut_ptr().cast(), drawn) };
-            a[l]
+            lane(drawn)
         };
-        out[l] = lane_normal(&mut next, ws[l]);
+        let v = lane_normal(&mut next, lane(w));
+        x = _mm512_mask_mov_pd(x, keep, _mm512_set1_pd(v));
     }
-    // SAFETY: as above.
-    unsafe { _mm512_storeu_pd(pair.as_mut_ptr().cast(), _mm512_loadu_pd(out.as_ptr())) };
-    st
+    (st, x)
 }
