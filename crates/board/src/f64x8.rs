@@ -349,6 +349,47 @@ mod tests {
         }
     }
 
+    /// A flicker source in eight lanes (the joined TIA sources, and each TIA source of an
+    /// eight-lane board) runs eight poles per pass, then four, then the rest in one pass:
+    /// `process` against `tick` on every block size of the stage contract, for 4 to 24 poles
+    /// (every remainder modulo eight among them), and lane by lane against a scalar source.
+    #[test]
+    fn a_flicker_source_in_eight_lanes_is_its_ticks_for_every_pole_count() {
+        use gyroemu_core::check::{self, Gen};
+        use gyroemu_core::flicker::{Flicker, FlickerParams};
+        use gyroemu_core::Stage;
+        if skip_without_avx512() {
+            return;
+        }
+        let mut g = Gen::new(0x0f11_c4e8);
+        let mut counts = Vec::new();
+        for tenth in (20..=120).step_by(5) {
+            let p = FlickerParams {
+                fs_hz: 1.0,
+                psd_at_1hz: 0.7,
+                f_lo_hz: 0.5 * 10f64.powf(-(tenth as f64) / 10.0),
+                f_hi_hz: 0.5,
+            };
+            let wide = Flicker::<F64x8>::stationary(&p, || g.sample(-1.0, 1.0)).unwrap();
+            counts.push(wide.design().poles());
+            let input = |g: &mut Gen| g.sample::<F64x8>(-2.0, 2.0);
+            check::tick_vs_process("flicker x8", &wide, input, |y| y.to_array());
+            // Lane 5 from its own start, as a scalar source fed lane 5's inputs.
+            let mut lane = Flicker::<f64>::at_rest(&p).unwrap();
+            let mut eight = Flicker::<F64x8>::at_rest(&p).unwrap();
+            let xs: Vec<F64x8> = (0..97).map(|_| input(&mut g)).collect();
+            let mut ys = vec![F64x8::default(); xs.len()];
+            eight.process(&xs, &mut ys);
+            for (n, (x, y)) in xs.iter().zip(&ys).enumerate() {
+                let want = lane.tick(x.lane(5));
+                assert_eq!(y.lane(5).to_bits(), want.to_bits(), "sample {n}");
+            }
+        }
+        for r in 0..8 {
+            assert!(counts.iter().any(|&n| n % 8 == r && n > 8), "{counts:?}");
+        }
+    }
+
     /// The loop entry runs its closure compiled for AVX-512 and returns its value.
     #[test]
     fn the_loop_entry_runs_its_closure() {

@@ -125,14 +125,23 @@ impl<S: Sample> Stage for Flicker<S> {
         for (y, &x) in y.iter_mut().zip(w) {
             *y = x * self.direct;
         }
+        let n = self.a.len();
         let mut k = 0;
-        while k + POLES_AT_ONCE <= self.a.len() {
+        if S::LANES >= 8 {
+            while k + 2 * POLES_AT_ONCE <= n {
+                self.poles::<{ 2 * POLES_AT_ONCE }>(k, w, y);
+                k += 2 * POLES_AT_ONCE;
+            }
+        }
+        while k + POLES_AT_ONCE <= n {
             self.poles::<POLES_AT_ONCE>(k, w, y);
             k += POLES_AT_ONCE;
         }
-        while k < self.a.len() {
-            self.poles::<1>(k, w, y);
-            k += 1;
+        match n - k {
+            1 => self.poles::<1>(k, w, y),
+            2 => self.poles::<2>(k, w, y),
+            3 => self.poles::<3>(k, w, y),
+            _ => {}
         }
     }
 
@@ -143,7 +152,10 @@ impl<S: Sample> Stage for Flicker<S> {
 
 /// Poles [`Flicker::process`] runs together per pass over a block: four keep the states, pole
 /// radii and residues in registers and give each sample's chain of four dependent
-/// multiply-adds enough independent work beside it.
+/// multiply-adds enough independent work beside it. Eight-lane sources (compiled for
+/// AVX-512: 32 registers) run twice as many per pass first, so the sums are read and written
+/// fewer times; the last one to three poles run in one pass, not one by one, since a pass of
+/// one pole waits on its multiply-add every sample (both measured in docs/performance.md).
 const POLES_AT_ONCE: usize = 4;
 
 impl<S: Sample> Flicker<S> {
