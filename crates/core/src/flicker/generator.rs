@@ -137,11 +137,9 @@ impl<S: Sample> Stage for Flicker<S> {
             self.poles::<POLES_AT_ONCE>(k, w, y);
             k += POLES_AT_ONCE;
         }
-        match n - k {
-            1 => self.poles::<1>(k, w, y),
-            2 => self.poles::<2>(k, w, y),
-            3 => self.poles::<3>(k, w, y),
-            _ => {}
+        while k < n {
+            self.poles::<1>(k, w, y);
+            k += 1;
         }
     }
 
@@ -154,8 +152,9 @@ impl<S: Sample> Stage for Flicker<S> {
 /// radii and residues in registers and give each sample's chain of four dependent
 /// multiply-adds enough independent work beside it. Eight-lane sources (compiled for
 /// AVX-512: 32 registers) run twice as many per pass first, so the sums are read and written
-/// fewer times; the last one to three poles run in one pass, not one by one, since a pass of
-/// one pole waits on its multiply-add every sample (both measured in docs/performance.md).
+/// fewer times (docs/performance.md). The last one to three poles still run one by one: a
+/// pass of two or three was faster there, but it changed the machine code of the noisy
+/// sample loop, which does not call it, and cost that loop 4 %.
 const POLES_AT_ONCE: usize = 4;
 
 impl<S: Sample> Flicker<S> {
