@@ -309,6 +309,8 @@ impl<S: Sample> Board<S> {
             }
             _ => None,
         };
+        // The presets' low-pass (two biquads) runs the block with its states in registers.
+        let mut pair = self.lp.hold_pair();
         let mut j0 = 0;
         // In runs that the drawn-ahead normals cover: drawing more is a call, kept out of the
         // per-sample loop.
@@ -456,7 +458,11 @@ impl<S: Sample> Board<S> {
                 if let Some(pr) = probe.as_deref_mut() {
                     pr.record_full(n0 + j, &u, &p, &y, &z);
                 }
-                let [i1, q1, i2, q2] = self.lp.tick([z[0].i, z[0].q, z[1].i, z[1].q]);
+                let zs = [z[0].i, z[0].q, z[1].i, z[1].q];
+                let [i1, q1, i2, q2] = match &mut pair {
+                    Some(lp) => lp.tick(zs),
+                    None => self.lp.tick(zs),
+                };
                 out = ([Iq::new(i1, q1), Iq::new(i2, q2)], [mod_cos, mod_sin]);
                 if let Some(pr) = probe.as_deref_mut() {
                     pr.check_lowpass(n0 + j, &out.0);
@@ -466,6 +472,9 @@ impl<S: Sample> Board<S> {
                 self.noise.normals.advance(run);
             }
             j0 += run;
+        }
+        if let Some(lp) = &pair {
+            self.lp.release_pair(lp);
         }
         out
     }

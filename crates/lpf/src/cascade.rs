@@ -56,6 +56,21 @@ impl<S: Sample> Cascade<S> {
         self.n
     }
 
+    /// Exactly `n` unit-numerator biquads (no one-pole, no first-order section).
+    pub fn is_biquads(&self, n: usize) -> bool {
+        !self.one_pole && !self.first_order && self.n == n
+    }
+
+    /// The product of the sections' numerator gains, applied at the input.
+    pub fn gain(&self) -> S {
+        self.gain
+    }
+
+    /// Section `k`'s recursion coefficients.
+    pub fn section(&self, k: usize) -> SectionCoefs<S> {
+        self.sec[k]
+    }
+
     /// One input sample of each of `C` channels through the cascade.
     #[inline(always)]
     pub fn tick<const C: usize>(&self, st: &mut CascadeState<S, C>, x: [S; C]) -> [S; C] {

@@ -15,7 +15,7 @@ mod lowpass;
 mod section;
 
 pub use averager::{Averager, Window, MAX_LANES};
-pub use bank::LowPassBank;
+pub use bank::{BiquadPair, LowPassBank};
 pub use decimator::{DecimateMode, Decimator};
 pub use design::{LowPassDesign, MAX_ORDER};
 pub use kahan::KahanSum;
