@@ -74,7 +74,9 @@ pub struct BiquadPair<S, const C: usize> {
 }
 
 impl<S: Sample, const C: usize> BiquadPair<S, C> {
-    /// One sample of every channel, as [`LowPassBank`]'s `tick`.
+    /// One sample of every channel, as [`LowPassBank`]'s `tick`. The cascade's biquad loop
+    /// with fixed bounds, kept apart on purpose: calling the cascade's loop over slices of
+    /// two cost the noiseless chain 8 to 10 % (measured, alternating runs).
     #[allow(clippy::needless_range_loop)] // the channel indexes the input and both states
     #[inline(always)]
     pub fn tick(&mut self, x: [S; C]) -> [S; C] {
