@@ -6,6 +6,7 @@
 pub mod bench;
 pub mod dump;
 pub mod fit;
+pub mod leaks;
 pub mod lock;
 pub mod progress;
 pub mod readout;
@@ -14,12 +15,15 @@ pub mod table_sweep;
 pub mod work;
 
 pub use dump::{dump_extra, DumpPlan};
+pub use leaks::Stage2Leaks;
 pub use lock::{lock_config_carrier, pll_params, resolve_lock, CarrierLock};
 pub use progress::{Progress, Quiet, Reporter, Task, Written};
-pub use readout::{post_process, theory_deg, Compensation, PointResult, SweepResult};
+pub use readout::{
+    post_process, post_process_with, theory_deg, Compensation, PointResult, SweepResult,
+};
 pub use sweep::{
-    dump_point, finish_sweep, run_sweep, run_sweep_with, OnGroup, SweepError, SweepOptions,
-    SweepRun, DUMP_STEM,
+    dump_point, finish_sweep, finish_sweep_with, run_sweep, run_sweep_with, OnGroup, SweepError,
+    SweepOptions, SweepRun, DUMP_STEM,
 };
 pub use table_sweep::run_table_sweeps;
 pub use work::{sweep_work, Work, MAX_POINT_SAMPLES};

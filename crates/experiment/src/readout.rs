@@ -3,6 +3,7 @@
 //! the paper's best linear fit.
 
 use crate::fit::{fit_line, LineFit};
+use crate::leaks::Stage2Leaks;
 use gyroemu_board::{
     unleak_sidebands, unleak_table_harmonics, ChainResponse, Health, LaneResult, Point, Shape,
 };
@@ -251,12 +252,24 @@ fn table_phase_readout(
 
 /// Turns each emulated point's lane averages into phases, compensation, theory and fits (the
 /// `samples` and rate fields of the result are left for the caller).
-#[allow(clippy::needless_range_loop)] // mode indices address parallel arrays
 pub fn post_process(
     cfg: &Config,
     rates: &[f64],
     points: &[Point],
     lanes: &[LaneResult],
+) -> Result<SweepResult, ParamError> {
+    post_process_with(cfg, rates, points, lanes, &Stage2Leaks::default())
+}
+
+/// [`post_process`], taking each rotating point's stage-2 leak from `leaks` where it holds
+/// that point's (the same value: see [`Stage2Leaks`]), else computing it.
+#[allow(clippy::needless_range_loop)] // mode indices address parallel arrays
+pub fn post_process_with(
+    cfg: &Config,
+    rates: &[f64],
+    points: &[Point],
+    lanes: &[LaneResult],
+    leaks: &Stage2Leaks,
 ) -> Result<SweepResult, ParamError> {
     let fs_out = cfg.fs_out_hz();
     let shape = cfg.shape();
@@ -333,7 +346,7 @@ pub fn post_process(
                 let mut alpha = [0.0; 2];
                 // The window is a not quite whole number of half periods of decimated samples:
                 // its exact leak is removed before the sidebands are read.
-                let leak = chain.stage2_leak(&points[i], cfg.n_settle_out())?;
+                let leak = leaks.get_or_compute(&chain, &points[i], cfg.n_settle_out())?;
                 for (k, mode) in [Mode::One, Mode::Two].into_iter().enumerate() {
                     let (c, s) = unleak_sidebands(lr.c[k], lr.s[k], leak);
                     let est = sideband_estimate(c, s, mode);

@@ -3,8 +3,9 @@
 //! of a whole run. `readout.rs` turns the averages into phases.
 
 use crate::dump::DumpPlan;
+use crate::leaks::Stage2Leaks;
 use crate::progress::{Progress, Written};
-use crate::readout::{post_process, SweepResult};
+use crate::readout::{post_process_with, SweepResult};
 use gyroemu_board::{
     lane_groups, max_lanes, GroupBoard, LaneResult, NonFinite, Point, Probe, RunOptions,
     CANONICAL_LANES,
@@ -362,6 +363,16 @@ pub fn finish_sweep(
     cfg: &Config,
     lanes: &BTreeMap<usize, LaneResult>,
 ) -> Result<SweepResult, SweepError> {
+    finish_sweep_with(cfg, lanes, &Stage2Leaks::default())
+}
+
+/// [`finish_sweep`] with stage-2 leaks computed beforehand (see [`Stage2Leaks`]): the same
+/// result, without waiting on the leaks it holds.
+pub fn finish_sweep_with(
+    cfg: &Config,
+    lanes: &BTreeMap<usize, LaneResult>,
+    leaks: &Stage2Leaks,
+) -> Result<SweepResult, SweepError> {
     let rates = cfg.emulated_rates_dps();
     let missing: Vec<usize> = (0..rates.len())
         .filter(|i| !lanes.contains_key(i))
@@ -372,7 +383,7 @@ pub fn finish_sweep(
     let points: Vec<Point> = rates.iter().map(|&r| cfg.plan_point(r)).collect();
     let lane_results: Vec<LaneResult> = (0..rates.len()).map(|i| lanes[&i]).collect();
     let (samples, point_samples) = canonical_work(cfg, &points);
-    let res = post_process(cfg, &rates, &points, &lane_results)?;
+    let res = post_process_with(cfg, &rates, &points, &lane_results, leaks)?;
     Ok(SweepResult {
         settle_s: cfg.settle_s(),
         fs_hz: cfg.fs_hz(),

@@ -11,7 +11,7 @@ use gyroemu_analysis::bandwidth::{
 use gyroemu_config::presets::preset;
 use gyroemu_config::{Config, DumpConfig};
 use gyroemu_experiment::{
-    finish_sweep, run_sweep_with, DumpPlan, Reporter, SweepOptions, SweepResult,
+    finish_sweep_with, run_sweep_with, DumpPlan, Reporter, Stage2Leaks, SweepOptions, SweepResult,
 };
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
 use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
@@ -176,8 +176,16 @@ pub fn reproduce(
                     let dir = out.join(job.preset);
                     let progress = |d: u64, t: u64| report(i, d, t);
                     let res = (|| {
-                        let run = run_sweep_with(&job.cfg, &progress, Some(&dir), opts)?;
-                        let r = finish_sweep(&job.cfg, &run.lanes)?;
+                        // The stage-2 leaks depend on the config alone: a thread the sweeps
+                        // leave idle computes them (rayon steals the oldest work first, so
+                        // other experiments' groups go before them), and the read-out does
+                        // not wait on them. An error here resurfaces in the read-out.
+                        let (run, leaks) = rayon::join(
+                            || run_sweep_with(&job.cfg, &progress, Some(&dir), opts),
+                            || Stage2Leaks::of_sweep(&job.cfg).unwrap_or_default(),
+                        );
+                        let run = run?;
+                        let r = finish_sweep_with(&job.cfg, &run.lanes, &leaks)?;
                         let written = if r.problems.is_empty() {
                             Some(write_job(out, job, &run.dump_files, &r))
                         } else {
