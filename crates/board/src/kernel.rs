@@ -158,6 +158,12 @@ impl<S: Sample> Board<S> {
         let (mut active, mut recount_at) = counting(0);
         // The decimated sample a cancel stopped the run at (its block not averaged).
         let mut stopped_at = None;
+        // The block after which the probe is handed on, if it is asked for.
+        let hand_on_at = match (opts.on_probe_recorded, opts.probe.as_deref()) {
+            (Some(_), Some(p)) => p.recorded_at(m),
+            _ => None,
+        }
+        .unwrap_or(u64::MAX);
         for k in 0..n_out {
             let n0 = k * m;
             // The recording path only for blocks that touch the dump window.
@@ -183,6 +189,9 @@ impl<S: Sample> Board<S> {
             }
             if let Some(p) = opts.probe.as_deref_mut() {
                 p.record_decimated(k, &z, &r, K == ROTATING);
+            }
+            if k == hand_on_at {
+                hand_on_probe(&mut opts);
             }
             if k % report_every == 0 {
                 progress(n0 + m);
@@ -631,4 +640,14 @@ pub(crate) fn flicker_drive<const K: u8, S: Sample>(
         })
     };
     [d[0] * b.amplitude[0], d[1] * b.amplitude[1]]
+}
+
+/// Hands the run's probe on ([`RunOptions::on_probe_recorded`]); the run records no more.
+/// Out of line: once per run, kept out of the sample loop's code.
+#[cold]
+#[inline(never)]
+fn hand_on_probe(opts: &mut RunOptions) {
+    if let (Some(hand_on), Some(p)) = (opts.on_probe_recorded, opts.probe.take()) {
+        hand_on(p);
+    }
 }

@@ -58,6 +58,9 @@ pub struct RunOptions<'a> {
     /// Decimated samples per row of the recorded series (0: no series). Each row holds the
     /// mean over its block of the averaged channels (after settling).
     pub series_block: u64,
+    /// Called once with `probe` as soon as both its windows have ended, from the run's thread
+    /// (so a dump can be written while the run goes on); the run then records no more.
+    pub on_probe_recorded: Option<&'a (dyn Fn(&Probe) + Sync)>,
 }
 
 /// What a run returns.

@@ -10,6 +10,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Which nodes to record, and the recorders for the full-rate and decimated nodes.
+#[derive(Clone)]
 pub struct Probe {
     lane: usize,
     nodes: [bool; 7],
@@ -172,6 +173,27 @@ impl Probe {
         }
         let (start, len) = self.full_window;
         !self.full.names().is_empty() && n0 < start.saturating_add(len) && n0 + m > start
+    }
+
+    /// The decimated sample `k` after which both windows have ended (input samples up to
+    /// `(k + 1) m - 1` recorded): nothing later is kept, so the dump is final. `None` for a
+    /// finite check, which watches every sample.
+    pub fn recorded_at(&self, m: u64) -> Option<u64> {
+        if self.check_lanes > 0 {
+            return None;
+        }
+        let (start, len) = self.full_window;
+        let full_end = if self.full.names().is_empty() {
+            0
+        } else {
+            start.saturating_add(len)
+        };
+        let dec_end = if self.decimated.names().is_empty() {
+            0
+        } else {
+            self.decimated.end()
+        };
+        Some(full_end.div_ceil(m.max(1)).max(dec_end).saturating_sub(1))
     }
 
     /// Records the full-rate nodes of input sample `n`.

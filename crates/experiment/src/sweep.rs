@@ -72,6 +72,10 @@ pub fn run_sweep(
 /// started are skipped) and is returned.
 pub type OnGroup<'a> = &'a (dyn Fn(&[(usize, LaneResult)]) -> Result<(), String> + Sync);
 
+/// Called with a dump's files once they are written (see [`SweepOptions::on_dump_early`]);
+/// returns the files it made from them.
+pub type OnDump<'a> = &'a (dyn Fn(&[PathBuf]) -> Result<Vec<PathBuf>, String> + Sync);
+
 /// What [`run_sweep_with`] runs and what it does with the points it finishes.
 #[derive(Default)]
 pub struct SweepOptions<'a> {
@@ -93,6 +97,13 @@ pub struct SweepOptions<'a> {
     /// 1: each group is then as wide as the CPU runs (most points per CPU-second), and the
     /// other work keeps the remaining threads busy.
     pub group_threads: Option<usize>,
+    /// Writes the dump as soon as its windows are recorded, in a task a thread left idle by
+    /// the lane groups takes, instead of after every group has run; then calls this in that
+    /// task with its files; the files it returns (made from the dump, e.g. its figures) are
+    /// listed in `dump_made`. Its group's points are still passed to `on_group`
+    /// only after the dump is written. `reproduce` gives it: its longest group then no longer
+    /// waits on its dump at the end.
+    pub on_dump_early: Option<OnDump<'a>>,
 }
 
 /// The points a [`run_sweep_with`] call has, and whether it was cancelled.
@@ -110,7 +121,10 @@ pub struct SweepRun {
     pub dump_files: Vec<PathBuf>,
     /// Their total size, bytes.
     pub dump_bytes: u64,
-    /// Wall time spent writing them, s (after the emulation, not part of its time).
+    /// The files `on_dump_early` made from them.
+    pub dump_made: Vec<PathBuf>,
+    /// Wall time spent writing them, s (after the emulation, not part of its time, unless
+    /// written early).
     pub dump_write_s: f64,
 }
 
@@ -230,73 +244,90 @@ pub fn run_sweep_with(
     // after the parallel section).
     type Finished = (Vec<(usize, LaneResult)>, u64, bool, Option<Probe>);
     type Outcome = Option<Result<Finished, SweepError>>;
-    let outcomes: Vec<Outcome> = boards
-        .into_par_iter()
-        .zip(groups.par_iter())
-        // A group per task, so a thread freed by other work can take any group not started.
-        .with_max_len(1)
-        .map(|(mut board, g)| {
-            if user_cancel() {
-                stop.store(true, Ordering::Relaxed);
+    // The dump written early (`on_dump_early`), by the task its recorded probe spawned.
+    let early: std::sync::Mutex<Option<Result<DumpWritten, SweepError>>> = Default::default();
+    let early_on = opts.on_dump_early.zip(dump_dir);
+    let outcomes: Vec<Outcome> = rayon::in_place_scope(|scope| {
+        let early = &early;
+        let hand_on = |p: &Probe| {
+            if let Some((then, dir)) = early_on {
+                let p = p.clone();
+                scope.spawn(move |_| {
+                    let w = write_dump(&p, dir, Some(then));
+                    *early.lock().unwrap_or_else(|e| e.into_inner()) = Some(w);
+                });
             }
-            if stop.load(Ordering::Relaxed) {
-                return None;
-            }
-            let points: Vec<Point> = g.iter().map(|&i| plan(i)).collect();
-            let mut probe = dump.as_ref().and_then(|(idx, plan)| {
-                g.iter()
-                    .position(|i| i == idx)
-                    .map(|lane| (lane, plan.probe(cfg, lane)))
-            });
-            let last = AtomicU64::new(0);
-            let report = |n: u64| {
-                add_group_progress(&done, &last, n, total, progress);
+        };
+        boards
+            .into_par_iter()
+            .zip(groups.par_iter())
+            // A group per task, so a thread freed by other work can take any group not started.
+            .with_max_len(1)
+            .map(|(mut board, g)| {
                 if user_cancel() {
                     stop.store(true, Ordering::Relaxed);
                 }
-            };
-            let run_opts = RunOptions {
-                probe: probe.as_mut().map(|(_, p)| p),
-                ..Default::default()
-            };
-            let res = board.run(n_settle, &points, run_opts, &report);
-            let finished = (|| {
-                let out = res?;
-                // A raised flag may have cut the run short: only the lanes whose own window
-                // ended before it hold their points' results. The dumped lane waits for a
-                // whole run, which writes its dump.
-                let whole = out.complete.iter().all(|&c| c);
-                let pts: Vec<(usize, LaneResult)> = g
-                    .iter()
-                    .copied()
-                    .zip(out.lanes)
-                    .zip(&out.complete)
-                    .enumerate()
-                    .filter(|(lane, (_, &c))| {
-                        whole || (c && probe.as_ref().is_none_or(|(l, _)| l != lane))
-                    })
-                    .map(|(_, (p, _))| p)
-                    .collect();
-                // A whole group that recorded the dump hands its probe on.
-                let probe = probe
-                    .filter(|_| whole && dump_dir.is_some())
-                    .map(|(_, p)| p);
-                if let (None, Some(f), false) = (&probe, opts.on_group, pts.is_empty()) {
-                    f(&pts).map_err(SweepError::Output)?;
+                if stop.load(Ordering::Relaxed) {
+                    return None;
                 }
-                let work = if whole {
-                    samples_of(g) * g.len() as u64
-                } else {
-                    0
+                let points: Vec<Point> = g.iter().map(|&i| plan(i)).collect();
+                let mut probe = dump.as_ref().and_then(|(idx, plan)| {
+                    g.iter()
+                        .position(|i| i == idx)
+                        .map(|lane| (lane, plan.probe(cfg, lane)))
+                });
+                let last = AtomicU64::new(0);
+                let report = |n: u64| {
+                    add_group_progress(&done, &last, n, total, progress);
+                    if user_cancel() {
+                        stop.store(true, Ordering::Relaxed);
+                    }
                 };
-                Ok((pts, work, whole, probe))
-            })();
-            if finished.is_err() {
-                stop.store(true, Ordering::Relaxed);
-            }
-            Some(finished)
-        })
-        .collect();
+                let run_opts = RunOptions {
+                    probe: probe.as_mut().map(|(_, p)| p),
+                    on_probe_recorded: early_on.map(|_| &hand_on as &(dyn Fn(&Probe) + Sync)),
+                    ..Default::default()
+                };
+                let res = board.run(n_settle, &points, run_opts, &report);
+                let finished = (|| {
+                    let out = res?;
+                    // A raised flag may have cut the run short: only the lanes whose own window
+                    // ended before it hold their points' results. The dumped lane waits for a
+                    // whole run, which writes its dump.
+                    let whole = out.complete.iter().all(|&c| c);
+                    let pts: Vec<(usize, LaneResult)> = g
+                        .iter()
+                        .copied()
+                        .zip(out.lanes)
+                        .zip(&out.complete)
+                        .enumerate()
+                        .filter(|(lane, (_, &c))| {
+                            whole || (c && probe.as_ref().is_none_or(|(l, _)| l != lane))
+                        })
+                        .map(|(_, (p, _))| p)
+                        .collect();
+                    // A whole group that recorded the dump hands its probe on.
+                    let probe = probe
+                        .filter(|_| whole && dump_dir.is_some())
+                        .map(|(_, p)| p);
+                    if let (None, Some(f), false) = (&probe, opts.on_group, pts.is_empty()) {
+                        f(&pts).map_err(SweepError::Output)?;
+                    }
+                    let work = if whole {
+                        samples_of(g) * g.len() as u64
+                    } else {
+                        0
+                    };
+                    Ok((pts, work, whole, probe))
+                })();
+                if finished.is_err() {
+                    stop.store(true, Ordering::Relaxed);
+                }
+                Some(finished)
+            })
+            .collect()
+    });
+    let mut early = early.into_inner().unwrap_or_else(|e| e.into_inner());
     let mut run = SweepRun {
         lanes: opts.done,
         computed: Vec::new(),
@@ -304,6 +335,7 @@ pub fn run_sweep_with(
         point_samples: 0,
         dump_files: Vec::new(),
         dump_bytes: 0,
+        dump_made: Vec::new(),
         dump_write_s: 0.0,
     };
     let mut first_err = None;
@@ -315,25 +347,22 @@ pub fn run_sweep_with(
             }
             Some(Ok((pts, work, whole, probe))) => {
                 if let (Some(p), Some(dir)) = (probe, dump_dir) {
+                    // Written early (its task ran within the scope above), else now.
+                    let written = early
+                        .take()
+                        .unwrap_or_else(|| write_dump(&p, dir, early_on.map(|(then, _)| then)));
                     // The dump first, then its group's points: a failed write leaves them
                     // unsaved, so a rerun records the dump again.
-                    let t = Instant::now();
-                    let written = p.write(dir, DUMP_STEM);
-                    run.dump_write_s += t.elapsed().as_secs_f64();
-                    let written = written
-                        .map_err(|e| SweepError::Output(e.to_string()))
-                        .and_then(|files| match opts.on_group {
-                            Some(f) => f(&pts).map(|_| files).map_err(SweepError::Output),
-                            None => Ok(files),
-                        });
+                    let written = written.and_then(|w| match opts.on_group {
+                        Some(f) => f(&pts).map(|_| w).map_err(SweepError::Output),
+                        None => Ok(w),
+                    });
                     match written {
-                        Ok(files) => {
-                            run.dump_bytes += files
-                                .iter()
-                                .filter_map(|f| std::fs::metadata(f).ok())
-                                .map(|m| m.len())
-                                .sum::<u64>();
-                            run.dump_files.extend(files);
+                        Ok(w) => {
+                            run.dump_bytes += w.bytes;
+                            run.dump_write_s += w.seconds;
+                            run.dump_files.extend(w.files);
+                            run.dump_made.extend(w.made);
                         }
                         Err(e) => {
                             first_err.get_or_insert(e);
@@ -350,11 +379,56 @@ pub fn run_sweep_with(
             }
         }
     }
+    // A dump written early for a group a cancel stopped: its files stay, listed.
+    match early {
+        Some(Ok(w)) => {
+            run.dump_bytes += w.bytes;
+            run.dump_write_s += w.seconds;
+            run.dump_files.extend(w.files);
+            run.dump_made.extend(w.made);
+        }
+        Some(Err(e)) => {
+            first_err.get_or_insert(e);
+        }
+        None => {}
+    }
     if let Some(e) = first_err {
         return Err(e);
     }
     run.computed.sort_unstable();
     Ok(run)
+}
+
+/// A dump written, and the files made from it.
+struct DumpWritten {
+    files: Vec<PathBuf>,
+    made: Vec<PathBuf>,
+    bytes: u64,
+    seconds: f64,
+}
+
+/// Writes `p` into `dir`, then runs `then` on its files.
+fn write_dump(p: &Probe, dir: &Path, then: Option<OnDump>) -> Result<DumpWritten, SweepError> {
+    let t = Instant::now();
+    let files = p
+        .write(dir, DUMP_STEM)
+        .map_err(|e| SweepError::Output(e.to_string()))?;
+    let seconds = t.elapsed().as_secs_f64();
+    let bytes = files
+        .iter()
+        .filter_map(|f| std::fs::metadata(f).ok())
+        .map(|m| m.len())
+        .sum::<u64>();
+    let made = match then {
+        Some(then) => then(&files).map_err(SweepError::Output)?,
+        None => Vec::new(),
+    };
+    Ok(DumpWritten {
+        files,
+        made,
+        bytes,
+        seconds,
+    })
 }
 
 /// Turns the lane results of every point of a sweep (by index in `emulated_rates_dps`) into

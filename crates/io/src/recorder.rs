@@ -65,6 +65,11 @@ impl SignalRecorder {
         self
     }
 
+    /// The first sample index past the window.
+    pub fn end(&self) -> u64 {
+        self.start.saturating_add(self.len)
+    }
+
     /// True when sample index `n` lies in the window (one subtraction and one compare).
     #[inline]
     pub fn wants(&self, n: u64) -> bool {

@@ -12,6 +12,7 @@ use gyroemu_config::presets::preset;
 use gyroemu_config::{Config, DumpConfig};
 use gyroemu_experiment::{
     finish_sweep_with, run_sweep_with, DumpPlan, Reporter, Stage2Leaks, SweepOptions, SweepResult,
+    SweepRun, DUMP_STEM,
 };
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
 use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
@@ -168,12 +169,20 @@ pub fn reproduce(
                     // The dump only records: the results are those of a run without it.
                     // Groups sized for one thread: the pool is shared by every experiment,
                     // so each group is as wide as the CPU runs (bits do not depend on it).
+                    let dir = out.join(job.preset);
+                    // The dump and its figures as soon as its window is recorded, on a
+                    // thread the groups leave idle: the longest experiment's would otherwise
+                    // be drawn after it, at the end of the run.
+                    let dump_figures = |_: &[PathBuf]| -> Result<Vec<PathBuf>, String> {
+                        let set = read_dump_set(&dir.join(DUMP_STEM)).map_err(|e| e.to_string())?;
+                        write_dump_figures(&set, &dir).map_err(|e| e.to_string())
+                    };
                     let opts = SweepOptions {
                         dump: Some(reproduce_dump(&job.cfg)),
                         group_threads: Some(1),
+                        on_dump_early: Some(&dump_figures),
                         ..Default::default()
                     };
-                    let dir = out.join(job.preset);
                     let progress = |d: u64, t: u64| report(i, d, t);
                     let res = (|| {
                         // The stage-2 leaks depend on the config alone: a thread the sweeps
@@ -187,7 +196,7 @@ pub fn reproduce(
                         let run = run?;
                         let r = finish_sweep_with(&job.cfg, &run.lanes, &leaks)?;
                         let written = if r.problems.is_empty() {
-                            Some(write_job(out, job, &run.dump_files, &r))
+                            Some(write_job(out, job, &run, &r))
                         } else {
                             None
                         };
@@ -387,26 +396,19 @@ fn figure_name(preset: &str) -> Option<&'static str> {
     })
 }
 
-/// An experiment's outputs: its results, its dump (`dump_files`, written by the sweep) and
-/// the dump's figures in its folder, and its own figure in `out`. Returns the files of its
+/// An experiment's outputs: its results, and its dump and the dump's figures (written by the
+/// sweep, in `run`) in its folder, and its own figure in `out`. Returns the files of its
 /// folder, then its figure.
 fn write_job(
     out: &Path,
     job: &Job,
-    dump_files: &[PathBuf],
+    swept: &SweepRun,
     r: &SweepResult,
 ) -> Result<(Vec<PathBuf>, Option<PathBuf>), ReportError> {
     let dir = out.join(job.preset);
     // In parallel: the last experiment to finish has the pool to itself.
-    let ((run, dump), figure) = rayon::join(
-        || {
-            rayon::join(
-                || write_run(&dir, &job.cfg, r, job.title),
-                || -> Result<_, ReportError> {
-                    write_dump_figures(&read_dump_set(&dir.join("dump"))?, &dir)
-                },
-            )
-        },
+    let (run, figure) = rayon::join(
+        || write_run(&dir, &job.cfg, r, job.title),
         || -> Result<_, ReportError> {
             let Some(name) = figure_name(job.preset) else {
                 return Ok(None);
@@ -421,8 +423,8 @@ fn write_job(
         },
     );
     let mut files = run?;
-    files.extend(dump_files.iter().cloned());
-    files.extend(dump?);
+    files.extend(swept.dump_files.iter().cloned());
+    files.extend(swept.dump_made.iter().cloned());
     Ok((files, figure?))
 }
 

@@ -159,6 +159,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         on_group: Some(&on_group),
         dump: None,
         group_threads: None,
+        on_dump_early: None,
     };
     let swept = match run_sweep_with(&held, &|d, t| task.update(d, t), Some(out), opts) {
         Ok(s) => s,

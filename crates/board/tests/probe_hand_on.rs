@@ -1,0 +1,116 @@
+//! A run hands its probe on (`RunOptions::on_probe_recorded`) once both dump windows have
+//! ended: exactly once, while the run goes on, holding what a run without the hand-on records;
+//! and the run's results do not change.
+
+mod common;
+
+use common::{m2tfg, noisy, point};
+use gyroemu_board::{Board, Probe, RunOptions, Shape, DUMP_NODES};
+use gyroemu_core::f64x4;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+
+/// Every file a probe writes, by name, with its bytes.
+fn files(p: &Probe) -> Vec<(String, Vec<u8>)> {
+    let dir = tempfile::tempdir().unwrap();
+    let mut out: Vec<(String, Vec<u8>)> = p
+        .write(dir.path(), "dump")
+        .unwrap()
+        .iter()
+        .map(|f| {
+            let name = f.file_name().unwrap().to_string_lossy().into_owned();
+            (name, std::fs::read(f).unwrap())
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+#[test]
+fn the_probe_is_handed_on_once_its_windows_end_with_a_whole_runs_recording() {
+    let n_settle = 12;
+    let points = [point(25.0, 300), point(100.0, 3000)];
+    let rad: Vec<f64> = points.iter().map(|p| p.rate_rad_s).collect();
+    let nodes: Vec<String> = DUMP_NODES.map(String::from).to_vec();
+    // From 10 ms: 2 ms at the full rate and 50 ms decimated, then 30.1 ms and 5 ms (either
+    // window ends last); both end before input sample 14 400, long before the run's 301 200.
+    let windows = [(0.002, 0.05), (0.0301, 0.005)];
+    let shapes = [
+        Shape::Coriolis,
+        Shape::RateTable { freq_hz: 2.0 },
+        Shape::Rotating,
+    ];
+    for (shape, (full_s, dec_s)) in shapes.into_iter().flat_map(|s| windows.map(|w| (s, w))) {
+        let p = noisy(m2tfg(shape), 5);
+        let (fs, m) = (p.fs_hz(), p.decimation);
+        let probe = || Probe::new(&nodes, fs, m, 0.01, full_s, 1).with_decimated_duration(dec_s);
+        let mut whole = probe();
+        let plain = Board::<f64x4>::new(&p, &rad, &[1, 2])
+            .unwrap()
+            .run(
+                n_settle,
+                &points,
+                RunOptions {
+                    probe: Some(&mut whole),
+                    ..Default::default()
+                },
+                &|_| {},
+            )
+            .unwrap();
+
+        let done = AtomicU64::new(0);
+        let handed = Mutex::new(Vec::new());
+        let hand_on = |pr: &Probe| {
+            let at = done.load(Ordering::SeqCst);
+            handed.lock().unwrap().push((at, files(pr)));
+        };
+        let mut early = probe();
+        let out = Board::<f64x4>::new(&p, &rad, &[1, 2])
+            .unwrap()
+            .run(
+                n_settle,
+                &points,
+                RunOptions {
+                    probe: Some(&mut early),
+                    on_probe_recorded: Some(&hand_on),
+                    ..Default::default()
+                },
+                &|n| done.store(n, Ordering::SeqCst),
+            )
+            .unwrap();
+        let handed = handed.into_inner().unwrap();
+        assert_eq!(handed.len(), 1, "{shape:?}: handed on once");
+        let (at, got) = &handed[0];
+        let end = (n_settle + 3000 + 1) * m as u64;
+        assert!(*at < end / 10, "{shape:?}: handed on at {at} of {end}");
+        assert_eq!(*got, files(&whole), "{shape:?}");
+        assert_eq!(files(&early), files(&whole), "{shape:?}");
+        assert_eq!(out.lanes, plain.lanes, "{shape:?}");
+    }
+}
+
+#[test]
+fn a_finite_check_is_never_handed_on() {
+    let points = [point(25.0, 30)];
+    let p = m2tfg(Shape::Rotating);
+    let calls = AtomicU64::new(0);
+    let hand_on = |_: &Probe| {
+        calls.fetch_add(1, Ordering::SeqCst);
+    };
+    let mut check = Probe::finite_check(1);
+    Board::<f64x4>::new(&p, &[points[0].rate_rad_s], &[1])
+        .unwrap()
+        .run(
+            12,
+            &points,
+            RunOptions {
+                probe: Some(&mut check),
+                on_probe_recorded: Some(&hand_on),
+                ..Default::default()
+            },
+            &|_| {},
+        )
+        .unwrap();
+    assert_eq!(calls.load(Ordering::SeqCst), 0);
+    assert!(check.fault().is_none());
+}
