@@ -66,9 +66,10 @@ pub fn run_sweep(
 
 /// Called with each finished lane group's points, `(index in emulated_rates_dps, lane
 /// result)`, and with the finished points of a group a cancel stopped: from the worker
-/// threads, except for the group that records the dump, whose dump is written and points
-/// passed after every group has run (so the write is timed apart from the emulation, and a
-/// group's points are never saved without its dump). An error stops the sweep (groups not
+/// threads, except for the group that records the dump, whose dump is written (while the
+/// groups run, with [`SweepOptions::on_dump_early`]) and points passed after every group has
+/// run (so the write is timed apart from the emulation, and a group's points are never saved
+/// without its dump). An error stops the sweep (groups not
 /// started are skipped) and is returned.
 pub type OnGroup<'a> = &'a (dyn Fn(&[(usize, LaneResult)]) -> Result<(), String> + Sync);
 
