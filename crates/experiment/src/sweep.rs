@@ -69,8 +69,8 @@ pub fn run_sweep(
 /// threads, except for the group that records the dump, whose dump is written (while the
 /// groups run, with [`SweepOptions::on_dump_early`]) and points passed after every group has
 /// run (so the write is timed apart from the emulation, and a group's points are never saved
-/// without its dump). An error stops the sweep (groups not
-/// started are skipped) and is returned.
+/// without its dump). An error stops the sweep (groups not started are skipped) and is
+/// returned.
 pub type OnGroup<'a> = &'a (dyn Fn(&[(usize, LaneResult)]) -> Result<(), String> + Sync);
 
 /// Called with a dump's files once they are written (see [`SweepOptions::on_dump_early`]);

@@ -166,9 +166,6 @@ pub fn reproduce(
                 .with_max_len(1)
                 .map(|&i| {
                     let job = &jobs[i];
-                    // The dump only records: the results are those of a run without it.
-                    // Groups sized for one thread: the pool is shared by every experiment,
-                    // so each group is as wide as the CPU runs (bits do not depend on it).
                     let dir = out.join(job.preset);
                     // The dump and its figures as soon as its window is recorded, on a
                     // thread the groups leave idle: the longest experiment's would otherwise
@@ -177,6 +174,9 @@ pub fn reproduce(
                         let set = read_dump_set(&dir.join(DUMP_STEM)).map_err(|e| e.to_string())?;
                         write_dump_figures(&set, &dir).map_err(|e| e.to_string())
                     };
+                    // The dump only records: the results are those of a run without it.
+                    // Groups sized for one thread: the pool is shared by every experiment,
+                    // so each group is as wide as the CPU runs (bits do not depend on it).
                     let opts = SweepOptions {
                         dump: Some(reproduce_dump(&job.cfg)),
                         group_threads: Some(1),
