@@ -22,8 +22,8 @@ pub use readout::{
     post_process, post_process_with, theory_deg, Compensation, PointResult, SweepResult,
 };
 pub use sweep::{
-    dump_point, finish_sweep, finish_sweep_with, run_sweep, run_sweep_with, OnGroup, SweepError,
-    SweepOptions, SweepRun, DUMP_STEM,
+    dump_point, finish_sweep, finish_sweep_with, run_sweep, run_sweep_with, OnDump, OnGroup,
+    SweepError, SweepOptions, SweepRun, DUMP_STEM,
 };
 pub use table_sweep::run_table_sweeps;
 pub use work::{sweep_work, Work, MAX_POINT_SAMPLES};

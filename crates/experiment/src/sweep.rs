@@ -130,6 +130,14 @@ pub struct SweepRun {
 }
 
 impl SweepRun {
+    /// Lists a dump written.
+    fn add_dump(&mut self, w: DumpWritten) {
+        self.dump_bytes += w.bytes;
+        self.dump_write_s += w.seconds;
+        self.dump_files.extend(w.files);
+        self.dump_made.extend(w.made);
+    }
+
     /// The dump written, for a progress line.
     pub fn written(&self) -> Written {
         Written {
@@ -359,12 +367,7 @@ pub fn run_sweep_with(
                         None => Ok(w),
                     });
                     match written {
-                        Ok(w) => {
-                            run.dump_bytes += w.bytes;
-                            run.dump_write_s += w.seconds;
-                            run.dump_files.extend(w.files);
-                            run.dump_made.extend(w.made);
-                        }
+                        Ok(w) => run.add_dump(w),
                         Err(e) => {
                             first_err.get_or_insert(e);
                             continue;
@@ -382,12 +385,7 @@ pub fn run_sweep_with(
     }
     // A dump written early for a group a cancel stopped: its files stay, listed.
     match early {
-        Some(Ok(w)) => {
-            run.dump_bytes += w.bytes;
-            run.dump_write_s += w.seconds;
-            run.dump_files.extend(w.files);
-            run.dump_made.extend(w.made);
-        }
+        Some(Ok(w)) => run.add_dump(w),
         Some(Err(e)) => {
             first_err.get_or_insert(e);
         }

@@ -4,7 +4,9 @@
 
 use gyroemu_board::{LaneResult, DUMP_NODES};
 use gyroemu_config::{presets::preset, Config};
-use gyroemu_experiment::{run_sweep_with, DumpPlan, SweepError, SweepOptions, SweepRun};
+use gyroemu_experiment::{
+    run_sweep_with, DumpPlan, OnDump, OnGroup, SweepError, SweepOptions, SweepRun,
+};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
@@ -41,6 +43,19 @@ fn sweep(dir: &Path, opts: SweepOptions) -> Result<SweepRun, SweepError> {
     run_sweep_with(&small(), &|_, _| {}, Some(dir), opts)
 }
 
+/// The sweep with the dump written early through `hook`, each group passed to `on_group`.
+fn early_sweep(dir: &Path, on_group: OnGroup, hook: OnDump) -> Result<SweepRun, SweepError> {
+    sweep(
+        dir,
+        SweepOptions {
+            dump: Some(plan()),
+            on_group: Some(on_group),
+            on_dump_early: Some(hook),
+            ..Default::default()
+        },
+    )
+}
+
 #[test]
 fn an_early_dump_writes_the_same_files_and_lists_the_hooks_apart() {
     let late_dir = tempfile::tempdir().unwrap();
@@ -74,16 +89,7 @@ fn an_early_dump_writes_the_same_files_and_lists_the_hooks_apart() {
             .extend(pts.iter().map(|p| (p.0, after)));
         Ok(())
     };
-    let early = sweep(
-        dir.path(),
-        SweepOptions {
-            dump: Some(plan()),
-            on_group: Some(&on_group),
-            on_dump_early: Some(&hook),
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let early = early_sweep(dir.path(), &on_group, &hook).unwrap();
 
     assert_eq!(early.lanes, late.lanes);
     assert_eq!(names(&early.dump_files), names(&late.dump_files));
@@ -113,16 +119,7 @@ fn a_failing_hook_stops_the_sweep_and_leaves_its_group_unsaved() {
         passed.lock().unwrap().extend(pts.iter().map(|p| p.0));
         Ok(())
     };
-    let err = sweep(
-        dir.path(),
-        SweepOptions {
-            dump: Some(plan()),
-            on_group: Some(&on_group),
-            on_dump_early: Some(&hook),
-            ..Default::default()
-        },
-    )
-    .unwrap_err();
+    let err = early_sweep(dir.path(), &on_group, &hook).unwrap_err();
     assert!(err.to_string().contains("no figures"), "{err}");
     assert!(!passed.into_inner().unwrap().contains(&DUMPED));
 }
