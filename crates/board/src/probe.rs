@@ -16,7 +16,6 @@ pub struct Probe {
     nodes: [bool; 7],
     full: SignalRecorder,
     decimated: SignalRecorder,
-    full_window: (u64, u64),
     /// Finite-check mode (locating a non-finite value): every lane of every node is checked
     /// and the first fault kept as (stage, input sample, lane); nothing is recorded.
     check_lanes: usize,
@@ -97,7 +96,6 @@ impl Probe {
             lane,
             nodes: on,
             full: SignalRecorder::new(names(&full_table, 0), fs_hz, start, len),
-            full_window: (start, len),
             // Decimated sample k is formed at input sample kM + M - 1.
             decimated: SignalRecorder::new(names(&dec_table, 5), fs_out, start_out, len_out)
                 .with_time_origin((decimation - 1) as f64 / fs_hz),
@@ -134,7 +132,6 @@ impl Probe {
             nodes: [false; 7],
             full: SignalRecorder::new(Vec::new(), 1.0, 0, 0),
             decimated: SignalRecorder::new(Vec::new(), 1.0, 0, 0),
-            full_window: (0, 0),
             check_lanes: lanes,
             fault: None,
         }
@@ -171,8 +168,7 @@ impl Probe {
         if self.check_lanes > 0 {
             return true;
         }
-        let (start, len) = self.full_window;
-        !self.full.names().is_empty() && n0 < start.saturating_add(len) && n0 + m > start
+        !self.full.names().is_empty() && n0 < self.full.end() && n0 + m > self.full.start()
     }
 
     /// The decimated sample `k` after which both windows have ended (input samples up to
@@ -182,18 +178,14 @@ impl Probe {
         if self.check_lanes > 0 {
             return None;
         }
-        let (start, len) = self.full_window;
-        let full_end = if self.full.names().is_empty() {
-            0
-        } else {
-            start.saturating_add(len)
-        };
-        let dec_end = if self.decimated.names().is_empty() {
-            0
-        } else {
-            self.decimated.end()
-        };
-        Some(full_end.div_ceil(m.max(1)).max(dec_end).saturating_sub(1))
+        // A recorder with no nodes has nothing to wait for.
+        let end = |r: &SignalRecorder| if r.names().is_empty() { 0 } else { r.end() };
+        Some(
+            end(&self.full)
+                .div_ceil(m.max(1))
+                .max(end(&self.decimated))
+                .saturating_sub(1),
+        )
     }
 
     /// Records the full-rate nodes of input sample `n`.

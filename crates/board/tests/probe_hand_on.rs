@@ -5,10 +5,26 @@
 mod common;
 
 use common::{m2tfg, noisy, point};
-use gyroemu_board::{Board, Probe, RunOptions, Shape, DUMP_NODES};
+use gyroemu_board::{Board, BoardParams, Point, Probe, RunOptions, RunOutput, Shape, DUMP_NODES};
 use gyroemu_core::f64x4;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
+
+/// A four-lane run of `points` on `p` (lanes at `rates`, lane seeds from 1).
+fn run(
+    p: &BoardParams,
+    rates: &[f64],
+    n_settle: u64,
+    points: &[Point],
+    opts: RunOptions,
+    progress: &(dyn Fn(u64) + Sync),
+) -> RunOutput {
+    let seeds: Vec<u64> = (1..=rates.len() as u64).collect();
+    Board::<f64x4>::new(p, rates, &seeds)
+        .unwrap()
+        .run(n_settle, points, opts, progress)
+        .unwrap()
+}
 
 /// Every file a probe writes, by name, with its bytes.
 fn files(p: &Probe) -> Vec<(String, Vec<u8>)> {
@@ -45,18 +61,17 @@ fn the_probe_is_handed_on_once_its_windows_end_with_a_whole_runs_recording() {
         let (fs, m) = (p.fs_hz(), p.decimation);
         let probe = || Probe::new(&nodes, fs, m, 0.01, full_s, 1).with_decimated_duration(dec_s);
         let mut whole = probe();
-        let plain = Board::<f64x4>::new(&p, &rad, &[1, 2])
-            .unwrap()
-            .run(
-                n_settle,
-                &points,
-                RunOptions {
-                    probe: Some(&mut whole),
-                    ..Default::default()
-                },
-                &|_| {},
-            )
-            .unwrap();
+        let plain = run(
+            &p,
+            &rad,
+            n_settle,
+            &points,
+            RunOptions {
+                probe: Some(&mut whole),
+                ..Default::default()
+            },
+            &|_| {},
+        );
 
         let done = AtomicU64::new(0);
         let handed = Mutex::new(Vec::new());
@@ -65,19 +80,18 @@ fn the_probe_is_handed_on_once_its_windows_end_with_a_whole_runs_recording() {
             handed.lock().unwrap().push((at, files(pr)));
         };
         let mut early = probe();
-        let out = Board::<f64x4>::new(&p, &rad, &[1, 2])
-            .unwrap()
-            .run(
-                n_settle,
-                &points,
-                RunOptions {
-                    probe: Some(&mut early),
-                    on_probe_recorded: Some(&hand_on),
-                    ..Default::default()
-                },
-                &|n| done.store(n, Ordering::SeqCst),
-            )
-            .unwrap();
+        let out = run(
+            &p,
+            &rad,
+            n_settle,
+            &points,
+            RunOptions {
+                probe: Some(&mut early),
+                on_probe_recorded: Some(&hand_on),
+                ..Default::default()
+            },
+            &|n| done.store(n, Ordering::SeqCst),
+        );
         let handed = handed.into_inner().unwrap();
         assert_eq!(handed.len(), 1, "{shape:?}: handed on once");
         let (at, got) = &handed[0];
@@ -98,19 +112,18 @@ fn a_finite_check_is_never_handed_on() {
         calls.fetch_add(1, Ordering::SeqCst);
     };
     let mut check = Probe::finite_check(1);
-    Board::<f64x4>::new(&p, &[points[0].rate_rad_s], &[1])
-        .unwrap()
-        .run(
-            12,
-            &points,
-            RunOptions {
-                probe: Some(&mut check),
-                on_probe_recorded: Some(&hand_on),
-                ..Default::default()
-            },
-            &|_| {},
-        )
-        .unwrap();
+    run(
+        &p,
+        &[points[0].rate_rad_s],
+        12,
+        &points,
+        RunOptions {
+            probe: Some(&mut check),
+            on_probe_recorded: Some(&hand_on),
+            ..Default::default()
+        },
+        &|_| {},
+    );
     assert_eq!(calls.load(Ordering::SeqCst), 0);
     assert!(check.fault().is_none());
 }

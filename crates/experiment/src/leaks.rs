@@ -35,7 +35,8 @@ impl Stage2Leaks {
         let chain = ChainResponse::new(&cfg.board_params())?;
         let n_settle = cfg.n_settle_out();
         let mut entries = Vec::new();
-        for &rate in &cfg.experiment.rates_dps {
+        // The points `finish_sweep` reads out.
+        for rate in cfg.emulated_rates_dps() {
             let point = cfg.plan_point(rate);
             let leak = chain.stage2_leak(&point, n_settle)?;
             entries.push(Entry::new(&chain, point, n_settle, leak));

@@ -66,6 +66,7 @@ impl SignalRecorder {
     }
 
     /// The first sample index past the window.
+    #[inline]
     pub fn end(&self) -> u64 {
         self.start.saturating_add(self.len)
     }
@@ -102,6 +103,7 @@ impl SignalRecorder {
     }
 
     /// First sample index of the window.
+    #[inline]
     pub fn start(&self) -> u64 {
         self.start
     }
