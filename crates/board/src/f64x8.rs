@@ -432,7 +432,7 @@ mod tests {
                         _ => edges[((r >> 20) % 8) as usize],
                     };
                     let x = code * step;
-                    let moved = f64::from_bits((x.to_bits() as i64 + ulps) as u64);
+                    let moved = f64::from_bits((x.to_bits() as i64).wrapping_add(ulps) as u64);
                     if x == 0.0 || !x.is_finite() {
                         x
                     } else {
