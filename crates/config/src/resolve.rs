@@ -144,7 +144,9 @@ impl Config {
             };
             // Within the point's run: settling plus its averaging window.
             let p = self.plan_point(rate);
-            let total = (self.n_settle_out() + p.window.samples()) as f64 / self.fs_out_hz();
+            // Saturating: this runs before validation has bounded settle_s and average_s.
+            let n_out = self.n_settle_out().saturating_add(p.window.samples());
+            let total = n_out as f64 / self.fs_out_hz();
             want.min(DEFAULT_DUMP_FRAMES / fs)
                 .max(20.0 / f0)
                 .min(total - start)

@@ -1171,6 +1171,13 @@ fn cases() -> Vec<Case> {
         )
         // The dump's own window is also far too long, whatever the run.
         .problems(2),
+        // The dump's default window is sized from the point's run before validation bounds
+        // it; the sizing must not wrap (or, with overflow checks, panic).
+        invalid(
+            "dump of a huge averaging window",
+            set(&dumped, "experiment", "average_s", "1e300"),
+            &["experiment.average_s", "1e300", "2^53"],
+        ),
     ]
 }
 

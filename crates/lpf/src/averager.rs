@@ -48,7 +48,8 @@ impl Window {
     /// or the zero end of a Hann window, is pushed too).
     pub fn samples(&self) -> u64 {
         match *self {
-            Window::Boxcar { n, .. } | Window::Hann { n } => n + 1,
+            // Saturating: a config's window is sized before validation bounds it.
+            Window::Boxcar { n, .. } | Window::Hann { n } => n.saturating_add(1),
         }
     }
 
@@ -183,6 +184,23 @@ mod tests {
             "f64 has one lane"
         );
         assert!(Averager::<f64, 2>::new(&two[..1], 3).is_err());
+    }
+
+    #[test]
+    fn samples_is_one_past_the_window_and_saturates_at_the_top() {
+        assert_eq!(Window::Boxcar { n: 7, frac: 0.5 }.samples(), 8);
+        assert_eq!(Window::Hann { n: 7 }.samples(), 8);
+        // A config's window is sized (as `f64 as u64`, saturating) before validation bounds
+        // it; wrapping to 0 there would make a huge run look empty.
+        assert_eq!(
+            Window::Boxcar {
+                n: u64::MAX,
+                frac: 0.0
+            }
+            .samples(),
+            u64::MAX
+        );
+        assert_eq!(Window::Hann { n: u64::MAX }.samples(), u64::MAX);
     }
 
     #[test]
