@@ -57,6 +57,40 @@ fn the_derived_decimation_keeps_the_mixer_product_off_dc() {
 }
 
 #[test]
+fn the_derived_decimation_is_the_farthest_alias_of_its_search_window() {
+    // A plain scan of every M the rule allows, against `decimation()`. Up to 2^17 the search
+    // covers M_max/2 ..= M_max; beyond, its top DECIMATION_CANDIDATES, and a 1e-4 of the
+    // output rate at most is given away against the whole range (checked to M_max = 1e7).
+    use gyroemu::config::DECIMATION_CANDIDATES;
+    for fs in [240e3, 250_003.141_592_653_6, 241_234.5] {
+        for m_max in [
+            1usize, 7, 100, 4097, 131_071, 131_072, 1_000_003, 10_000_000,
+        ] {
+            let cutoff = fs / (20.0 * m_max as f64 + 0.5);
+            let board = format!("[board]\nfs_hz = {fs:?}\nlpf_cutoff_hz = {cutoff:?}");
+            let cfg =
+                parse_config(&minimal("rotating", 15e3, 2000.0, &[100.0], 1.0, &board)).unwrap();
+            assert_eq!((fs / (20.0 * cutoff)).floor() as usize, m_max);
+            let m = cfg.decimation();
+            let d = |m: usize| alias_distance(fs, 15e3, m);
+            let all = (m_max.div_ceil(2)..=m_max).map(d).fold(0.0, f64::max);
+            let top = m_max - m_max.div_ceil(2).max(m_max + 1 - DECIMATION_CANDIDATES);
+            let (lo, slack) = if m_max < 131_072 {
+                (m_max.div_ceil(2), 1e-12)
+            } else {
+                (m_max - top, 1e-4)
+            };
+            assert!(lo <= m && m <= m_max, "{fs} {m_max}: M = {m}");
+            assert!(
+                d(m) >= all - slack,
+                "{fs} {m_max}: M = {m}: {} < {all}",
+                d(m)
+            );
+        }
+    }
+}
+
+#[test]
 fn a_second_order_low_pass_with_the_derived_decimation_reads_psi_exactly() {
     // 1 kHz, Q = 100, rotating at 1800 deg/s, order 2: the low-pass leaves 2e-5 of the 2 f0
     // product. With M = 16 the output rate divides 2 f0 and that residue sits on DC, biasing

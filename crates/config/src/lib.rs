@@ -27,7 +27,10 @@ pub use config::{
 pub use error::ConfigError;
 pub use parse::{parse_config, parse_config_explained, plain_words};
 pub use plan::sweep_grid;
-pub use resolve::{Derived, SWEEP_AVERAGE_TAUS, SWEEP_SETTLE_TAUS, SWEEP_SPAN_HALF_BANDWIDTHS};
+pub use resolve::{
+    Derived, DECIMATION_CANDIDATES, SWEEP_AVERAGE_TAUS, SWEEP_SETTLE_TAUS,
+    SWEEP_SPAN_HALF_BANDWIDTHS,
+};
 pub use validate::MAX_RUN_SAMPLES;
 pub use validate_regime::{MAX_HOLD_ERROR_MDEG, NODE_RANGE, WARN_HOLD_ERROR_MDEG};
 pub use validate_sweep::{MAX_SWEEP_POINTS, MIN_POINTS_NEAR_RESONANCE, MIN_SWEEP_POINTS};

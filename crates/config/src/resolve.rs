@@ -18,6 +18,8 @@ pub const F0_OVER_MIN_CUTOFF: f64 = 100.0;
 pub const F0_OVER_MAX_CUTOFF: f64 = 10.0;
 /// The default decimation keeps this many output samples per cutoff period.
 pub const OUTPUT_SAMPLES_PER_CUTOFF: f64 = 20.0;
+/// The derived decimation searches at most this many M, the largest (see `decimation`).
+pub const DECIMATION_CANDIDATES: usize = 1 << 16;
 /// A default dump holds at most this many full-rate frames (small files).
 pub const DEFAULT_DUMP_FRAMES: f64 = 50_000.0;
 
@@ -95,6 +97,9 @@ impl Config {
     /// stage-1 mixer's 2 f_c product, aliased by the decimation, farthest from DC (the largest
     /// such M on a tie). An output rate dividing 2 f_c would fold what the low-pass leaves of
     /// that product onto the averaged DC (at 16 samples per period, every M multiple of 8).
+    /// From `M_max` = 2^17 on, only the top [`DECIMATION_CANDIDATES`] are searched: so many
+    /// consecutive M still put the product next to the output Nyquist (tested), and a
+    /// mistyped rate (`M_max` up to 1e9) is refused at once instead of after a second's search.
     pub fn decimation(&self) -> usize {
         self.board.decimation.unwrap_or_else(|| {
             let m = (self.fs_hz() / (OUTPUT_SAMPLES_PER_CUTOFF * self.lpf_cutoff_hz())).floor();
@@ -108,7 +113,10 @@ impl Config {
                 let a = (two_fc_per_sample * m as f64).rem_euclid(1.0);
                 a.min(1.0 - a)
             };
-            (m_max.div_ceil(2)..=m_max)
+            let lowest = m_max
+                .div_ceil(2)
+                .max(m_max - (DECIMATION_CANDIDATES - 1).min(m_max - 1));
+            (lowest..=m_max)
                 .rev()
                 .fold((m_max, -1.0), |best, m| {
                     let d = dist(m);
