@@ -1,0 +1,168 @@
+//! Every number of every preset set, one at a time, to an extreme (zero, negative, tiny,
+//! huge, the largest integers, NaN and infinities): validation must refuse or accept it
+//! without a panic, and a config it accepts must plan without an integer wrapping (the plan's
+//! integer sample counts agree with the same sums done in f64). The cargo-fuzz targets
+//! (`fuzz/`, nightly, not in CI) edit one line of a preset; this sweep is deterministic, runs
+//! in CI, and also covers a `[dump]` section, which no preset carries.
+
+use gyroemu::analysis::montecarlo::validate_lot;
+use gyroemu::analysis::selfcal::validate_selfcal;
+use gyroemu::config::presets::PRESETS;
+use gyroemu::config::{parse_config, Config};
+use gyroemu::experiment::sweep_work;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use toml::Value;
+
+const FLOATS: [f64; 12] = [
+    0.0,
+    -0.0,
+    -1.0,
+    5e-324,
+    1e-300,
+    1e300,
+    -1e300,
+    f64::MAX,
+    f64::NAN,
+    f64::INFINITY,
+    f64::NEG_INFINITY,
+    4.5e15,
+];
+const INTS: [i64; 7] = [0, -1, 1, i64::MAX, i64::MIN, 1 << 32, (1 << 53) + 1];
+
+/// A dump of the largest rate from the settled start, every node: the defaults, written out.
+const DUMP: &str = "\n[dump]\nstart_s = 0.5\nduration_s = 0.002\n";
+
+/// Every path to a number (or to an array of numbers) in `v`.
+fn numeric_paths(v: &Value, at: &mut Vec<String>, out: &mut Vec<Vec<String>>) {
+    match v {
+        Value::Integer(_) | Value::Float(_) => out.push(at.clone()),
+        Value::Table(t) => {
+            for (k, x) in t {
+                at.push(k.clone());
+                numeric_paths(x, at, out);
+                at.pop();
+            }
+        }
+        Value::Array(a) => {
+            if a.iter()
+                .any(|x| matches!(x, Value::Integer(_) | Value::Float(_)))
+            {
+                out.push(at.clone());
+            }
+            for (i, x) in a.iter().enumerate() {
+                at.push(i.to_string());
+                numeric_paths(x, at, out);
+                at.pop();
+            }
+        }
+        _ => {}
+    }
+}
+
+fn slot<'a>(v: &'a mut Value, path: &[String]) -> &'a mut Value {
+    path.iter().fold(v, |v, k| match v {
+        Value::Table(t) => t.get_mut(k).expect("path from the same tree"),
+        Value::Array(a) => &mut a[k.parse::<usize>().expect("index")],
+        _ => unreachable!("paths end at numbers"),
+    })
+}
+
+/// The replacements tried at a number: every extreme of its own type and one of the other.
+fn extremes(v: &Value) -> Vec<Value> {
+    let floats = FLOATS.iter().map(|&f| Value::Float(f));
+    let ints = INTS.iter().map(|&i| Value::Integer(i));
+    match v {
+        Value::Integer(_) => ints.chain([Value::Float(1e300)]).collect(),
+        Value::Float(_) => floats.chain([Value::Integer(i64::MAX)]).collect(),
+        Value::Array(a) => {
+            let mut out = vec![Value::Array(vec![])];
+            out.extend(floats.map(|f| Value::Array(vec![f])));
+            out.extend(a.first().map(|x| Value::Array(vec![x.clone(); 65])));
+            out
+        }
+        _ => vec![],
+    }
+}
+
+/// Validates `text` as each command that reads it would, then plans an accepted config.
+fn check(name: &str, text: &str) {
+    let Ok(cfg) = parse_config(text) else {
+        return;
+    };
+    let plain = cfg.validate().is_ok();
+    if name == "m2tfg-sweep" {
+        let _ = cfg.validate_sweep();
+    }
+    if cfg.selfcal.is_some() {
+        let _ = validate_selfcal(&cfg);
+    }
+    if cfg.montecarlo.is_some() {
+        let _ = validate_lot(&cfg, &[0, 1]);
+    }
+    if plain {
+        plans_without_wrapping(&cfg);
+    }
+}
+
+/// The sweep's integer sample counts agree with the same sums in f64 (a wrapped sum would be
+/// far off); validation bounds a point's run at 2^53 input samples.
+fn plans_without_wrapping(cfg: &Config) {
+    let w = sweep_work(cfg);
+    let longest = cfg
+        .emulated_rates_dps()
+        .iter()
+        .map(|&r| cfg.plan_point(r).window.samples() as f64)
+        .fold(1.0, f64::max);
+    let want = (cfg.n_settle_out() as f64 + longest) * cfg.decimation() as f64;
+    assert!(
+        want <= 2f64.powi(53),
+        "{want} input samples in one point's run"
+    );
+    assert!(
+        (w.longest_samples as f64 - want).abs() <= 1e-9 * want,
+        "longest run {} samples, {want} in f64",
+        w.longest_samples
+    );
+    assert!(w.point_samples as f64 >= want, "{w:?} against {want}");
+    if let Some(d) = cfg.dump_resolved() {
+        let (start, duration) = (d.start_s.unwrap(), d.duration_s.unwrap());
+        assert!(start.is_finite() && duration.is_finite(), "{d:?}");
+    }
+}
+
+#[test]
+fn no_extreme_number_panics_validation_or_wraps_a_plan() {
+    let mut failures = Vec::new();
+    let mut tried = 0;
+    for (name, _, text) in PRESETS {
+        for extra in ["", DUMP] {
+            let text = format!("{text}{extra}");
+            let tree: Value = toml::from_str(&text).expect("presets parse");
+            let mut paths = Vec::new();
+            numeric_paths(&tree, &mut Vec::new(), &mut paths);
+            for path in &paths {
+                for x in extremes(slot(&mut tree.clone(), path)) {
+                    let mut edited = tree.clone();
+                    *slot(&mut edited, path) = x.clone();
+                    let edited = toml::to_string(&edited).expect("serialises");
+                    tried += 1;
+                    if let Err(e) = catch_unwind(AssertUnwindSafe(|| check(name, &edited))) {
+                        let msg = e
+                            .downcast_ref::<String>()
+                            .cloned()
+                            .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
+                            .unwrap_or_default();
+                        failures.push(format!("{name}: {} = {x}: {msg}", path.join(".")));
+                    }
+                }
+            }
+        }
+    }
+    assert!(tried > 1000, "only {tried} edits");
+    assert!(
+        failures.is_empty(),
+        "{} of {tried}:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
