@@ -93,6 +93,21 @@ impl NoiseParams {
         ]
     }
 
+    /// The four flicker sources' densities at 1 Hz as the board designs them, with the keys
+    /// of [`NoiseParams::flicker_levels`]: the TIA's input-referred (A^2/Hz) through a gain of
+    /// `tia_gain_ohm`, the others the squares of their levels. Validation reads them so a
+    /// level whose density overflows is refused with its key before the board is built.
+    pub fn flicker_psds_at_1hz(&self, tia_gain_ohm: f64) -> [(&'static str, f64); 4] {
+        let i_v = gyroemu_tia::input_referred_noise_a_per_rthz(
+            0.0,
+            self.tia_voltage_noise_v_per_rthz,
+            tia_gain_ohm,
+        );
+        let [(tia, corner), slow @ ..] = self.flicker_levels();
+        let [a, b, c] = slow.map(|(key, x)| (key, x * x));
+        [(tia, i_v * i_v * corner), a, b, c]
+    }
+
     /// Whether any flicker source is on.
     pub fn has_flicker(&self) -> bool {
         self.flicker_levels().iter().any(|&(_, v)| v > 0.0)

@@ -31,9 +31,31 @@ impl Config {
                 "noise.tia_voltage_noise_v_per_rthz",
                 n.tia_voltage_noise_v_per_rthz,
             );
-            // The levels as the board reads them (the low corner does not matter here).
-            for (key, v) in crate::plan::noise_params(n, 0.0).flicker_levels() {
-                p.non_negative(key, v);
+            // The levels as the board reads them (the low corner does not matter here), then
+            // the densities it designs from them, which must not overflow.
+            let board_noise = crate::plan::noise_params(n, 0.0);
+            let levels = board_noise.flicker_levels();
+            let levels_ok = levels.map(|(key, v)| p.non_negative(key, v));
+            // The TIA's density overflows through its white level, not its corner.
+            let mut named = levels;
+            named[0] = (
+                "noise.tia_voltage_noise_v_per_rthz",
+                n.tia_voltage_noise_v_per_rthz,
+            );
+            let psds = board_noise.flicker_psds_at_1hz(b.tia_gain_ohm);
+            for (((key, v), (_, psd)), ok) in named.into_iter().zip(psds).zip(levels_ok) {
+                if ok && p.clean(&["board.tia_gain_ohm", key]) {
+                    p.check(
+                        psd.is_finite(),
+                        key,
+                        v,
+                        format!(
+                            "gives a flicker density at 1 Hz of {psd:e}, which must be finite \
+                             (the square of the level; for the TIA's, \
+                             (e_n / tia_gain_ohm)^2 x tia_voltage_flicker_corner_hz in A^2/Hz)"
+                        ),
+                    );
+                }
             }
             if n.tia_voltage_flicker_corner_hz > 0.0 && n.tia_voltage_noise_v_per_rthz == 0.0 {
                 warnings.push(

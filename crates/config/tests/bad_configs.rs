@@ -923,6 +923,31 @@ fn cases() -> Vec<Case> {
                 ">= 0",
             ],
         ),
+        // A level whose density (its square) overflows, refused by its key before the board
+        // is built (the board refused it, unnamed, after validation had passed).
+        invalid(
+            "drive phase flicker density overflows",
+            set(&noise, "noise", "drive_phase_flicker_rad_per_rthz", "1e200"),
+            &[
+                "noise.drive_phase_flicker_rad_per_rthz",
+                "1e200",
+                "density at 1 Hz of inf",
+            ],
+        ),
+        invalid(
+            "tia flicker density overflows",
+            set(
+                &set(&noise, "noise", "tia_voltage_flicker_corner_hz", "1000.0").0,
+                "noise",
+                "tia_voltage_noise_v_per_rthz",
+                "1e160",
+            ),
+            &[
+                "noise.tia_voltage_noise_v_per_rthz",
+                "1e160",
+                "tia_voltage_flicker_corner_hz",
+            ],
+        ),
         case(
             "noise section with no source warns",
             with(c.clone(), "\n[noise]\nseed = 3\n"),

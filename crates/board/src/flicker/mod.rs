@@ -106,21 +106,17 @@ impl<S: Sample> FlickerSources<S> {
         };
         let mut rng = LaneRng::new(n.seed ^ FLICKER_SALT, streams);
         let (fs, fs_out) = (p.fs_hz(), p.fs_out_hz());
-        let i_v = gyroemu_tia::input_referred_noise_a_per_rthz(
-            0.0,
-            n.tia_voltage_noise_v_per_rthz,
-            p.tia.gain_ohm,
-        );
-        let tia_s1 = i_v * i_v * n.tia_voltage_flicker_corner_hz;
+        let [tia_s1, amplitude_s1, phase_s1, carrier_s1] =
+            n.flicker_psds_at_1hz(p.tia.gain_ohm).map(|(_, s1)| s1);
         let fast = |s1: f64| FlickerParams {
             fs_hz: fs,
             psd_at_1hz: s1,
             f_lo_hz: n.flicker_f_lo_hz,
             f_hi_hz: 0.5 * fs,
         };
-        let slow = |x: f64| FlickerParams {
+        let slow = |s1: f64| FlickerParams {
             fs_hz: fs_out,
-            psd_at_1hz: x * x,
+            psd_at_1hz: s1,
             f_lo_hz: n.flicker_f_lo_hz,
             f_hi_hz: 0.5 * fs_out,
         };
@@ -131,15 +127,9 @@ impl<S: Sample> FlickerSources<S> {
             Flicker::stationary(&params, || rng.pair::<S>().0).map(Some)
         };
         let tia = [source(fast(tia_s1))?, source(fast(tia_s1))?];
-        let amplitude = [
-            source(slow(n.drive_amplitude_flicker_per_rthz))?,
-            source(slow(n.drive_amplitude_flicker_per_rthz))?,
-        ];
-        let phase = [
-            source(slow(n.drive_phase_flicker_rad_per_rthz))?,
-            source(slow(n.drive_phase_flicker_rad_per_rthz))?,
-        ];
-        let carrier = source(slow(n.carrier_phase_flicker_rad_per_rthz))?;
+        let amplitude = [source(slow(amplitude_s1))?, source(slow(amplitude_s1))?];
+        let phase = [source(slow(phase_s1))?, source(slow(phase_s1))?];
+        let carrier = source(slow(carrier_s1))?;
         let one = (S::splat(1.0), S::splat(0.0));
         Ok(Some(Self {
             rng,
