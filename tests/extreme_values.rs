@@ -7,9 +7,11 @@
 
 use gyroemu::analysis::montecarlo::validate_lot;
 use gyroemu::analysis::selfcal::validate_selfcal;
+use gyroemu::board::{Board, Point, RunOptions};
 use gyroemu::config::presets::PRESETS;
 use gyroemu::config::{parse_config, Config};
 use gyroemu::experiment::sweep_work;
+use gyroemu::lpf::Window;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use toml::Value;
 
@@ -101,6 +103,32 @@ fn check(name: &str, text: &str) {
     }
     if plain {
         plans_without_wrapping(&cfg);
+        runs_briefly(&cfg);
+    }
+}
+
+/// A few output samples of an accepted config's board: built and run without a panic, and
+/// finite averages unless the run stops on a non-finite value (its guard names the stage).
+fn runs_briefly(cfg: &Config) {
+    let m = cfg.decimation() as u64;
+    if m > 1 << 14 {
+        return;
+    }
+    let rate = cfg.emulated_rates_dps()[0].to_radians();
+    let point = Point {
+        rate_rad_s: rate,
+        window: Window::Boxcar { n: 2, frac: 0.0 },
+    };
+    let mut board = Board::<f64>::new(&cfg.board_params(), &[rate], &[0]).expect("validated");
+    if let Ok(out) = board.run(1, &[point], RunOptions::default(), &|_| {}) {
+        let r = &out.lanes[0];
+        let finite = r.z.iter().chain(&r.c).chain(&r.s);
+        assert!(
+            finite
+                .into_iter()
+                .all(|v| v.re.is_finite() && v.im.is_finite()),
+            "{r:?}"
+        );
     }
 }
 
