@@ -134,6 +134,10 @@ enum Command {
 /// Exit code for a config or usage the emulator refuses.
 pub const EXIT_BAD_INPUT: u8 = 2;
 
+/// The most worker threads `--threads` accepts: more than the hardware threads of any
+/// machine this runs on (a two-socket server has a few hundred).
+pub const MAX_THREADS: usize = 1024;
+
 /// The exit code of a failed command: 2 for refused input, 130 for an interrupted run, 1 for
 /// a failure while running.
 fn exit_code(e: &anyhow::Error) -> u8 {
@@ -189,14 +193,19 @@ fn main() -> ExitCode {
 fn run_cli() -> ExitCode {
     let cli = Cli::parse();
     if let Some(t) = cli.threads {
-        if t == 0 {
-            eprintln!("error: --threads = 0: must be at least 1");
+        if !(1..=MAX_THREADS).contains(&t) {
+            // A mistyped count would otherwise start that many OS threads before anything.
+            eprintln!("error: --threads = {t}: must be from 1 to {MAX_THREADS}");
             return ExitCode::from(EXIT_BAD_INPUT);
         }
-        // Only fails when a pool exists already, which cannot happen this early.
-        let _ = rayon::ThreadPoolBuilder::new()
+        // No pool exists this early, so only the OS can refuse the threads.
+        if let Err(e) = rayon::ThreadPoolBuilder::new()
             .num_threads(t)
-            .build_global();
+            .build_global()
+        {
+            eprintln!("error: --threads = {t}: the worker threads could not be started ({e})");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
     }
     if let Some(n) = cli.lanes {
         if let Err(e) = gyroemu_board::set_max_lanes(n) {

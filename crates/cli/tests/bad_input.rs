@@ -250,3 +250,37 @@ fn a_bad_config_leaves_an_existing_output_folder_empty() {
     );
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 0);
 }
+
+#[test]
+fn global_flags_out_of_range_exit_2_before_any_thread_or_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(dir.path(), "good.toml", GOOD.as_bytes());
+    let out = dir.path().join("out");
+    for (flags, needles) in [
+        (["--threads", "0"], ["--threads = 0", "from 1 to 1024"]),
+        // Would start 100 000 OS threads (more than 20 s) before the refusal.
+        (
+            ["--threads", "100000"],
+            ["--threads = 100000", "from 1 to 1024"],
+        ),
+        (["--lanes", "3"], ["lanes", "3"]),
+    ] {
+        let o = Command::new(env!("CARGO_BIN_EXE_gyroemu"))
+            .args(flags)
+            .arg("run")
+            .arg(&cfg)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .expect("binary runs");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{flags:?}: {err}");
+        let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+        assert_eq!(lines.len(), 1, "{flags:?}: {err}");
+        assert!(lines[0].starts_with("error: "), "{flags:?}: {err}");
+        for n in needles {
+            assert!(lines[0].contains(n), "{flags:?}: `{n}` missing from: {err}");
+        }
+        assert!(!out.exists(), "{flags:?}: {out:?} created");
+    }
+}
