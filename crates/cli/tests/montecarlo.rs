@@ -207,6 +207,10 @@ fn bad_input_is_refused_before_any_sample() {
         &["montecarlo.q_sigma_rel", "Q <= 0"],
     );
     refused(&t, "0", &["at least 1 device"]);
+    // Refused at once: these allocated the lot's indices first (u64::MAX: a capacity
+    // overflow panic; 1e9: aborted out of memory).
+    refused(&t, "1000001", &["--devices = 1000001", "at most 1000000"]);
+    refused(&t, "18446744073709551615", &["at most 1000000"]);
     // A phase-shifter spread of 50 degrees passes the section's own rules, but the devices
     // drawn beyond 90 degrees are not valid boards: each refused device is named.
     refused(
@@ -221,4 +225,40 @@ fn bad_input_is_refused_before_any_sample() {
             " of the lot, drawn from [montecarlo])",
         ],
     );
+}
+
+#[test]
+fn merge_refuses_a_manifest_claiming_an_oversized_lot() {
+    // A hand-edited shard manifest is input too: its lot size lists every device index, so
+    // 1e12 would run out of memory instead of being refused.
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = config(dir.path(), "lot.toml", &tiny());
+    let split = dir.path().join("split");
+    for i in 0..2 {
+        let sh = format!("{i}/2");
+        ok(lot(
+            &cfg,
+            &split,
+            "1",
+            &["--devices", "2", "--shard", &sh],
+            &[],
+        ));
+    }
+    let mut edited = 0;
+    for e in std::fs::read_dir(&split).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().to_string();
+        if name.starts_with("shard-") && name.ends_with(".json") {
+            let t = std::fs::read_to_string(&p).unwrap();
+            let t2 = t.replace("\"points_total\": 2", "\"points_total\": 1000000000000");
+            assert_ne!(t, t2, "{name}: {t}");
+            std::fs::write(&p, t2).unwrap();
+            edited += 1;
+        }
+    }
+    assert_eq!(edited, 2);
+    let o = gyroemu(&["merge", s(&split)], &[]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("at most 1000000 devices"), "{err}");
 }

@@ -20,6 +20,9 @@ pub(crate) fn merge_lot(
 ) -> Result<Vec<PathBuf>, RunError> {
     let (first_name, first) = (&split.first_name, &split.first);
     let n = first.points_total;
+    // A hand-edited manifest could claim any size; the items are listed from it below.
+    crate::lot_run::check_lot_size(n)
+        .map_err(|e| bad(format!("`{first_name}`: its manifest claims {e}")))?;
     for (name, m) in split.by_index.values() {
         if m.config_toml != first.config_toml {
             let d = text_diff(&first.config_toml, &m.config_toml).unwrap_or_default();

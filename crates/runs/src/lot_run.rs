@@ -37,6 +37,25 @@ pub enum LotOutcome {
     },
 }
 
+/// The largest lot: its device indices and their validation stay small (a million
+/// self-calibrations is months of a machine's time; a mistyped `--devices` would otherwise
+/// allocate without bound before the work cap is reached).
+pub const MAX_DEVICES: usize = 1_000_000;
+
+/// Refuses a lot of `n` devices outside `1 ..= MAX_DEVICES`, with the rule.
+pub fn check_lot_size(n: usize) -> Result<(), String> {
+    if n == 0 {
+        return Err("--devices = 0: a lot needs at least 1 device".into());
+    }
+    if n > MAX_DEVICES {
+        return Err(format!(
+            "--devices = {n}: a lot holds at most {MAX_DEVICES} devices (split a larger study \
+             into lots with different montecarlo.seed)"
+        ));
+    }
+    Ok(())
+}
+
 /// Runs the devices of the lot of `n` devices of `req` not yet saved in `req.out`, saving
 /// each as it finishes; then (a whole lot) writes its files. The manifest ends `complete`,
 /// `interrupted` or `failed` (with the cause in `next`).
@@ -51,11 +70,7 @@ pub fn run_lot(
             "the config has no [montecarlo] section: a lot draws its devices from it".into(),
         ));
     }
-    if n == 0 {
-        return Err(RunError::BadInput(
-            "--devices = 0: a lot needs at least 1 device".into(),
-        ));
-    }
+    check_lot_size(n).map_err(RunError::BadInput)?;
     let hash = lot_hash(cfg);
     let config_toml = canonical_toml(cfg);
     let mine = Shard::items(req.shard.as_ref(), n);

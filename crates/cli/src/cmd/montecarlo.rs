@@ -7,7 +7,7 @@ use crate::progress::Terminal;
 use anyhow::Result;
 use gyroemu_analysis::montecarlo::{device_config, draw_device, validate_lot, LotSummary};
 use gyroemu_runs::shard::Shard;
-use gyroemu_runs::{run_lot, LotOutcome, RunRequest};
+use gyroemu_runs::{check_lot_size, run_lot, LotOutcome, RunRequest};
 use std::path::Path;
 
 /// The arguments of `gyroemu montecarlo`.
@@ -43,9 +43,7 @@ pub fn montecarlo_command(a: &MonteCarloArgs) -> Result<()> {
     let n = a
         .devices
         .ok_or_else(|| BadInput("--devices N is required".into()))?;
-    if n == 0 {
-        return Err(BadInput("--devices = 0: a lot needs at least 1 device".into()).into());
-    }
+    check_lot_size(n).map_err(BadInput)?;
     let shard = a.out.shard()?;
     let mine: Vec<u64> = Shard::items(shard.as_ref(), n)
         .into_iter()
