@@ -300,7 +300,7 @@ fn inspect_refuses_missing_or_damaged_dumps_with_exit_2() {
 
 /// `bench` measures the whole chain, noiseless, with noise and with flicker too, in the lanes a run uses here and
 /// in each lane type the CPU runs, and every stage, on 1 and on all threads (the figures are
-/// timing, so only their presence and sign are checked), and refuses zero repeats.
+/// timing, so only their presence and sign are checked), and refuses repeats and samples out of range.
 #[test]
 fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
     let o = gyroemu(&[
@@ -369,9 +369,21 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
         assert_eq!(figures(label, "1"), figures(&typed, "1"), "{label}");
     }
     assert!(!text.contains("(f64x8)") || eight, "{text}");
-    let bad = gyroemu(&["bench", "--repeats", "0"]);
-    assert_eq!(bad.status.code(), Some(2));
-    assert!(stderr(&bad).contains("--repeats = 0"), "{}", stderr(&bad));
+    // Refused before any measurement: u64::MAX repeats panicked on a capacity overflow, and
+    // 2^64 samples would have run for ever.
+    for (args, needle) in [
+        (["--repeats", "0"], "--repeats = 0: must be from 1 to 1000"),
+        (
+            ["--repeats", "18446744073709551615"],
+            "--repeats = 18446744073709551615: must be from 1 to 1000",
+        ),
+        (["--samples", "18446744073709551615"], "at most 2^40"),
+    ] {
+        let bad = gyroemu(&["bench", args[0], args[1]]);
+        assert_eq!(bad.status.code(), Some(2), "{args:?}");
+        assert!(stderr(&bad).contains(needle), "{}", stderr(&bad));
+        assert!(bad.stdout.is_empty(), "{args:?}");
+    }
 }
 
 /// `config --resolved` fills in every derived key with its rule, and what it prints is a config

@@ -3,16 +3,25 @@
 use crate::input::{print_out, BadInput};
 use anyhow::Result;
 
+/// The most measurements of each figure `--repeats` asks for (each is kept for the median).
+const MAX_REPEATS: usize = 1000;
+/// The most input samples per lane group `--samples` asks for: 2^40, hours per measurement.
+const MAX_SAMPLES: u64 = 1 << 40;
+
 /// Prints point-samples per second for the chain and each stage.
 pub fn bench_command(preset_name: &str, samples: u64, repeats: usize) -> Result<()> {
     let cfg = gyroemu_config::presets::preset(preset_name).map_err(|e| BadInput(e.to_string()))?;
-    if repeats == 0 {
-        return Err(BadInput("--repeats = 0: must be at least 1".into()).into());
-    }
-    if samples < 100 * cfg.decimation() as u64 {
+    if !(1..=MAX_REPEATS).contains(&repeats) {
         return Err(BadInput(format!(
-            "--samples = {samples}: must be at least 100 decimation blocks ({})",
-            100 * cfg.decimation()
+            "--repeats = {repeats}: must be from 1 to {MAX_REPEATS}"
+        ))
+        .into());
+    }
+    let min = 100 * cfg.decimation() as u64;
+    if !(min..=MAX_SAMPLES).contains(&samples) {
+        return Err(BadInput(format!(
+            "--samples = {samples}: must be at least 100 decimation blocks ({min}) and at \
+             most 2^40 (hours per measurement)"
         ))
         .into());
     }
