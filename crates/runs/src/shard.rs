@@ -65,10 +65,20 @@ impl Shard {
     }
 }
 
+/// `--shard-count N` as the signed count the rules compare (an `N` past `i64::MAX` refused).
+fn count_of_flag(n: usize) -> Result<i64, RunError> {
+    i64::try_from(n).map_err(|_| {
+        RunError::BadInput(format!("--shard-count = {n}: must be at most {}", i64::MAX))
+    })
+}
+
 fn int(name: &str, text: &str) -> Result<i64, RunError> {
-    text.trim()
-        .parse()
-        .map_err(|_| RunError::BadInput(format!("{name} = `{text}`: not an integer")))
+    text.trim().parse().map_err(|_| {
+        RunError::BadInput(format!(
+            "{name} = `{text}`: not an integer (at most {})",
+            i64::MAX
+        ))
+    })
 }
 
 /// Parses `i/n` (0 <= i < n).
@@ -108,9 +118,17 @@ pub fn resolve_shard(
             env("SLURM_ARRAY_TASK_COUNT"),
             env("SLURM_ARRAY_TASK_MAX"),
         ) {
-            (Some(n), _, _) => n as i64,
+            (Some(n), _, _) => count_of_flag(n)?,
             (None, Some(c), _) => int("SLURM_ARRAY_TASK_COUNT", &c)?,
-            (None, None, Some(max)) => (int("SLURM_ARRAY_TASK_MAX", &max)? - min) / step + 1,
+            (None, None, Some(max)) => int("SLURM_ARRAY_TASK_MAX", &max)?
+                .checked_sub(min)
+                .map(|span| span / step + 1)
+                .ok_or_else(|| {
+                    RunError::BadInput(format!(
+                        "SLURM_ARRAY_TASK_MAX = {max} and SLURM_ARRAY_TASK_MIN = {min}: their \
+                         difference overflows a 64-bit integer"
+                    ))
+                })?,
             _ => {
                 return Err(RunError::BadInput(
                     "SLURM_ARRAY_TASK_ID is set but neither SLURM_ARRAY_TASK_COUNT nor \
@@ -120,17 +138,23 @@ pub fn resolve_shard(
             }
         };
         let src = format!("SLURM_ARRAY_TASK_ID = {}", id);
-        if (id - min) % step != 0 {
+        let Some(offset) = id.checked_sub(min) else {
+            return Err(RunError::BadInput(format!(
+                "{src} and SLURM_ARRAY_TASK_MIN = {min}: their difference overflows a 64-bit \
+                 integer"
+            )));
+        };
+        if offset % step != 0 {
             return Err(RunError::BadInput(format!(
                 "{src} is not on the array's grid (SLURM_ARRAY_TASK_MIN = {min}, step {step})"
             )));
         }
-        return Shard::new((id - min) / step, count, src).map(Some);
+        return Shard::new(offset / step, count, src).map(Some);
     }
     if let Some(idx) = env("JOB_COMPLETION_INDEX") {
         let idx = int("JOB_COMPLETION_INDEX", &idx)?;
         let count = match (count_flag, env(SHARD_COUNT_ENV)) {
-            (Some(n), _) => n as i64,
+            (Some(n), _) => count_of_flag(n)?,
             (None, Some(c)) => int(SHARD_COUNT_ENV, &c)?,
             (None, None) => {
                 return Err(RunError::BadInput(format!(
@@ -204,5 +228,51 @@ mod tests {
         let k8s = env_of(&[("JOB_COMPLETION_INDEX", "5"), (SHARD_COUNT_ENV, "6")]);
         assert_eq!(resolve_shard(None, None, &k8s).unwrap().unwrap().count, 6);
         assert!(resolve_shard(None, Some(3), &none).is_err());
+    }
+
+    /// The message of `resolve_shard`'s refusal.
+    fn refusal(
+        flag: Option<&str>,
+        count: Option<usize>,
+        env: &dyn Fn(&str) -> Option<String>,
+    ) -> String {
+        match resolve_shard(flag, count, env) {
+            Err(RunError::BadInput(m)) => m,
+            other => panic!("not refused: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn numbers_past_the_64_bit_range_are_refused_not_wrapped() {
+        let none = env_of(&[]);
+        let m = refusal(Some("0/18446744073709551615"), None, &none);
+        assert!(
+            m.contains("--shard count") && m.contains("at most 9223372036854775807"),
+            "{m}"
+        );
+        // MAX - MIN overflows (a wrapped count would have been negative or tiny).
+        let slurm = env_of(&[
+            ("SLURM_ARRAY_TASK_ID", "0"),
+            ("SLURM_ARRAY_TASK_MIN", "-9223372036854775807"),
+            ("SLURM_ARRAY_TASK_MAX", "9223372036854775807"),
+        ]);
+        let m = refusal(None, None, &slurm);
+        assert!(
+            m.contains("SLURM_ARRAY_TASK_MAX") && m.contains("overflows"),
+            "{m}"
+        );
+        let slurm = env_of(&[
+            ("SLURM_ARRAY_TASK_ID", "9223372036854775807"),
+            ("SLURM_ARRAY_TASK_MIN", "-2"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ]);
+        let m = refusal(None, None, &slurm);
+        assert!(
+            m.contains("SLURM_ARRAY_TASK_ID") && m.contains("overflows"),
+            "{m}"
+        );
+        let k8s = env_of(&[("JOB_COMPLETION_INDEX", "1")]);
+        let m = refusal(None, Some(usize::MAX), &k8s);
+        assert!(m.contains("--shard-count = 18446744073709551615"), "{m}");
     }
 }
