@@ -24,7 +24,13 @@ average_s = 0.1
 "#;
 
 fn run(config: &Path, out: &Path) -> Output {
+    run_with(&[], config, out)
+}
+
+/// `gyroemu FLAGS run CONFIG --out OUT` (global flags before the command).
+fn run_with(flags: &[&str], config: &Path, out: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_gyroemu"))
+        .args(flags)
         .arg("run")
         .arg(config)
         .arg("--out")
@@ -36,7 +42,12 @@ fn run(config: &Path, out: &Path) -> Output {
 /// Runs the case and checks exit code 2, a single `error:` line holding every needle, and
 /// that `out` was not created.
 fn refused(what: &str, config: &Path, out: &Path, needles: &[&str]) {
-    let o = run(config, out);
+    refused_with(&[], what, config, out, needles);
+}
+
+/// [`refused`] with global flags before the command.
+fn refused_with(flags: &[&str], what: &str, config: &Path, out: &Path, needles: &[&str]) {
+    let o = run_with(flags, config, out);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{what}: {err}");
     let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
@@ -265,22 +276,7 @@ fn global_flags_out_of_range_exit_2_before_any_thread_or_sample() {
         ),
         (["--lanes", "3"], ["lanes", "3"]),
     ] {
-        let o = Command::new(env!("CARGO_BIN_EXE_gyroemu"))
-            .args(flags)
-            .arg("run")
-            .arg(&cfg)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .expect("binary runs");
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{flags:?}: {err}");
-        let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
-        assert_eq!(lines.len(), 1, "{flags:?}: {err}");
-        assert!(lines[0].starts_with("error: "), "{flags:?}: {err}");
-        for n in needles {
-            assert!(lines[0].contains(n), "{flags:?}: `{n}` missing from: {err}");
-        }
+        refused_with(&flags, &flags.join(" "), &cfg, &out, &needles);
         assert!(!out.exists(), "{flags:?}: {out:?} created");
     }
 }

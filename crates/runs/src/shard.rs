@@ -244,35 +244,47 @@ mod tests {
 
     #[test]
     fn numbers_past_the_64_bit_range_are_refused_not_wrapped() {
-        let none = env_of(&[]);
-        let m = refusal(Some("0/18446744073709551615"), None, &none);
-        assert!(
-            m.contains("--shard count") && m.contains("at most 9223372036854775807"),
-            "{m}"
-        );
-        // MAX - MIN overflows (a wrapped count would have been negative or tiny).
-        let slurm = env_of(&[
-            ("SLURM_ARRAY_TASK_ID", "0"),
-            ("SLURM_ARRAY_TASK_MIN", "-9223372036854775807"),
-            ("SLURM_ARRAY_TASK_MAX", "9223372036854775807"),
-        ]);
-        let m = refusal(None, None, &slurm);
-        assert!(
-            m.contains("SLURM_ARRAY_TASK_MAX") && m.contains("overflows"),
-            "{m}"
-        );
-        let slurm = env_of(&[
-            ("SLURM_ARRAY_TASK_ID", "9223372036854775807"),
-            ("SLURM_ARRAY_TASK_MIN", "-2"),
-            ("SLURM_ARRAY_TASK_COUNT", "4"),
-        ]);
-        let m = refusal(None, None, &slurm);
-        assert!(
-            m.contains("SLURM_ARRAY_TASK_ID") && m.contains("overflows"),
-            "{m}"
-        );
-        let k8s = env_of(&[("JOB_COMPLETION_INDEX", "1")]);
-        let m = refusal(None, Some(usize::MAX), &k8s);
-        assert!(m.contains("--shard-count = 18446744073709551615"), "{m}");
+        type Vars = &'static [(&'static str, &'static str)];
+        /// The flag, `--shard-count`, the environment, what the refusal names.
+        type Case = (Option<&'static str>, Option<usize>, Vars, [&'static str; 2]);
+        // Before, the Slurm sums wrapped into a negative shard, refused under the wrong rule.
+        let cases: [Case; 4] = [
+            (
+                Some("0/18446744073709551615"),
+                None,
+                &[],
+                ["--shard count", "at most 9223372036854775807"],
+            ),
+            (
+                None,
+                None,
+                &[
+                    ("SLURM_ARRAY_TASK_ID", "0"),
+                    ("SLURM_ARRAY_TASK_MIN", "-9223372036854775807"),
+                    ("SLURM_ARRAY_TASK_MAX", "9223372036854775807"),
+                ],
+                ["SLURM_ARRAY_TASK_MAX", "overflows"],
+            ),
+            (
+                None,
+                None,
+                &[
+                    ("SLURM_ARRAY_TASK_ID", "9223372036854775807"),
+                    ("SLURM_ARRAY_TASK_MIN", "-2"),
+                    ("SLURM_ARRAY_TASK_COUNT", "4"),
+                ],
+                ["SLURM_ARRAY_TASK_ID", "overflows"],
+            ),
+            (
+                None,
+                Some(usize::MAX),
+                &[("JOB_COMPLETION_INDEX", "1")],
+                ["--shard-count = 18446744073709551615", "at most"],
+            ),
+        ];
+        for (flag, count, vars, needles) in cases {
+            let m = refusal(flag, count, &env_of(vars));
+            assert!(needles.iter().all(|n| m.contains(n)), "{m}");
+        }
     }
 }
