@@ -122,11 +122,11 @@ pub fn resolve_shard(
             (None, Some(c), _) => int("SLURM_ARRAY_TASK_COUNT", &c)?,
             (None, None, Some(max)) => int("SLURM_ARRAY_TASK_MAX", &max)?
                 .checked_sub(min)
-                .map(|span| span / step + 1)
+                .and_then(|span| (span / step).checked_add(1))
                 .ok_or_else(|| {
                     RunError::BadInput(format!(
-                        "SLURM_ARRAY_TASK_MAX = {max} and SLURM_ARRAY_TASK_MIN = {min}: their \
-                         difference overflows a 64-bit integer"
+                        "SLURM_ARRAY_TASK_MAX = {max} and SLURM_ARRAY_TASK_MIN = {min}: the \
+                         array's size overflows a 64-bit integer"
                     ))
                 })?,
             _ => {
@@ -248,7 +248,7 @@ mod tests {
         /// The flag, `--shard-count`, the environment, what the refusal names.
         type Case = (Option<&'static str>, Option<usize>, Vars, [&'static str; 2]);
         // Before, the Slurm sums wrapped into a negative shard, refused under the wrong rule.
-        let cases: [Case; 4] = [
+        let cases: [Case; 5] = [
             (
                 Some("0/18446744073709551615"),
                 None,
@@ -261,6 +261,16 @@ mod tests {
                 &[
                     ("SLURM_ARRAY_TASK_ID", "0"),
                     ("SLURM_ARRAY_TASK_MIN", "-9223372036854775807"),
+                    ("SLURM_ARRAY_TASK_MAX", "9223372036854775807"),
+                ],
+                ["SLURM_ARRAY_TASK_MAX", "overflows"],
+            ),
+            (
+                // MAX - MIN fits, one more task does not.
+                None,
+                None,
+                &[
+                    ("SLURM_ARRAY_TASK_ID", "0"),
                     ("SLURM_ARRAY_TASK_MAX", "9223372036854775807"),
                 ],
                 ["SLURM_ARRAY_TASK_MAX", "overflows"],
