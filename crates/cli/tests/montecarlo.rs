@@ -2,8 +2,8 @@
 //! Kubernetes' index) merged equal one machine byte for byte; `--print-device I` prints a
 //! config on which `gyroemu selfcal` finds the lot's error of device I; a real SIGINT exits
 //! 130 keeping the finished devices and the rerun equals an uninterrupted lot; bad input
-//! (no [montecarlo], a bad key, no devices, an impossible drawn device) exits 2 before any
-//! sample is computed.
+//! (no [montecarlo], a bad key, no devices, an impossible drawn device, a lot above the work
+//! cap) exits 2 before any sample is computed.
 
 mod common;
 
@@ -211,6 +211,17 @@ fn bad_input_is_refused_before_any_sample() {
     // overflow panic; 1e9: aborted out of memory).
     refused(&t, "1000001", &["--devices = 1000001", "at most 1000000"]);
     refused(&t, "18446744073709551615", &["at most 1000000"]);
+    // A lot far above the work cap is refused once the devices validated so far pass it
+    // (validating all 1e6 first took 2.5 minutes on 2 cores).
+    refused(
+        &t.replace("average_s = 0.2", "average_s = 200.0"),
+        "1000000",
+        &[
+            "of these 1000000 devices alone run",
+            "above the cap",
+            "--force",
+        ],
+    );
     // A phase-shifter spread of 50 degrees passes the section's own rules, but the devices
     // drawn beyond 90 degrees are not valid boards: each refused device is named.
     refused(

@@ -14,4 +14,4 @@ pub use device::{run_device, Column, ColumnKind, DeviceInputs, DeviceResult, COL
 pub use draw::{device_config, draw_device, DeviceDraw, DRAW_STREAM_BASE, PARAMETERS};
 pub use stats::{percentile, wilson_interval, Spread, PERCENTILES, Z95};
 pub use summary::{LotSummary, YieldEstimate};
-pub use validate::{device_work, lot_work, validate_lot};
+pub use validate::{device_work, lot_work, validate_lot, validate_lot_capped, LotRefusal};

@@ -6,7 +6,7 @@ use crate::selfcal::{sweep_configs, validate_selfcal};
 use gyroemu_board::Point;
 use gyroemu_config::{Config, ConfigError};
 use gyroemu_experiment::sweep::canonical_work;
-use gyroemu_experiment::{sweep_work, Work};
+use gyroemu_experiment::{sweep_work, Work, MAX_POINT_SAMPLES};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 
@@ -14,55 +14,107 @@ use std::collections::BTreeMap;
 /// counted).
 const LISTED_DEVICES: usize = 5;
 
+/// Devices validated per pass: a lot above the work cap is refused after the pass that
+/// crosses it, not after validating a million devices (about 0.3 ms of CPU each).
+const CHUNK: usize = 4096;
+
+/// A device's warnings and work, or its refusal.
+type DeviceCheck = Result<(Vec<String>, Work), ConfigError>;
+
+/// Why a lot was refused before any sample: a config rule, or the work cap.
+#[derive(Debug)]
+pub enum LotRefusal {
+    /// The config, its sweeps or a drawn device broke a rule.
+    Config(ConfigError),
+    /// The devices run more point-samples than [`MAX_POINT_SAMPLES`] without `--force`: the
+    /// plan, with what to do.
+    Cap(String),
+}
+
 /// Validates the lot of `cfg` for the devices `indices`, before any sample is computed: the
 /// `[montecarlo]` section present, the config's own rules, `selfcal`'s rules on its two sweeps
 /// (the `[selfcal]` analyses do not run in a lot), then every drawn device's config the same
 /// way. Returns the warnings (those of the devices grouped by text, naming the first device
 /// and how many share it), or every problem in one error, a device's problems naming it.
 pub fn validate_lot(cfg: &Config, indices: &[u64]) -> Result<Vec<String>, ConfigError> {
+    validate_lot_capped(cfg, indices, true).map_err(|r| match r {
+        LotRefusal::Config(e) => e,
+        LotRefusal::Cap(m) => unreachable!("no cap when forced: {m}"),
+    })
+}
+
+/// [`validate_lot`], and unless `force` the cap of [`MAX_POINT_SAMPLES`] on the devices'
+/// work, as `gyroemu run` caps a shard's share of its sweep (saved or not). The devices are
+/// validated 4096 at a time (`CHUNK`); when no device has been refused, the lot is
+/// refused as soon as the devices validated so far run more than the cap (their work is a
+/// lower bound on the lot's), so a mistyped `--devices` is told in seconds.
+pub fn validate_lot_capped(
+    cfg: &Config,
+    indices: &[u64],
+    force: bool,
+) -> Result<Vec<String>, LotRefusal> {
     let Some(mc) = &cfg.montecarlo else {
-        return Err(ConfigError::message(
+        return Err(LotRefusal::Config(ConfigError::message(
             "the config has no [montecarlo] section: a lot draws its devices from its \
              tolerances and judges them against its spec_abs_relative_error (example: \
              `gyroemu config --preset m2tfg-montecarlo`)",
-        ));
+        )));
     };
     let plain = Config {
         selfcal: None,
         ..cfg.clone()
     };
-    let mut warnings = plain.validate()?;
-    warnings.extend(validate_selfcal(&plain)?);
-    let checked: Vec<(u64, Result<Vec<String>, ConfigError>)> = indices
-        .par_iter()
-        .map(|&i| {
-            let dev = device_config(cfg, &draw_device(mc, i));
-            let r = dev.validate().and_then(|mut w| {
-                w.extend(validate_selfcal(&dev)?);
-                Ok(w)
-            });
-            (i, r)
-        })
-        .collect();
+    let mut warnings = plain.validate().map_err(LotRefusal::Config)?;
+    warnings.extend(validate_selfcal(&plain).map_err(LotRefusal::Config)?);
     let mut refused = Vec::new();
     let mut refused_devices = 0usize;
     // Warning text -> (first device, devices).
     let mut device_warnings: BTreeMap<String, (u64, usize)> = BTreeMap::new();
-    for (i, r) in checked {
-        match r {
-            Ok(w) => {
-                for w in w.into_iter().filter(|w| !warnings.contains(w)) {
-                    device_warnings.entry(w).or_insert((i, 0)).1 += 1;
+    let mut work = Work::default();
+    let mut validated = 0usize;
+    for chunk in indices.chunks(CHUNK) {
+        let checked: Vec<(u64, DeviceCheck)> = chunk
+            .par_iter()
+            .map(|&i| {
+                let dev = device_config(cfg, &draw_device(mc, i));
+                let r = dev.validate().and_then(|mut w| {
+                    w.extend(validate_selfcal(&dev)?);
+                    // Planned only once valid: the work of a refused device means nothing.
+                    let work = if force {
+                        Work::default()
+                    } else {
+                        device_work(&dev).0
+                    };
+                    Ok((w, work))
+                });
+                (i, r)
+            })
+            .collect();
+        for (i, r) in checked {
+            match r {
+                Ok((w, dw)) => {
+                    work = work.plus(dw);
+                    for w in w.into_iter().filter(|w| !warnings.contains(w)) {
+                        device_warnings.entry(w).or_insert((i, 0)).1 += 1;
+                    }
+                }
+                Err(e) => {
+                    refused_devices += 1;
+                    if refused_devices <= LISTED_DEVICES {
+                        refused.push(e.map_details(|d| {
+                            format!("{d} (device {i} of the lot, drawn from [montecarlo])")
+                        }));
+                    }
                 }
             }
-            Err(e) => {
-                refused_devices += 1;
-                if refused_devices <= LISTED_DEVICES {
-                    refused.push(e.map_details(|d| {
-                        format!("{d} (device {i} of the lot, drawn from [montecarlo])")
-                    }));
-                }
-            }
+        }
+        validated += chunk.len();
+        if !force && refused_devices == 0 && work.point_samples > MAX_POINT_SAMPLES {
+            return Err(LotRefusal::Cap(cap_refusal(
+                &work,
+                validated,
+                indices.len(),
+            )));
         }
     }
     if refused_devices > LISTED_DEVICES {
@@ -74,7 +126,7 @@ pub fn validate_lot(cfg: &Config, indices: &[u64]) -> Result<Vec<String>, Config
         )));
     }
     if let Some(e) = ConfigError::from_problems(refused) {
-        return Err(e);
+        return Err(LotRefusal::Config(e));
     }
     let mut grouped: Vec<(String, (u64, usize))> = device_warnings.into_iter().collect();
     grouped.sort_by_key(|(_, (first, _))| *first);
@@ -101,6 +153,29 @@ pub fn validate_lot(cfg: &Config, indices: &[u64]) -> Result<Vec<String>, Config
         ));
     }
     Ok(warnings)
+}
+
+/// The cap's refusal for the `validated` devices of a lot of `total` whose `work` crossed it:
+/// the whole plan when every device was validated, else a lower bound and the lot's work
+/// extrapolated from the devices' mean (said as such).
+fn cap_refusal(work: &Work, validated: usize, total: usize) -> String {
+    if validated == total {
+        return work
+            .check_cap(false)
+            .expect_err("the caller saw the work above the cap");
+    }
+    let mean = work.point_samples as f64 / validated as f64;
+    format!(
+        "plan: the first {validated} of these {total} devices alone run {:.3e} point-samples \
+         (about {:.3e} for all {total} at their mean; longest point {:.4} s of signal): above \
+         the cap of {:.0e} point-samples without --force (a mistyped --devices, Q or \
+         averaging time would otherwise start a run of days); run fewer devices, shorten \
+         experiment.average_s or experiment.settle_s, or add --force to run it anyway",
+        work.point_samples as f64,
+        mean * total as f64,
+        work.longest_s,
+        MAX_POINT_SAMPLES as f64
+    )
 }
 
 /// The work of one device's self-calibration (its config from [`device_config`]): the two

@@ -5,7 +5,9 @@ use crate::cmd::out_args::OutArgs;
 use crate::input::{list_written, print_out, read_config, refused, BadInput};
 use crate::progress::Terminal;
 use anyhow::Result;
-use gyroemu_analysis::montecarlo::{device_config, draw_device, validate_lot, LotSummary};
+use gyroemu_analysis::montecarlo::{
+    device_config, draw_device, validate_lot, validate_lot_capped, LotRefusal, LotSummary,
+};
 use gyroemu_runs::shard::Shard;
 use gyroemu_runs::{check_lot_size, run_lot, LotOutcome, RunRequest};
 use std::path::Path;
@@ -49,8 +51,12 @@ pub fn montecarlo_command(a: &MonteCarloArgs) -> Result<()> {
         .into_iter()
         .map(|i| i as u64)
         .collect();
-    // The config, its sweeps and every device this process draws, before any sample.
-    let warnings = validate_lot(&cfg, &mine).map_err(|e| refused(a.config, &text, e))?;
+    // The config, its sweeps and every device this process draws, and the cap on their work,
+    // before any sample.
+    let warnings = validate_lot_capped(&cfg, &mine, a.out.force).map_err(|r| match r {
+        LotRefusal::Config(e) => refused(a.config, &text, e),
+        LotRefusal::Cap(m) => BadInput(m),
+    })?;
     for w in warnings {
         eprintln!("warning: {}: {w}", a.config.display());
     }
