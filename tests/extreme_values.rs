@@ -1,15 +1,19 @@
 //! Every number of every preset set, one at a time, to an extreme (zero, negative, tiny,
 //! huge, the largest integers, NaN and infinities): validation must refuse or accept it
 //! without a panic, and a config it accepts must plan without an integer wrapping (the plan's
-//! integer sample counts agree with the same sums done in f64). The cargo-fuzz targets
+//! integer sample counts agree with the same sums done in f64), build, run a few samples of
+//! each point and read them out. The cargo-fuzz targets
 //! (`fuzz/`, nightly, not in CI) edit one line of a preset; this sweep is deterministic, runs
 //! in CI, and also covers a `[dump]` section, which no preset carries.
 
 use gyroemu::analysis::montecarlo::validate_lot;
-use gyroemu::analysis::selfcal::validate_selfcal;
+use gyroemu::analysis::selfcal::{sweep_configs, validate_selfcal};
+use gyroemu::analysis::stepped_sine::stepped_sine_work;
 use gyroemu::board::{Board, Point, RunOptions};
 use gyroemu::config::presets::PRESETS;
 use gyroemu::config::{parse_config, Config};
+use gyroemu::experiment::pll_params;
+use gyroemu::experiment::readout::post_process;
 use gyroemu::experiment::sweep_work;
 use gyroemu::lpf::Window;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -92,11 +96,22 @@ fn check(name: &str, text: &str) {
         return;
     };
     let plain = cfg.validate().is_ok();
-    if name == "m2tfg-sweep" {
-        let _ = cfg.validate_sweep();
+    if name == "m2tfg-sweep" && cfg.validate_sweep().is_ok() {
+        stepped_sine_plans(&cfg);
     }
-    if cfg.selfcal.is_some() {
-        let _ = validate_selfcal(&cfg);
+    if cfg.selfcal.is_some() && validate_selfcal(&cfg).is_ok() && plain {
+        // What `selfcal` runs is what it validated.
+        let (rotating, table) = sweep_configs(&cfg);
+        for c in [rotating, table] {
+            assert!(c.validate().is_ok(), "{:?}", c.validate());
+            plans_without_wrapping(&c);
+        }
+    }
+    if cfg.pll.is_some() && plain {
+        // The loop is designed from validated keys alone, before its lock runs.
+        if let Err(e) = pll_params(&cfg, &cfg) {
+            panic!("validated, but the PLL's design refused: {e}");
+        }
     }
     if cfg.montecarlo.is_some() {
         let _ = validate_lot(&cfg, &[0, 1]);
@@ -107,27 +122,62 @@ fn check(name: &str, text: &str) {
     }
 }
 
-/// A few output samples of an accepted config's board: built and run without a panic, and
-/// finite averages when the run completes (a non-finite value stops it with an error).
+/// A few output samples of each point of an accepted config's board: built and run without a
+/// panic, finite averages when the run completes (a non-finite value stops it with an error),
+/// and the read-out (phases, theory, compensation, fits) run on them without a panic.
 fn runs_briefly(cfg: &Config) {
     let m = cfg.decimation() as u64;
     if m > 1 << 14 {
         return;
     }
-    let rate = cfg.emulated_rates_dps()[0].to_radians();
-    let point = Point {
-        rate_rad_s: rate,
+    let rates = cfg.emulated_rates_dps();
+    let point = |rate_dps: f64| Point {
+        rate_rad_s: rate_dps.to_radians(),
         window: Window::Boxcar { n: 2, frac: 0.0 },
     };
-    let mut board = Board::<f64>::new(&cfg.board_params(), &[rate], &[0]).expect("validated");
-    if let Ok(out) = board.run(1, &[point], RunOptions::default(), &|_| {}) {
-        let r = &out.lanes[0];
+    let mut lanes = Vec::new();
+    for (i, &r) in rates.iter().enumerate() {
+        let p = point(r);
+        let mut board = Board::<f64>::new(&cfg.board_params(), &[p.rate_rad_s], &[i as u64])
+            .expect("validated");
+        let Ok(out) = board.run(1, &[p], RunOptions::default(), &|_| {}) else {
+            return;
+        };
+        let r = out.lanes[0].clone();
         let mut averages = r.z.iter().chain(&r.c).chain(&r.s);
         assert!(
             averages.all(|v| v.re.is_finite() && v.im.is_finite()),
             "{r:?}"
         );
+        lanes.push(r);
     }
+    let points: Vec<Point> = rates.iter().map(|&r| point(r)).collect();
+    if let Err(e) = post_process(cfg, &rates, &points, &lanes) {
+        panic!("validated, built and run, but the read-out refused: {e}");
+    }
+}
+
+/// A stepped-sine sweep's plan: ascending finite frequencies, and its sample counts agree
+/// with the same products in f64.
+fn stepped_sine_plans(cfg: &Config) {
+    let f = cfg.sweep_frequencies_hz();
+    assert!(
+        !f.is_empty() && f.iter().all(|x| x.is_finite() && *x > 0.0),
+        "{f:?}"
+    );
+    assert!(f.windows(2).all(|w| w[0] < w[1]), "{f:?}");
+    let (settle, point) = cfg.sweep_point();
+    let per_run = (settle as f64 + point.window.samples() as f64) * cfg.decimation() as f64;
+    assert!(
+        per_run <= 2f64.powi(53),
+        "{per_run} input samples in one run"
+    );
+    let w = stepped_sine_work(cfg);
+    let want = 2.0 * f.len() as f64 * per_run;
+    assert!(
+        (w.point_samples as f64 - want).abs() <= 1e-9 * want,
+        "{w:?} against {want}"
+    );
 }
 
 /// The sweep's integer sample counts agree with the same sums in f64 (a wrapped sum would be
