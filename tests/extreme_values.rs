@@ -143,7 +143,7 @@ fn runs_briefly(cfg: &Config) {
         let Ok(out) = board.run(1, &[p], RunOptions::default(), &|_| {}) else {
             return;
         };
-        let r = out.lanes[0].clone();
+        let r = out.lanes[0];
         let mut averages = r.z.iter().chain(&r.c).chain(&r.s);
         assert!(
             averages.all(|v| v.re.is_finite() && v.im.is_finite()),
