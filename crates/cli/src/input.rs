@@ -10,13 +10,35 @@ use std::path::Path;
 #[error("{0}")]
 pub struct BadInput(pub String);
 
+/// The largest config file read: far above any real one (a preset is about 3 kB), and a
+/// bound on what a path to an endless stream (`/dev/zero`, a pipe that never ends) reads.
+pub const MAX_CONFIG_BYTES: u64 = 16 << 20;
+
+/// Reads a config file's text: readable, at most [`MAX_CONFIG_BYTES`], UTF-8.
+pub fn read_config_text(path: &Path) -> Result<String> {
+    use std::io::Read;
+    let cannot =
+        |e: std::io::Error| BadInput(format!("cannot read config `{}`: {e}", path.display()));
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_CONFIG_BYTES + 1).read_to_end(&mut bytes))
+        .map_err(cannot)?;
+    if bytes.len() as u64 > MAX_CONFIG_BYTES {
+        return Err(BadInput(format!(
+            "config `{}` is larger than {} MiB: not a gyroemu config (a preset is about 3 kB)",
+            path.display(),
+            MAX_CONFIG_BYTES >> 20
+        ))
+        .into());
+    }
+    Ok(String::from_utf8(bytes)
+        .map_err(|_| BadInput(format!("config `{}` is not UTF-8 text", path.display())))?)
+}
+
 /// Reads and parses a config file (every problem of its text in one refusal), not yet
 /// validated; returns it with its text.
 pub fn read_config(path: &Path) -> Result<(Config, String)> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| BadInput(format!("cannot read config `{}`: {e}", path.display())))?;
-    let text = String::from_utf8(bytes)
-        .map_err(|_| BadInput(format!("config `{}` is not UTF-8 text", path.display())))?;
+    let text = read_config_text(path)?;
     let cfg = parse_config(&text).map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
     Ok((cfg, text))
 }

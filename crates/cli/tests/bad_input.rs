@@ -92,6 +92,23 @@ fn unreadable_configs_exit_2_and_write_nothing() {
             vec!["nope.toml", "cannot read config"],
         ),
         ("a directory", d.to_path_buf(), vec!["cannot read config"]),
+        // An endless stream is read up to the limit, not until memory runs out; a file of
+        // exactly the limit is read (then refused as the blank text it is), one byte more not.
+        (
+            "an endless stream",
+            PathBuf::from("/dev/zero"),
+            vec!["/dev/zero", "larger than 16 MiB"],
+        ),
+        (
+            "a file at the size limit",
+            write(d, "limit.toml", &vec![b' '; 16 << 20]),
+            vec!["limit.toml", "empty"],
+        ),
+        (
+            "a file one byte above it",
+            write(d, "above.toml", &vec![b' '; (16 << 20) + 1]),
+            vec!["above.toml", "larger than 16 MiB"],
+        ),
         (
             "bad value",
             write(

@@ -417,4 +417,14 @@ fn config_resolved_prints_the_complete_config_with_its_rules() {
     std::fs::write(&path, "[device]\nf0_hz = -1.0\n").unwrap();
     let o = gyroemu(&["config", "--resolved", path.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    // It reads a config as `run` does: bounded, UTF-8.
+    for (bytes, needle) in [
+        (&b"q = \xe9"[..], "not UTF-8"),
+        (&vec![b' '; (16 << 20) + 1][..], "larger than 16 MiB"),
+    ] {
+        std::fs::write(&path, bytes).unwrap();
+        let o = gyroemu(&["config", "--resolved", path.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains(needle), "{}", stderr(&o));
+    }
 }

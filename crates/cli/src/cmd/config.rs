@@ -1,6 +1,6 @@
 //! `gyroemu config [--preset NAME] [--list]`.
 
-use crate::input::{print_out, refused, BadInput};
+use crate::input::{print_out, read_config_text, refused, BadInput};
 use anyhow::Result;
 use gyroemu_config::parse_config_explained;
 use gyroemu_config::presets::{preset_text, PRESETS};
@@ -9,8 +9,7 @@ use std::path::Path;
 /// `gyroemu config --resolved FILE`: the config with every key filled in, each derived value
 /// listed with its rule, and the settling time used.
 pub fn resolved_command(path: &Path) -> Result<()> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| BadInput(format!("cannot read config `{}`: {e}", path.display())))?;
+    let text = read_config_text(path)?;
     let (cfg, derived) =
         parse_config_explained(&text).map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
     let warnings = cfg.validate().map_err(|e| refused(path, &text, e))?;
