@@ -249,6 +249,13 @@ fn an_output_folder_that_cannot_be_created_exits_2_before_any_sample() {
         &["output folder", "cannot be created"],
     );
     assert_eq!(std::fs::read(&file).unwrap(), b"keep");
+    refused(
+        "out is a file",
+        &config,
+        &file,
+        &["output folder", "is a file, not a folder"],
+    );
+    assert_eq!(std::fs::read(&file).unwrap(), b"keep");
     // Nothing else appeared beside the inputs.
     let mut names: Vec<String> = std::fs::read_dir(d)
         .unwrap()

@@ -56,6 +56,13 @@ pub enum RunOutcome {
 
 /// Makes sure the output folder exists and is writable before any sample is computed.
 pub fn prepare_out(out: &Path) -> Result<(), RunError> {
+    // `create_dir_all` on a file says only "File exists".
+    if out.exists() && !out.is_dir() {
+        return Err(RunError::BadInput(format!(
+            "output folder `{}` is a file, not a folder: choose another --out",
+            out.display()
+        )));
+    }
     std::fs::create_dir_all(out).map_err(|e| {
         RunError::BadInput(format!(
             "output folder `{}` cannot be created: {e}",
