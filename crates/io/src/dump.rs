@@ -127,16 +127,19 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
             )))
         }
     };
-    let n_ch = g
-        .get("core:num_channels")
-        .and_then(Value::as_u64)
-        .unwrap_or(1);
-    if n_ch == 0 || n_ch > 65_535 {
-        return Err(bad(format!(
-            "core:num_channels = {n_ch}: must be 1..=65535"
-        )));
-    }
-    let n_ch = n_ch as usize;
+    // Absent optional fields take SigMF's defaults; present ones must be what they claim
+    // (a channel count of 1e19 once read as the default 1).
+    let n_ch = match g.get("core:num_channels") {
+        None => 1,
+        Some(v) => match v.as_u64() {
+            Some(n @ 1..=65_535) => n as usize,
+            _ => {
+                return Err(bad(format!(
+                    "core:num_channels = {v}: must be an integer 1..=65535"
+                )))
+            }
+        },
+    };
     let channels: Vec<SigmfChannel> = match g.get("gyroemu:channels").and_then(Value::as_array) {
         Some(list) => {
             if list.len() != n_ch {
@@ -169,14 +172,26 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
             })
             .collect(),
     };
-    let t0_s = g.get("gyroemu:t0_s").and_then(Value::as_f64).unwrap_or(0.0);
-    let global_index = meta
+    let t0_s = match g.get("gyroemu:t0_s") {
+        None => 0.0,
+        Some(v) => match v.as_f64() {
+            Some(t) if t.is_finite() => t,
+            _ => return Err(bad(format!("gyroemu:t0_s = {v}: must be a finite number"))),
+        },
+    };
+    let global_index = match meta
         .get("captures")
         .and_then(Value::as_array)
         .and_then(|c| c.first())
         .and_then(|c| c.get("core:global_index"))
-        .and_then(Value::as_u64)
-        .unwrap_or(0);
+    {
+        None => 0,
+        Some(v) => v.as_u64().ok_or_else(|| {
+            bad(format!(
+                "captures[0].core:global_index = {v}: must be an integer >= 0"
+            ))
+        })?,
+    };
     let extra = g
         .iter()
         .filter_map(|(k, v)| Some((k.strip_prefix("gyroemu:")?.to_string(), v.as_f64()?)))

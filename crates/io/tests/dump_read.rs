@@ -112,6 +112,33 @@ fn damaged_dumps_are_refused_naming_the_file_and_the_rule() {
     let meta = std::fs::read_to_string(p("sigmf-meta")).unwrap();
     std::fs::write(p("sigmf-meta"), meta.replace("rf64_le", "cf32_le")).unwrap();
     refused(&p("sigmf-meta"), "core:datatype = `cf32_le`");
+    // Optional fields present with a wrong value are refused, not read as their defaults.
+    for (from, to, needle) in [
+        (
+            "\"core:num_channels\": 3",
+            "\"core:num_channels\": 1e19",
+            "core:num_channels = 1e+19: must be an integer 1..=65535",
+        ),
+        (
+            "\"core:num_channels\": 3",
+            "\"core:num_channels\": 0",
+            "core:num_channels = 0",
+        ),
+        (
+            "\"core:global_index\": 1000",
+            "\"core:global_index\": -1",
+            "core:global_index = -1: must be an integer >= 0",
+        ),
+        (
+            "\"gyroemu:t0_s\": ",
+            "\"gyroemu:t0_s\": \"soon\", \"x\": ",
+            "gyroemu:t0_s = \"soon\": must be a finite number",
+        ),
+    ] {
+        assert!(meta.contains(from), "`{from}` not in {meta}");
+        std::fs::write(p("sigmf-meta"), meta.replacen(from, to, 1)).unwrap();
+        refused(&p("sigmf-meta"), needle);
+    }
     std::fs::write(p("sigmf-meta"), "{ not json").unwrap();
     refused(&p("sigmf-meta"), "not JSON");
     std::fs::write(p("csv"), "a,b\n1,2\n").unwrap();

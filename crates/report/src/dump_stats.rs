@@ -3,7 +3,7 @@
 
 use crate::dump_figures::{db_unit, SPECTRUM_RANGE_DB};
 use crate::dump_set::{channel_unit, DumpSet};
-use gyroemu_spectrum::{find_tones, welch, Tone};
+use gyroemu_spectrum::{find_tones, scale_exponent, welch, Tone};
 
 /// Tones listed per channel.
 pub const TONES_LISTED: usize = 4;
@@ -34,9 +34,8 @@ pub fn channel_stats(d: &gyroemu_io::Dump) -> Vec<ChannelStats> {
         .iter()
         .zip(&d.data)
         .map(|(c, x)| {
-            let n = x.len().max(1) as f64;
-            let rms = (x.iter().map(|v| v * v).sum::<f64>() / n).sqrt();
             let peak = x.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+            let rms = rms(x, peak);
             let (mut tones, spectrum_error) = match welch(x, d.sample_rate_hz, None) {
                 Ok(p) => (find_tones(&p, TONES_LISTED, TONE_MIN_SNR_DB), None),
                 Err(e) => (Vec::new(), Some(e.to_string())),
@@ -55,6 +54,15 @@ pub fn channel_stats(d: &gyroemu_io::Dump) -> Vec<ChannelStats> {
             }
         })
         .collect()
+}
+
+/// Root mean square of `x` (largest |sample| `peak`): squares of samples far from 1 are
+/// taken scaled by a power of two (exact), so that 1e200 does not read inf nor 1e-170 zero.
+fn rms(x: &[f64], peak: f64) -> f64 {
+    let n = x.len().max(1) as f64;
+    let e = scale_exponent(peak);
+    let (down, up) = (2f64.powi(-e), 2f64.powi(e));
+    (x.iter().map(|v| (v * down) * (v * down)).sum::<f64>() / n).sqrt() * up
 }
 
 /// The table `gyroemu inspect` prints: one block per recording, one line per channel.

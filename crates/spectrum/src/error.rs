@@ -30,4 +30,15 @@ pub enum SpectrumError {
         /// Its value.
         value: f64,
     },
+    /// The power spectrum is beyond f64's range: a bin's power overflows (samples near 1e154
+    /// and above), or the strongest is below the smallest normal number (samples near 1e-154
+    /// and below).
+    #[error(
+        "the power spectrum is outside f64's range (2.2e-308 to 1.8e308): samples up to \
+         {peak:e} have powers near {peak:e}^2"
+    )]
+    OutOfRange {
+        /// The largest |sample|.
+        peak: f64,
+    },
 }

@@ -67,7 +67,8 @@ pub fn default_segment_len(n: usize) -> usize {
 /// [`default_segment_len`]) starting every `segment_len - segment_len / 2` samples, each
 /// multiplied by a periodic Hann window, transformed, and their one-sided |X_k|^2 averaged.
 /// Bins `0 < k < L/2` carry both signs of frequency (doubled); 0 and L/2 do not. The mean is
-/// not removed. Refuses non-finite samples, a bad rate and segments outside `4..=x.len()`.
+/// not removed. Refuses non-finite samples, a bad rate, segments outside `4..=x.len()`, and a
+/// spectrum beyond f64's range (see [`SpectrumError::OutOfRange`]).
 pub fn welch(x: &[f64], fs_hz: f64, segment_len: Option<usize>) -> Result<Psd, SpectrumError> {
     if !(fs_hz.is_finite() && fs_hz > 0.0) {
         return Err(SpectrumError::Rate(fs_hz));
@@ -81,6 +82,11 @@ pub fn welch(x: &[f64], fs_hz: f64, segment_len: Option<usize>) -> Result<Psd, S
     if let Some((index, &value)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
         return Err(SpectrumError::NonFinite { index, value });
     }
+    // Samples far from 1 are scaled by a power of two (exact) so that no square over- or
+    // underflows on the way; the power is scaled back at the end.
+    let peak = x.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+    let e = scale_exponent(peak);
+    let (down, up) = (pow2(-e), pow2(e));
     let l = segment_len.unwrap_or_else(|| default_segment_len(x.len()));
     if !(4..=x.len()).contains(&l) {
         return Err(SpectrumError::Segment {
@@ -101,7 +107,7 @@ pub fn welch(x: &[f64], fs_hz: f64, segment_len: Option<usize>) -> Result<Psd, S
     let mut start = 0;
     while start + l <= x.len() {
         for ((b, &xi), &wi) in buf.iter_mut().zip(&x[start..start + l]).zip(&w) {
-            *b = Complex64::new(xi * wi, 0.0);
+            *b = Complex64::new(xi * down * wi, 0.0);
         }
         fft.process_with_scratch(&mut buf, &mut scratch);
         for (a, b) in acc.iter_mut().zip(&buf) {
@@ -117,9 +123,14 @@ pub fn welch(x: &[f64], fs_hz: f64, segment_len: Option<usize>) -> Result<Psd, S
         .map(|(k, a)| {
             // Bin L/2 exists only for even L and is its own mirror image.
             let both_signs = k > 0 && !(l.is_multiple_of(2) && k == l / 2);
-            a * scale * if both_signs { 2.0 } else { 1.0 }
+            let sides = if both_signs { 2.0 } else { 1.0 };
+            a * scale * sides * up * up
         })
-        .collect();
+        .collect::<Vec<f64>>();
+    let strongest = power.iter().fold(0.0, |m: f64, p| m.max(*p));
+    if power.iter().any(|p| !p.is_finite()) || (peak > 0.0 && strongest < f64::MIN_POSITIVE) {
+        return Err(SpectrumError::OutOfRange { peak });
+    }
     Ok(Psd {
         fs_hz,
         segment_len: l,
@@ -127,4 +138,19 @@ pub fn welch(x: &[f64], fs_hz: f64, segment_len: Option<usize>) -> Result<Psd, S
         power,
         enbw_hz: fs_hz * s2 / (s1 * s1),
     })
+}
+
+/// The power of two `e` by which samples of largest magnitude `peak` are divided so that
+/// their squares and sums stay in f64's normal range: 0 (no scaling, the bits of the plain
+/// sums) for `peak` within 2^-300 .. 2^300, else about log2(peak), within +-1000.
+pub fn scale_exponent(peak: f64) -> i32 {
+    if peak == 0.0 || !peak.is_finite() || (-300.0..=300.0).contains(&peak.log2()) {
+        return 0;
+    }
+    (peak.log2().floor() as i32).clamp(-1000, 1000)
+}
+
+/// 2^e for |e| <= 1000, exactly.
+fn pow2(e: i32) -> f64 {
+    f64::from_bits(((1023 + e) as u64) << 52)
 }

@@ -1,0 +1,64 @@
+//! `gyroemu inspect`'s RMS and peak of a channel: the RMS of a square wave is its amplitude
+//! (to the rounding of its sum), at any magnitude f64 holds (1e300 once read inf, 1e-170 read 0); ordinary
+//! samples keep the bits of the plain mean of squares; a spectrum beyond f64's range is said,
+//! with no tones listed.
+
+use gyroemu_io::{Dump, SigmfChannel};
+use gyroemu_report::dump_stats::channel_stats;
+use std::collections::BTreeMap;
+
+fn dump(x: Vec<f64>) -> Dump {
+    Dump {
+        path: "x.csv".into(),
+        sample_rate_hz: 1000.0,
+        global_index: 0,
+        t0_s: 0.0,
+        channels: vec![SigmfChannel {
+            name: "x_v".into(),
+            unit: "V".into(),
+        }],
+        data: vec![x],
+        extra: BTreeMap::new(),
+    }
+}
+
+#[test]
+fn a_square_wave_reads_its_amplitude_at_any_magnitude() {
+    for a in [1e-300, 1e-170, 1e-5, 1.0, 7.5e3, 1e170, 1e300, f64::MAX] {
+        let x: Vec<f64> = (0..256).map(|i| if i % 2 == 0 { a } else { -a }).collect();
+        let s = &channel_stats(&dump(x))[0];
+        assert_eq!(s.peak, a);
+        // A sum of 256 rounded squares: within 256 ulps of the amplitude.
+        assert!(
+            (s.rms / a - 1.0).abs() < 256.0 * f64::EPSILON,
+            "{a:e}: {}",
+            s.rms
+        );
+    }
+}
+
+#[test]
+fn ordinary_samples_keep_the_plain_mean_of_squares() {
+    let x: Vec<f64> = (0..1000)
+        .map(|i| 1e-3 * (i as f64 * 0.37).sin() + 2e-4)
+        .collect();
+    let plain = (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
+    assert_eq!(channel_stats(&dump(x))[0].rms.to_bits(), plain.to_bits());
+}
+
+#[test]
+fn a_spectrum_beyond_f64_lists_no_tones_and_says_why() {
+    for a in [1e-170, 1e300] {
+        let x: Vec<f64> = (0..256).map(|i| if i % 2 == 0 { a } else { -a }).collect();
+        let s = &channel_stats(&dump(x))[0];
+        assert!(s.tones.is_empty(), "{a:e}: {:?}", s.tones);
+        let why = s.spectrum_error.as_deref().unwrap_or_default();
+        assert!(why.contains("outside f64's range"), "{a:e}: {why}");
+    }
+    // Within range the Nyquist tone is found at its level: 20 log10(1e150) dB above 1.
+    let x: Vec<f64> = (0..256)
+        .map(|i| if i % 2 == 0 { 1e150 } else { -1e150 })
+        .collect();
+    let s = &channel_stats(&dump(x))[0];
+    assert!((s.tones[0].freq_hz - 500.0).abs() < 1e-6, "{:?}", s.tones);
+}
