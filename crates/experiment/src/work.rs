@@ -27,11 +27,12 @@ pub struct Work {
 }
 
 impl Work {
-    /// Two pieces of work done one after the other.
+    /// Two pieces of work done one after the other (sums saturate: a lot of huge devices
+    /// must stay above the cap, not wrap below it).
     pub fn plus(self, o: Work) -> Work {
         Work {
-            points: self.points + o.points,
-            point_samples: self.point_samples + o.point_samples,
+            points: self.points.saturating_add(o.points),
+            point_samples: self.point_samples.saturating_add(o.point_samples),
             longest_s: self.longest_s.max(o.longest_s),
             longest_samples: self.longest_samples.max(o.longest_samples),
         }
@@ -104,4 +105,23 @@ pub fn measured_throughput(cfg: &Config) -> f64 {
     (0..3)
         .map(|_| chain(cfg, n_in, rayon::current_num_threads()))
         .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sums_of_work_saturate_above_the_cap_instead_of_wrapping_below_it() {
+        let huge = Work {
+            points: usize::MAX - 1,
+            point_samples: u64::MAX - 1,
+            longest_s: 1.0,
+            longest_samples: 10,
+        };
+        let w = huge.plus(huge);
+        assert_eq!((w.points, w.point_samples), (usize::MAX, u64::MAX));
+        assert!(w.check_cap(false).is_err());
+        assert!(w.check_cap(true).is_ok());
+    }
 }

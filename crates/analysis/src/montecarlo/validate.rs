@@ -205,5 +205,8 @@ pub fn lot_work(cfg: &Config, indices: &[u64]) -> (Work, u64) {
     indices
         .par_iter()
         .map(|&i| device_work(&device_config(cfg, &draw_device(mc, i))))
-        .reduce(|| (Work::default(), 0), |(a, x), (b, y)| (a.plus(b), x + y))
+        .reduce(
+            || (Work::default(), 0),
+            |(a, x), (b, y)| (a.plus(b), x.saturating_add(y)),
+        )
 }
