@@ -127,8 +127,11 @@ pub fn welch(x: &[f64], fs_hz: f64, segment_len: Option<usize>) -> Result<Psd, S
             a * scale * sides * up * up
         })
         .collect::<Vec<f64>>();
+    // Underflow: the (scaled) segments hold power, but scaled back it is below the normal
+    // range. Samples only in the tail no segment reaches leave every bin at 0: not this.
+    let held = acc.iter().any(|&a| a > 0.0);
     let strongest = power.iter().fold(0.0, |m: f64, p| m.max(*p));
-    if power.iter().any(|p| !p.is_finite()) || (peak > 0.0 && strongest < f64::MIN_POSITIVE) {
+    if power.iter().any(|p| !p.is_finite()) || (held && strongest < f64::MIN_POSITIVE) {
         return Err(SpectrumError::OutOfRange { peak });
     }
     Ok(Psd {

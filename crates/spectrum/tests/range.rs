@@ -64,7 +64,13 @@ fn powers_beyond_f64_are_refused() {
             other => panic!("2^{k}: expected OutOfRange, got {other:?}"),
         }
     }
-    // Silence is a spectrum of zeros, not out of range.
+    // Silence is a spectrum of zeros, not out of range; so is a sample in the tail that no
+    // segment reaches (65 samples: segments of 16 every 8 end at sample 64).
     let p = welch(&[0.0; 64], 1000.0, None).unwrap();
+    assert!(p.power.iter().all(|&v| v == 0.0));
+    let mut tail = [0.0; 65];
+    tail[64] = 1.0;
+    let p = welch(&tail, 1000.0, None).unwrap();
+    assert_eq!(p.segment_len, 16);
     assert!(p.power.iter().all(|&v| v == 0.0));
 }
