@@ -3,7 +3,7 @@
 
 use crate::dump_figures::{db_unit, SPECTRUM_RANGE_DB};
 use crate::dump_set::{channel_unit, DumpSet};
-use gyroemu_spectrum::{find_tones, scale_exponent, welch, Tone};
+use gyroemu_spectrum::{find_tones, power_of_two_scale, welch, Tone};
 
 /// Tones listed per channel.
 pub const TONES_LISTED: usize = 4;
@@ -60,8 +60,7 @@ pub fn channel_stats(d: &gyroemu_io::Dump) -> Vec<ChannelStats> {
 /// taken scaled by a power of two (exact), so that 1e200 does not read inf nor 1e-170 zero.
 fn rms(x: &[f64], peak: f64) -> f64 {
     let n = x.len().max(1) as f64;
-    let e = scale_exponent(peak);
-    let (down, up) = (2f64.powi(-e), 2f64.powi(e));
+    let (down, up) = power_of_two_scale(peak);
     (x.iter().map(|v| (v * down) * (v * down)).sum::<f64>() / n).sqrt() * up
 }
 

@@ -15,5 +15,5 @@ mod window;
 
 pub use error::SpectrumError;
 pub use tones::{find_tones, tone_near, Tone};
-pub use welch::{default_segment_len, scale_exponent, welch, Psd};
+pub use welch::{default_segment_len, power_of_two_scale, scale_exponent, welch, Psd};
 pub use window::{hann, hann_response, HANN_ENBW_BINS};

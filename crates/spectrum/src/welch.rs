@@ -85,8 +85,7 @@ pub fn welch(x: &[f64], fs_hz: f64, segment_len: Option<usize>) -> Result<Psd, S
     // Samples far from 1 are scaled by a power of two (exact) so that no square over- or
     // underflows on the way; the power is scaled back at the end.
     let peak = x.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
-    let e = scale_exponent(peak);
-    let (down, up) = (pow2(-e), pow2(e));
+    let (down, up) = power_of_two_scale(peak);
     let l = segment_len.unwrap_or_else(|| default_segment_len(x.len()));
     if !(4..=x.len()).contains(&l) {
         return Err(SpectrumError::Segment {
@@ -153,7 +152,12 @@ pub fn scale_exponent(peak: f64) -> i32 {
     (peak.log2().floor() as i32).clamp(-1000, 1000)
 }
 
-/// 2^e for |e| <= 1000, exactly.
-fn pow2(e: i32) -> f64 {
-    f64::from_bits(((1023 + e) as u64) << 52)
+/// The factors `(2^-e, 2^e)` of [`scale_exponent`] for samples of largest magnitude `peak`:
+/// samples times the first have squares in range; a root mean square times the second (or a
+/// power times it twice) is back in the samples' unit, exactly.
+pub fn power_of_two_scale(peak: f64) -> (f64, f64) {
+    let e = scale_exponent(peak);
+    // 2^e for |e| <= 1000, exactly: an exponent field with a zero mantissa.
+    let pow2 = |e: i32| f64::from_bits(((1023 + e) as u64) << 52);
+    (pow2(-e), pow2(e))
 }
