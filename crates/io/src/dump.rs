@@ -100,6 +100,21 @@ fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
     std::fs::read(path).map_err(|e| read_err(path, e.to_string()))
 }
 
+/// An optional metadata field: `default` when absent (SigMF's), else `read` of it, or why not
+/// (a channel count of 1e19 was once read as the default 1).
+fn optional<T>(
+    v: Option<&Value>,
+    name: &str,
+    rule: &str,
+    default: T,
+    read: impl Fn(&Value) -> Option<T>,
+) -> Result<T, String> {
+    match v {
+        None => Ok(default),
+        Some(v) => read(v).ok_or_else(|| format!("{name} = {v}: must be {rule}")),
+    }
+}
+
 /// Reads a SigMF recording from its `.sigmf-meta` path.
 pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
     let bad = |reason: String| read_err(meta_path, reason);
@@ -127,19 +142,18 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
             )))
         }
     };
-    // Absent optional fields take SigMF's defaults; present ones must be what they claim
-    // (a channel count of 1e19 once read as the default 1).
-    let n_ch = match g.get("core:num_channels") {
-        None => 1,
-        Some(v) => match v.as_u64() {
-            Some(n @ 1..=65_535) => n as usize,
-            _ => {
-                return Err(bad(format!(
-                    "core:num_channels = {v}: must be an integer 1..=65535"
-                )))
-            }
+    let n_ch = optional(
+        g.get("core:num_channels"),
+        "core:num_channels",
+        "an integer 1..=65535",
+        1,
+        |v| {
+            v.as_u64()
+                .filter(|n| (1..=65_535).contains(n))
+                .map(|n| n as usize)
         },
-    };
+    )
+    .map_err(bad)?;
     let channels: Vec<SigmfChannel> = match g.get("gyroemu:channels").and_then(Value::as_array) {
         Some(list) => {
             if list.len() != n_ch {
@@ -172,26 +186,25 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
             })
             .collect(),
     };
-    let t0_s = match g.get("gyroemu:t0_s") {
-        None => 0.0,
-        Some(v) => match v.as_f64() {
-            Some(t) if t.is_finite() => t,
-            _ => return Err(bad(format!("gyroemu:t0_s = {v}: must be a finite number"))),
-        },
-    };
-    let global_index = match meta
-        .get("captures")
-        .and_then(Value::as_array)
-        .and_then(|c| c.first())
-        .and_then(|c| c.get("core:global_index"))
-    {
-        None => 0,
-        Some(v) => v.as_u64().ok_or_else(|| {
-            bad(format!(
-                "captures[0].core:global_index = {v}: must be an integer >= 0"
-            ))
-        })?,
-    };
+    let t0_s = optional(
+        g.get("gyroemu:t0_s"),
+        "gyroemu:t0_s",
+        "a finite number",
+        0.0,
+        |v| v.as_f64().filter(|t| t.is_finite()),
+    )
+    .map_err(bad)?;
+    let global_index = optional(
+        meta.get("captures")
+            .and_then(Value::as_array)
+            .and_then(|c| c.first())
+            .and_then(|c| c.get("core:global_index")),
+        "captures[0].core:global_index",
+        "an integer >= 0",
+        0,
+        Value::as_u64,
+    )
+    .map_err(bad)?;
     let extra = g
         .iter()
         .filter_map(|(k, v)| Some((k.strip_prefix("gyroemu:")?.to_string(), v.as_f64()?)))
