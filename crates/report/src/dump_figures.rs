@@ -8,7 +8,7 @@ use crate::dump_set::{groups, DumpSet, Group};
 use crate::error::ReportError;
 use gyroemu_io::Dump;
 use gyroemu_plot::{render_panels_png, Figure, Series, SeriesStyle};
-use gyroemu_spectrum::{tone_near, welch, Psd};
+use gyroemu_spectrum::{tone_near, welch, Psd, SpectrumError};
 use std::path::{Path, PathBuf};
 
 /// Carrier periods of the full-rate nodes shown in `signals.png` (the waveforms stay legible).
@@ -237,11 +237,22 @@ fn spectrum_panel(
     fs_hz: f64,
     marks: impl Fn(&Psd) -> (Vec<Mark>, Option<String>),
 ) -> Option<Figure> {
-    let psds: Vec<(&str, Psd)> = chans
-        .iter()
-        .filter(|(_, x)| x.iter().any(|&v| v != 0.0))
-        .filter_map(|(name, x)| Some((*name, welch(x, fs_hz, None).ok()?)))
-        .collect();
+    // A channel left out is named in the title, so a missing trace never reads as a quiet one.
+    let mut psds: Vec<(&str, Psd)> = Vec::new();
+    let mut left_out = Vec::new();
+    for (name, x) in chans {
+        if x.iter().all(|&v| v == 0.0) {
+            left_out.push(format!("{name} (all zero)"));
+            continue;
+        }
+        match welch(x, fs_hz, None) {
+            Ok(p) => psds.push((name, p)),
+            Err(SpectrumError::OutOfRange { .. }) => {
+                left_out.push(format!("{name} (power outside f64's range)"))
+            }
+            Err(_) => left_out.push(format!("{name} (no spectrum)")),
+        }
+    }
     let first = &psds.first()?.1;
     let peak = psds
         .iter()
@@ -249,10 +260,12 @@ fn spectrum_panel(
         .fold(0.0, f64::max);
     let floor = peak * 10f64.powf(-SPECTRUM_RANGE_DB / 10.0);
     let (marks, note) = marks(first);
+    let left_out = (!left_out.is_empty()).then(|| format!("not drawn: {}", left_out.join(", ")));
+    let notes: Vec<String> = note.into_iter().chain(left_out).collect();
     let mut f = Figure::new(
-        match note {
-            Some(n) => format!("{title}: {n}"),
-            None => title.to_string(),
+        match notes.is_empty() {
+            false => format!("{title}: {}", notes.join("; ")),
+            true => title.to_string(),
         },
         format!(
             "Frequency (Hz): {} segment(s) of {}, ENBW {} Hz",

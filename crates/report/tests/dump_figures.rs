@@ -154,3 +154,41 @@ fn every_name_of_the_dump_reads_the_same_pair_and_figures_are_written() {
         assert_eq!(&std::fs::read(f).unwrap()[..4], b"\x89PNG");
     }
 }
+
+/// A channel the spectrum cannot draw (all zero, or powers beyond f64) is named in its panel's
+/// title, so a missing trace never reads as a quiet one; the channels that can be drawn are.
+#[test]
+fn a_channel_left_out_of_the_spectrum_is_named_in_the_title() {
+    let dir = tempfile::tempdir().unwrap();
+    let names = ["drive1", "drive2", "tia1_v", "tia2_v"]
+        .map(String::from)
+        .to_vec();
+    let mut rec = SignalRecorder::new(names, FS, 0, 4096);
+    for n in 0..4096u64 {
+        let c = (2.0 * PI * F0 * n as f64 / FS).cos();
+        // 1e200 squared is past f64's largest number: no Welch power of drive2 exists.
+        rec.record(n, &[0.8 * c, 1e200 * c, 1e-3 * c, 0.0]);
+    }
+    rec.write(dir.path(), "dump_fullrate").unwrap();
+    let set = read_dump_set(dir.path()).unwrap();
+    let (_, panels) = spectrum_panels(&set);
+    let drive = panels
+        .iter()
+        .find(|f| f.title.starts_with("Drive"))
+        .unwrap();
+    assert!(
+        drive
+            .title
+            .ends_with("not drawn: drive2 (power outside f64's range)"),
+        "{}",
+        drive.title
+    );
+    assert_eq!(drive.series.len(), 1);
+    let tia = panels.iter().find(|f| f.title.starts_with("TIA")).unwrap();
+    assert!(
+        tia.title.ends_with("not drawn: tia2_v (all zero)"),
+        "{}",
+        tia.title
+    );
+    assert_eq!(tia.series.len(), 1);
+}
