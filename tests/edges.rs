@@ -68,6 +68,44 @@ fn a_working_adc_counts_no_dead_sample_and_clipping_is_counted_and_warned() {
 }
 
 #[test]
+fn an_undithered_adc_states_how_far_its_rounding_can_move_the_phase_and_stays_within() {
+    // Without noise the ADC's error is a sawtooth of a carrier of 16 samples per period: it
+    // repeats every period, so no averaging removes it (at 2.6 LSBs the phase froze on a
+    // staircase with no warning). The bound is asin(LSB / A): twice the half-LSB bias over
+    // the amplitude, computed here from the board's values.
+    for lsbs in [2.6, 40.0, 120.0] {
+        let c = with_adc(lsbs);
+        let bound_mdeg = (1.0 / lsbs).min(1.0).asin().to_degrees() * 1e3;
+        let w = c.validate().expect("a warning, not a refusal");
+        let said: Vec<&String> = w.iter().filter(|w| w.contains("rounding error")).collect();
+        assert_eq!(said.len(), 2, "{lsbs} LSBs: {w:?}");
+        assert!(
+            said.iter()
+                .all(|w| w.contains(&format!("{bound_mdeg:.3e} mdeg")) && w.contains("adc_bits")),
+            "{said:?} against {bound_mdeg:.3e}"
+        );
+        let r = run(&c);
+        for p in &r.points {
+            for k in 0..2 {
+                let e = ((p.phase_deg[k] - p.theory_deg[k]) * 1e3).abs();
+                assert!(
+                    e <= bound_mdeg,
+                    "{lsbs} LSBs, mode {k}: {e} > {bound_mdeg} mdeg"
+                );
+            }
+        }
+    }
+    // 2^31 LSBs of amplitude: the bound (3e-5 mdeg) is below the 0.01 mdeg stated.
+    let mut c = with_adc(1.0);
+    c.board.adc_bits = Some(32);
+    assert!(!c
+        .validate()
+        .unwrap()
+        .iter()
+        .any(|w| w.contains("rounding error")));
+}
+
+#[test]
 fn a_dead_drive_refuses_both_modes_naming_the_dac_setting() {
     // Validation refuses a drive below half a DAC LSB; a library user who skips it still gets
     // no phase: the run counts the all-zero drive and refuses both modes.

@@ -175,6 +175,16 @@ impl Config {
                         0.5 * step
                     ));
                 }
+                if tia_out >= 0.5 * step {
+                    let bound_mdeg = self.adc_phase_bound_mdeg(step, tia_out);
+                    if bound_mdeg > WARN_HOLD_ERROR_MDEG {
+                        warnings.push(format!(
+                            "the ADC's LSB ({step:e} V) against the TIA output of mode {} (about {tia_out:e} V){}: its rounding error follows the carrier instead of averaging out and can move the measured phase by up to about {bound_mdeg:.3e} mdeg; raise board.adc_bits or lower board.adc_full_scale_v",
+                            k + 1,
+                            if self.noise.is_some() { " and the TIA noise there" } else { ", no noise to dither it" }
+                        ));
+                    }
+                }
                 if tia_out > b.adc_full_scale_v - 0.5 * step {
                     warnings.push(format!(
                         "the TIA output of mode {} (about {tia_out:e} V) exceeds the ADC's range (board.adc_full_scale_v = {}): it will clip; raise board.adc_full_scale_v or lower board.tia_gain_ohm",
@@ -192,6 +202,28 @@ impl Config {
                 }
             }
         }
+    }
+
+    /// How far the ADC's systematic rounding error can move the measured phase, mdeg: its
+    /// bias under the TIA's white noise (a lower bound on the noise there, so an upper bound
+    /// on the bias) against the carrier's amplitude.
+    fn adc_phase_bound_mdeg(&self, step: f64, amplitude: f64) -> f64 {
+        let b = &self.board;
+        let sigma = self.noise.as_ref().map_or(0.0, |n| {
+            let density = gyroemu_tia::input_referred_noise_a_per_rthz(
+                n.tia_current_noise_a_per_rthz,
+                n.tia_voltage_noise_v_per_rthz,
+                b.tia_gain_ohm,
+            );
+            // A one-pole TIA passes pi/2 of its pole frequency of white noise.
+            let band = b
+                .tia_pole_hz
+                .map_or(f64::INFINITY, |fp| core::f64::consts::FRAC_PI_2 * fp)
+                .min(0.5 * self.fs_hz());
+            b.tia_gain_ohm * density * band.sqrt()
+        });
+        let bias = gyroemu_theory::quantiser_bias_bound(step, sigma);
+        gyroemu_theory::quantiser_phase_bound_rad(bias, amplitude).to_degrees() * 1e3
     }
 
     /// The DAC holds each drive sample for a period: the measured phase departs from the

@@ -5,6 +5,8 @@
 
 pub mod closed_form;
 mod device;
+pub mod quantiser;
 
 pub use closed_form::*;
 pub use device::DrivenDevice;
+pub use quantiser::{quantiser_bias_bound, quantiser_phase_bound_rad};
