@@ -33,9 +33,14 @@ impl Dump {
         self.data.first().map_or(0, Vec::len)
     }
 
-    /// Time of frame `k`, s.
+    /// Time of frame `k`, s. The readers refuse a recording whose last index passes
+    /// `u64::MAX`; a `k` beyond the frames held is summed in f64 rather than wrapped.
     pub fn time_s(&self, k: usize) -> f64 {
-        self.t0_s + (self.global_index + k as u64) as f64 / self.sample_rate_hz
+        let n = match self.global_index.checked_add(k as u64) {
+            Some(n) => n as f64,
+            None => self.global_index as f64 + k as f64,
+        };
+        self.t0_s + n / self.sample_rate_hz
     }
 
     /// The samples of the channel named `name`.
@@ -80,8 +85,10 @@ pub enum DumpSource {
 }
 
 /// Reads the dump at `path` (see [`dump_source`]). Every refusal names the file and the key,
-/// line or rule: a missing file, a datatype other than `rf64_le`, a data file whose size or
-/// SHA-512 disagrees with the metadata, a CSV without `sample,time_s` or with a bad number.
+/// line or rule: a missing file, a device or an oversized file, a datatype other than
+/// `rf64_le`, a data file whose size or SHA-512 disagrees with the metadata, captures other
+/// than one from sample 0, no samples, a CSV without `sample,time_s`, with a bad number or
+/// with rows not of consecutive samples.
 pub fn read_dump(path: &Path) -> Result<Dump, IoError> {
     match dump_source(path) {
         DumpSource::Sigmf(meta) => read_sigmf(&meta),
@@ -96,8 +103,56 @@ fn read_err(path: &Path, reason: impl Into<String>) -> IoError {
     }
 }
 
-fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
-    std::fs::read(path).map_err(|e| read_err(path, e.to_string()))
+/// The most frames a gyroemu dump holds: its config refuses a window of more than 5e7
+/// full-rate samples (`dump.duration_s`), and the decimated window is shorter.
+const MAX_DUMP_FRAMES: u64 = 50_000_000;
+
+/// A gyroemu `.sigmf-meta` is a few kB; 16 MiB is far beyond any of them.
+const MAX_META_BYTES: u64 = 16 << 20;
+
+/// The largest dump CSV gyroemu writes: [`MAX_DUMP_FRAMES`] rows of `sample`, `time_s` and at
+/// most 14 channels (the decimated nodes), each cell at most 25 bytes with its separator
+/// (`-2.2250738585072014e-308,`): 20 GB.
+const MAX_CSV_BYTES: u64 = MAX_DUMP_FRAMES * 16 * 25;
+
+#[cfg(unix)]
+fn is_fifo(t: &std::fs::FileType) -> bool {
+    std::os::unix::fs::FileTypeExt::is_fifo(t)
+}
+
+#[cfg(not(unix))]
+fn is_fifo(_: &std::fs::FileType) -> bool {
+    false
+}
+
+/// Reads `path` whole if it holds at most `cap` bytes, else refuses saying `beyond`. Only a
+/// regular file or a FIFO (`<(...)`) is read: a device such as /dev/zero never ends. A FIFO's
+/// size is unknown until it ends, hence the cap on the bytes read as well as on the size.
+fn read_bytes(path: &Path, cap: u64, beyond: &str) -> Result<Vec<u8>, IoError> {
+    let io = |e: std::io::Error| read_err(path, e.to_string());
+    let too_big = || read_err(path, format!("more than {cap} bytes: {beyond}"));
+    // Stat before opening: opening a device may block or act.
+    let kind = std::fs::metadata(path).map_err(io)?.file_type();
+    if !(kind.is_file() || is_fifo(&kind)) {
+        return Err(read_err(
+            path,
+            "not a regular file (nor a FIFO): a device such as /dev/zero may never end",
+        ));
+    }
+    let file = std::fs::File::open(path).map_err(io)?;
+    let size = file.metadata().map_err(io)?.len();
+    if size > cap {
+        return Err(too_big());
+    }
+    let mut bytes = Vec::new();
+    bytes
+        .try_reserve_exact(usize::try_from(size).unwrap_or(usize::MAX))
+        .map_err(|_| read_err(path, format!("{size} bytes do not fit in memory")))?;
+    std::io::Read::read_to_end(&mut std::io::Read::take(file, cap + 1), &mut bytes).map_err(io)?;
+    if bytes.len() as u64 > cap {
+        return Err(too_big());
+    }
+    Ok(bytes)
 }
 
 /// An optional metadata field: `default` when absent (SigMF's), else `read` of it, or why not
@@ -118,8 +173,12 @@ fn optional<T>(
 /// Reads a SigMF recording from its `.sigmf-meta` path.
 pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
     let bad = |reason: String| read_err(meta_path, reason);
-    let meta: Value = serde_json::from_slice(&read_bytes(meta_path)?)
-        .map_err(|e| bad(format!("not JSON: {e}")))?;
+    let meta = read_bytes(
+        meta_path,
+        MAX_META_BYTES,
+        "not a gyroemu SigMF meta (those are a few kB)",
+    )?;
+    let meta: Value = serde_json::from_slice(&meta).map_err(|e| bad(format!("not JSON: {e}")))?;
     let g = meta
         .get("global")
         .and_then(Value::as_object)
@@ -194,11 +253,27 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
         |v| v.as_f64().filter(|t| t.is_finite()),
     )
     .map_err(bad)?;
+    // gyroemu writes one capture from the file's first sample: a second one marks a
+    // discontinuity that one time axis cannot describe.
+    let captures = optional(
+        meta.get("captures"),
+        "captures",
+        "an array of at most one capture (gyroemu records without a break)",
+        Vec::new(),
+        |v| v.as_array().filter(|c| c.len() <= 1).cloned(),
+    )
+    .map_err(bad)?;
+    let capture = captures.first();
+    optional(
+        capture.and_then(|c| c.get("core:sample_start")),
+        "captures[0].core:sample_start",
+        "0 (the capture starts at the file's first sample)",
+        (),
+        |v| (v.as_u64() == Some(0)).then_some(()),
+    )
+    .map_err(bad)?;
     let global_index = optional(
-        meta.get("captures")
-            .and_then(Value::as_array)
-            .and_then(|c| c.first())
-            .and_then(|c| c.get("core:global_index")),
+        capture.and_then(|c| c.get("core:global_index")),
         "captures[0].core:global_index",
         "an integer >= 0",
         0,
@@ -215,7 +290,11 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
         "{}.sigmf-data",
         name.trim_end_matches(".sigmf-meta")
     ));
-    let bytes = read_bytes(&data_path)?;
+    let bytes = read_bytes(
+        &data_path,
+        MAX_DUMP_FRAMES * 8 * n_ch as u64,
+        &format!("over {MAX_DUMP_FRAMES} frames of {n_ch} f64, the longest dump gyroemu writes"),
+    )?;
     if bytes.len() % (8 * n_ch) != 0 {
         return Err(read_err(
             &data_path,
@@ -238,6 +317,17 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
         }
     }
     let frames = bytes.len() / (8 * n_ch);
+    if frames == 0 {
+        return Err(read_err(&data_path, "holds no samples (0 bytes)"));
+    }
+    // Frame k is at global index global_index + k: the last must be a u64 (no wrap-around).
+    if global_index.checked_add(frames as u64 - 1).is_none() {
+        return Err(bad(format!(
+            "captures[0].core:global_index = {global_index}: its {frames} frames would run \
+             past sample index {}",
+            u64::MAX
+        )));
+    }
     let mut data = vec![Vec::with_capacity(frames); n_ch];
     for (i, w) in bytes.chunks_exact(8).enumerate() {
         let v = f64::from_le_bytes(w.try_into().expect("chunks of 8"));
@@ -254,10 +344,42 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
     })
 }
 
+/// The line a CSV record starts on, from the position the csv crate gives it: that is where
+/// it began scanning, before the blank lines it skips and the `\n` of a `\r\n`, so those are
+/// counted here.
+fn record_line(bytes: &[u8], pos: &csv::Position) -> u64 {
+    let from = usize::try_from(pos.byte()).map_or(bytes.len(), |b| b.min(bytes.len()));
+    let skipped = bytes[from..]
+        .iter()
+        .take_while(|&&b| b == b'\n' || b == b'\r')
+        .filter(|&&b| b == b'\n')
+        .count();
+    pos.line() + skipped as u64
+}
+
+/// The line data row `row` (0-based) of `bytes`, already parsed once, starts on: read again,
+/// as it is only wanted for a message.
+fn row_line(bytes: &[u8], row: usize) -> u64 {
+    let mut rd = csv::Reader::from_reader(bytes);
+    let mut rec = csv::StringRecord::new();
+    for _ in 0..=row {
+        if !matches!(rd.read_record(&mut rec), Ok(true)) {
+            return 0;
+        }
+    }
+    rec.position().map_or(0, |p| record_line(bytes, p))
+}
+
 /// Reads a dump CSV (`sample, time_s, <channels...>`): the rate from the first and last rows'
-/// sample and time, units from the channel names' suffixes.
+/// sample and time, units from the channel names' suffixes. Every row must be the next
+/// sample of the one before, at its time on the straight line through the first and last
+/// rows: a missing, repeated or edited row would otherwise change the rate read.
 pub fn read_csv_dump(path: &Path) -> Result<Dump, IoError> {
-    let bytes = read_bytes(path)?;
+    let bytes = read_bytes(
+        path,
+        MAX_CSV_BYTES,
+        "beyond the largest dump CSV gyroemu writes (5e7 rows of at most 16 columns)",
+    )?;
     let mut rd = csv::Reader::from_reader(bytes.as_slice());
     let headers: Vec<String> = rd
         .headers()
@@ -276,10 +398,19 @@ pub fn read_csv_dump(path: &Path) -> Result<Dump, IoError> {
     }
     let n_ch = headers.len() - 2;
     let mut data = vec![Vec::new(); n_ch];
-    let (mut first, mut last) = (None, None);
-    for (row, rec) in rd.records().enumerate() {
-        let line = row + 2;
-        let rec = rec.map_err(|e| read_err(path, format!("line {line}: {e}")))?;
+    let mut times = Vec::new();
+    let mut first_last: Option<(u64, u64)> = None;
+    let mut rec = csv::StringRecord::new();
+    loop {
+        match rd.read_record(&mut rec) {
+            Ok(true) => {}
+            Ok(false) => break,
+            Err(e) => {
+                let line = record_line(&bytes, e.position().unwrap_or(rd.position()));
+                return Err(read_err(path, format!("line {line}: {e}")));
+            }
+        }
+        let line = rec.position().map_or(0, |p| record_line(&bytes, p));
         if rec.len() != headers.len() {
             return Err(read_err(
                 path,
@@ -310,21 +441,81 @@ pub fn read_csv_dump(path: &Path) -> Result<Dump, IoError> {
                 ),
             )
         })?;
+        if let Some((_, prev)) = first_last {
+            let Some(want) = prev.checked_add(1) else {
+                return Err(read_err(
+                    path,
+                    format!("line {line}: a row after sample index {prev}, the largest there is"),
+                ));
+            };
+            if n != want {
+                return Err(read_err(
+                    path,
+                    format!(
+                        "line {line}, column `sample`: {n}, expected {want}: each row must be \
+                         the next sample of the row before (a row missing, repeated or edited)"
+                    ),
+                ));
+            }
+        }
+        first_last = Some((first_last.map_or(n, |(n0, _)| n0), n));
         let t = num(1)?;
-        first.get_or_insert((n, t));
-        last = Some((n, t));
+        if !t.is_finite() {
+            return Err(read_err(
+                path,
+                format!(
+                    "line {line}, column `time_s`: `{}` is not a finite time",
+                    &rec[1]
+                ),
+            ));
+        }
+        times.push(t);
         for (k, ch) in data.iter_mut().enumerate() {
             ch.push(num(k + 2)?);
         }
     }
-    let (Some((n0, t0)), Some((n1, t1))) = (first, last) else {
-        return Err(read_err(path, "no data rows"));
+    let Some((n0, n1)) = first_last else {
+        return Err(read_err(path, "holds no samples (no data rows)"));
     };
-    let fs = (n1 as f64 - n0 as f64) / (t1 - t0);
-    if !(n1 > n0 && fs.is_finite() && fs > 0.0) {
+    let (t0, t1) = (times[0], times[times.len() - 1]);
+    let steps = times.len() - 1;
+    let fs = steps as f64 / (t1 - t0);
+    if !(steps > 0 && fs.is_finite() && fs > 0.0) {
         return Err(read_err(
             path,
             "the rate cannot be read from the `sample` and `time_s` columns (one row, or time not increasing)",
+        ));
+    }
+    // The writer prints each time as the f64 t0_s + n / fs_hz, exactly: a row strays from the
+    // line through the first and last rows by a few roundings of its terms (each at most
+    // max|t| + n/fs in size): 16 ulps of that bound the strays. A thousandth of a sample period on
+    // top is margin, still far below a row out of step.
+    let scale = times.iter().fold(0.0, |m: f64, t| m.max(t.abs())) + n1 as f64 / fs;
+    let tol = 1e-3 / fs + 16.0 * f64::EPSILON * scale;
+    for (i, &t) in times.iter().enumerate() {
+        let want = t0 + (t1 - t0) * (i as f64 / steps as f64);
+        if (t - want).abs() > tol {
+            return Err(read_err(
+                path,
+                format!(
+                    "line {}, column `time_s`: {t} s, but {want} s on the straight line through \
+                     the first and last rows ({fs} Hz): the times are not those of consecutive \
+                     samples",
+                    row_line(&bytes, i)
+                ),
+            ));
+        }
+    }
+    // The first and last times carry up to an ulp of `scale` each: far from t = 0 over few
+    // rows that is a wrong rate, refused rather than printed.
+    let rate_err = 2.0 * f64::EPSILON * scale / (t1 - t0);
+    if rate_err > 1e-6 {
+        return Err(read_err(
+            path,
+            format!(
+                "the `time_s` column, at {t1} s, gives the rate only to {rate_err:.1e} of itself \
+                 over {steps} rows (f64 rounding): read the SigMF recording instead"
+            ),
         ));
     }
     let channels = headers[2..]
