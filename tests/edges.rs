@@ -140,3 +140,44 @@ fn an_underflowing_chain_gives_no_phase_instead_of_zero() {
         r.points
     );
 }
+
+#[test]
+fn a_decimation_that_folds_the_mixer_product_onto_dc_is_stated_and_bounded() {
+    // Order 1 at 1 kHz leaves |L(2 f_c)| of the 30 kHz product; M = 8 makes the output rate
+    // 30 kHz, which aliases it exactly onto the averaged DC (a 6 % scale-factor error with no
+    // warning before). The bound: asin |L(2 f_c)| of the bilinear one-pole, prewarped at the
+    // cutoff, H(z) = k (1 + 1/z) / (1 + a/z), k = t / (1 + t), a = (t - 1)/(t + 1).
+    let board = "fs_hz = 240000.0\ntia_pole_hz = 60000.0\nlpf_order = 1\nlpf_cutoff_hz = 1000.0";
+    let rates = [25.0, 175.0];
+    let mut c = config_with_board("coriolis", 15e3, 2000.0, 1.0, 1.0, &rates, 0.5, board);
+    let derived = c.validate().unwrap();
+    assert!(
+        !derived.iter().any(|w| w.contains("2 f_c product")),
+        "the derived decimation avoids the fold: {derived:?}"
+    );
+    c.board.decimation = Some(8);
+    let t = (PI * 1000.0 / 240e3).tan();
+    let (k, a) = (t / (1.0 + t), (t - 1.0) / (t + 1.0));
+    let z = num_complex::Complex64::from_polar(1.0, -2.0 * PI * 30e3 / 240e3);
+    let leak = (k * (1.0 + z) / (1.0 + a * z)).norm();
+    let bound_mdeg = leak.asin().to_degrees() * 1e3;
+    let w = c.validate().unwrap();
+    assert!(
+        w.iter()
+            .any(|w| w.contains("board.decimation = 8")
+                && w.contains(&format!("{bound_mdeg:.3e} mdeg"))),
+        "{w:?} against {bound_mdeg:.3e}"
+    );
+    let r = run(&c);
+    let errs: Vec<f64> = r
+        .points
+        .iter()
+        .flat_map(|p| (0..2).map(|k| ((p.phase_deg[k] - p.theory_deg[k]) * 1e3).abs()))
+        .collect();
+    assert!(
+        errs.iter().all(|&e| e <= bound_mdeg),
+        "{errs:?} > {bound_mdeg}"
+    );
+    // The fold is real: the worst point moves by a sizeable share of the bound.
+    assert!(errs.iter().any(|&e| e >= 0.1 * bound_mdeg), "{errs:?}");
+}

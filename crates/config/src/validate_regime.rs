@@ -56,6 +56,7 @@ impl Config {
             return;
         }
         self.validate_converters(p, warnings);
+        self.validate_mixer_product(warnings);
         self.validate_table_harmonics(warnings);
         self.validate_hold(p, warnings);
     }
@@ -201,6 +202,48 @@ impl Config {
                     ));
                 }
             }
+        }
+    }
+
+    /// The stage-1 mixer's 2 f_c product, what the low-pass leaves of it, aliased by the
+    /// decimation: a hand-set decimation whose output rate divides 2 f_c folds it onto DC
+    /// (6 % of the scale factor at order 1, M = 8). It moves the phasor by at most
+    /// |L(2 f_c)| x the averaging window's exact gain at the alias's distance from each
+    /// frequency the read-out demodulates (DC; Omega when rotating; the table's harmonics).
+    fn validate_mixer_product(&self, warnings: &mut Vec<String>) {
+        let Ok(chain) = gyroemu_board::ChainResponse::new(&self.board_params()) else {
+            return;
+        };
+        let (fc, fs_out) = (self.carrier_hz(), self.fs_out_hz());
+        let leak = chain.lowpass(2.0 * fc).norm();
+        let alias = 2.0 * fc - fs_out * (2.0 * fc / fs_out).round();
+        let (mut worst, mut at): (f64, f64) = (0.0, 0.0);
+        for rate in self.emulated_rates_dps() {
+            let window = self.plan_point(rate).window;
+            let refs: Vec<f64> = match self.shape() {
+                Shape::Coriolis => vec![0.0],
+                Shape::Rotating => vec![0.0, rate.abs() / 360.0],
+                Shape::RateTable { freq_hz } => (0..=15).map(|h| h as f64 * freq_hz).collect(),
+            };
+            for f in refs {
+                for df in [alias - f, alias + f] {
+                    let gain = window.response(df / fs_out).norm();
+                    let e = (leak * gain).min(1.0).asin();
+                    if e > worst {
+                        (worst, at) = (e, f);
+                    }
+                }
+            }
+        }
+        let worst_mdeg = worst.to_degrees() * 1e3;
+        if worst_mdeg > WARN_HOLD_ERROR_MDEG {
+            warnings.push(format!(
+                "board.decimation = {}: the stage-1 mixer's 2 f_c product ({} Hz), {:.1e} of it left by the low-pass, aliases to {:.6e} Hz at the output rate {fs_out} Hz, too close to the {at} Hz the read-out demodulates for its averaging to remove it: it can move the measured phase by up to {worst_mdeg:.3e} mdeg; choose a decimation whose output rate does not divide 2 f_c (remove the key for the derived one), or raise board.lpf_order",
+                self.decimation(),
+                2.0 * fc,
+                leak,
+                alias.abs()
+            ));
         }
     }
 

@@ -3,7 +3,7 @@
 
 use crate::{KahanSum, STAGE};
 use gyroemu_core::detmath::sin_cos_turns;
-use gyroemu_core::{ParamError, ParamResult, Sample};
+use gyroemu_core::{Complex64, ParamError, ParamResult, Sample};
 
 /// Most lanes an [`Averager`] serves (the widest sample type).
 pub const MAX_LANES: usize = 8;
@@ -61,6 +61,31 @@ impl Window {
         }
     }
 
+    /// The window's normalised response to a tone of `cycles` cycles per sample,
+    /// `sum_j w_j e^{-j 2 pi cycles j} / sum_j w_j`, in closed form (geometric sums, so a
+    /// window of 1e9 samples costs the same as one of ten): what the average keeps of a
+    /// component that is not at DC.
+    pub fn response(&self, cycles: f64) -> Complex64 {
+        match *self {
+            Window::Boxcar { n, frac } => {
+                let (s, c) = sin_cos_turns((cycles * n as f64).rem_euclid(1.0));
+                (geometric(cycles, n) + Complex64::new(c, -s) * frac) / (n as f64 + frac)
+            }
+            Window::Hann { n } => {
+                // sin^2(pi (j + 1/2)/n) = 1/2 - (e^{i 2 pi (j + 1/2)/n} + conj) / 4.
+                let step = 1.0 / n as f64;
+                let (s, c) = sin_cos_turns(0.5 * step);
+                let half = Complex64::new(c, s);
+                let sum = 0.5 * geometric(cycles, n)
+                    - 0.25
+                        * (half * geometric(cycles - step, n)
+                            + half.conj() * geometric(cycles + step, n));
+                let weights: f64 = if n == 1 { 1.0 } else { 0.5 * n as f64 };
+                sum / weights
+            }
+        }
+    }
+
     fn check(&self) -> ParamResult<()> {
         match *self {
             Window::Boxcar { frac, .. } if !(0.0..1.0).contains(&frac) => Err(ParamError::new(
@@ -73,6 +98,19 @@ impl Window {
             _ => Ok(()),
         }
     }
+}
+
+/// `sum_{j < n} e^{-i 2 pi t j}` = e^{-i pi t (n - 1)} sin(pi n t) / sin(pi t), with t taken
+/// to the nearest whole turn first (so whole turns give exactly n).
+fn geometric(turns: f64, n: u64) -> Complex64 {
+    let t = turns - turns.round();
+    if t == 0.0 {
+        return Complex64::new(n as f64, 0.0);
+    }
+    let (num, _) = sin_cos_turns((0.5 * t * n as f64).rem_euclid(1.0));
+    let (den, _) = sin_cos_turns(0.5 * t);
+    let (s, c) = sin_cos_turns((0.5 * t * (n as f64 - 1.0)).rem_euclid(1.0));
+    Complex64::new(c, -s) * (num / den)
 }
 
 /// Weighted means `sum(w x) / sum(w)` of up to `C` channels, each lane with its own

@@ -240,3 +240,41 @@ fn an_early_read_equals_the_mean_of_a_shorter_window() {
         long.push(&[xj]);
     }
 }
+
+/// `Window::response` in closed form against the sum over every weight, for boxcar windows
+/// with and without a fractional end and Hann windows, at tones from DC to Nyquist (a seeded
+/// sweep, plus whole turns and exact zeros of the Dirichlet kernel).
+#[test]
+fn window_response_is_the_direct_sum_of_its_weights() {
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for case in 0..300 {
+        let n = 1 + (next() * 3000.0) as u64;
+        let w = match case % 3 {
+            0 => Window::Boxcar { n, frac: 0.0 },
+            1 => Window::Boxcar { n, frac: next() },
+            _ => Window::Hann { n },
+        };
+        let mut cycles = vec![0.0, 0.5, 1.0, next() * 0.5, next() * 4.0 / n as f64];
+        cycles.push(1.0 / n as f64); // a zero of the boxcar's Dirichlet kernel
+        for f in cycles {
+            let (mut sum, mut wsum) = (Complex64::new(0.0, 0.0), 0.0);
+            for j in 0..w.samples() {
+                let (s, c) = sin_cos_turns(f * j as f64);
+                sum += Complex64::new(c, -s) * w.weight(j);
+                wsum += w.weight(j);
+            }
+            let want = sum / wsum;
+            let got = w.response(f);
+            assert!(
+                (got - want).norm() < 1e-9,
+                "{w:?} at {f} cycles/sample: {got} against {want}"
+            );
+        }
+    }
+}
