@@ -205,12 +205,14 @@ pub fn run_device(
     }
     let rotating = finish_sweep(&rot_cfg, &runs[0].lanes)?;
     let coriolis = finish_sweep(&cor_cfg, &runs[1].lanes)?;
+    // The canonical count (four points per group in index order), not what this machine's
+    // grouping ran: a device's record must not depend on threads, lanes or shards.
+    let samples = rotating.point_samples + coriolis.point_samples;
     let core = SelfcalCore::from_sweeps(&cfg, rotating, coriolis);
     let inputs = DeviceInputs {
         config: &cfg,
         nominal_angular_gain: base.device.angular_gain,
         core: &core,
     };
-    let samples = runs[0].point_samples + runs[1].point_samples;
     Ok(Some(DeviceResult::new(index, &inputs, samples)))
 }
