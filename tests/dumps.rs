@@ -127,3 +127,47 @@ nodes = ["drive"]
         .validate()
         .unwrap();
 }
+
+#[test]
+fn a_dump_whose_output_rate_no_wav_holds_is_warned_and_written_without_wav() {
+    // Decimation by 600000 puts the output at 0.4 Hz, which rounds to no WAV rate: the
+    // validation says so before any sample, and the run writes the CSV and SigMF (the WAV
+    // refusal used to come after the whole emulation, losing every result).
+    let text = r#"
+[device]
+f0_hz = 15000.0
+q = 2000.0
+angular_gain = 1.0
+[drive]
+f1 = 1.0
+f2 = 1.0
+[board]
+fs_hz = 240000.0
+lpf_cutoff_hz = 0.1
+decimation = 600000
+[experiment]
+kind = "coriolis"
+rates_dps = [100.0]
+settle_s = 10.0
+average_s = 5.0
+[dump]
+rate_dps = 100.0
+start_s = 0.0
+duration_s = 12.0
+nodes = ["lowpass"]
+"#;
+    let cfg = parse_config(text).unwrap();
+    let w = cfg.validate().unwrap();
+    assert!(
+        w.iter()
+            .any(|w| w.contains("decimated recording gets no WAV") && w.contains("fs_hz = 0.4")),
+        "{w:?}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    run_sweep(&cfg, &|_, _| {}, Some(dir.path())).unwrap();
+    let (h, rows) = read_csv(&dir.path().join("dump_decimated.csv"));
+    assert!(h.contains(&"lp_i1".to_string()));
+    assert_eq!(rows.len(), (12.0f64 * 0.4).round() as usize);
+    assert!(dir.path().join("dump_decimated.sigmf-data").exists());
+    assert!(!dir.path().join("dump_decimated.wav").exists());
+}

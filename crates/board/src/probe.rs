@@ -277,6 +277,33 @@ impl Probe {
         self.decimated.record(k, &frame[..n]);
     }
 
+    /// Why a recording of `nodes` gets no WAV (see [`gyroemu_io::wav_f32_rate_problem`]):
+    /// `(recording, reason)` for the full-rate one at `fs_hz` and the decimated one at
+    /// `fs_hz / decimation`, each when it has channels.
+    pub fn wav_problems(
+        nodes: &[String],
+        fs_hz: f64,
+        decimation: usize,
+    ) -> Vec<(&'static str, String)> {
+        let count = |table: &[(&str, &[&str])]| -> u64 {
+            table
+                .iter()
+                .filter(|(n, _)| nodes.iter().any(|m| m == n))
+                .map(|(_, c)| c.iter().filter(|c| !c.is_empty()).count() as u64)
+                .sum()
+        };
+        let full: Vec<(&str, &[&str])> = FULL_NODES.iter().map(|(n, c)| (*n, &c[..])).collect();
+        let dec: Vec<(&str, &[&str])> = DEC_NODES.iter().map(|(n, c)| (*n, &c[..])).collect();
+        [
+            ("full-rate", fs_hz, count(&full)),
+            ("decimated", fs_hz / decimation as f64, count(&dec)),
+        ]
+        .into_iter()
+        .filter(|&(_, _, ch)| ch > 0)
+        .filter_map(|(what, fs, ch)| Some((what, gyroemu_io::wav_f32_rate_problem(fs, ch)?)))
+        .collect()
+    }
+
     /// The names of every file [`Probe::write`] may write for `stem` (to clear a folder of
     /// an earlier dump).
     pub fn file_names(stem: &str) -> Vec<String> {

@@ -46,7 +46,7 @@ impl Config {
         {
             self.validate_regime(&mut p, &mut warnings);
         }
-        self.validate_dump(&mut p);
+        self.validate_dump(&mut p, &mut warnings);
         if sweep {
             self.validate_sweep_rules(&mut p, &mut warnings);
         }
@@ -378,7 +378,7 @@ impl Config {
     /// The dump's rules. Its window is weighed against the point's run only when the rest of
     /// the config is valid (the run's length depends on nearly every key), and a window key
     /// derived from the run is judged only then.
-    fn validate_dump(&self, p: &mut Rules) {
+    fn validate_dump(&self, p: &mut Rules, warnings: &mut Vec<String>) {
         let (Some(given), Some(dump)) = (&self.dump, self.dump_resolved()) else {
             return;
         };
@@ -453,6 +453,14 @@ impl Config {
                 format!("\"{n}\""),
                 format!("must be one of {DUMP_NODES:?}"),
             );
+        }
+        if p.clean(&["board.fs_hz", "board.decimation"]) {
+            let (fs, m) = (self.fs_hz(), self.decimation());
+            for (what, why) in gyroemu_board::Probe::wav_problems(&nodes, fs, m) {
+                warnings.push(format!(
+                    "dump: the {what} recording gets no WAV ({why}); its CSV and SigMF are written"
+                ));
+            }
         }
     }
 }

@@ -26,4 +26,7 @@ pub use sigmf::{
     write_sigmf, SigmfChannel, SigmfFiles, SigmfMeta, DEFAULT_HW, GYROEMU_EXTENSION_VERSION,
     SIGMF_DATATYPE_REAL_F64, SIGMF_VERSION,
 };
-pub use wav::{check_wav_f32_size, write_wav_f32, WAV_F32_HEADER_BYTES, WAV_F32_MAX_DATA_BYTES};
+pub use wav::{
+    check_wav_f32_size, wav_f32_rate_problem, write_wav_f32, WAV_F32_HEADER_BYTES,
+    WAV_F32_MAX_DATA_BYTES,
+};

@@ -6,7 +6,7 @@ use crate::fast_text::{push_f64, push_i64};
 use crate::sigmf::{
     check_request, unit_from_name, write_sigmf_frames, SigmfChannel, SigmfMeta, DEFAULT_HW,
 };
-use crate::wav::{check_wav_f32_size, write_interleaved};
+use crate::wav::{check_wav_f32_size, wav_f32_rate_problem, write_interleaved};
 use crate::IoError;
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -146,40 +146,46 @@ impl SignalRecorder {
 
     /// Writes, each atomically:
     /// - `<dir>/<stem>.csv` (columns `sample`, `time_s`, then one per name; exact float text);
-    /// - `<dir>/<stem>.wav` (one 32-bit float channel per name at round(fs_hz) Hz). WAV values
-    ///   are the raw signals, not normalised, so they may exceed +-1: read them with
-    ///   `soundfile.read(path)` or `scipy.io.wavfile.read(path)`, not an audio player;
+    /// - `<dir>/<stem>.wav` (one 32-bit float channel per name at round(fs_hz) Hz), when a WAV
+    ///   header can hold the rate ([`wav_f32_rate_problem`]; an output rate below 0.5 Hz, or
+    ///   a byte rate past 2^32, has only the CSV and SigMF). WAV values are the raw signals,
+    ///   not normalised, so they may exceed +-1: read them with `soundfile.read(path)` or
+    ///   `scipy.io.wavfile.read(path)`, not an audio player;
     /// - `<dir>/<stem>.sigmf-data` + `<dir>/<stem>.sigmf-meta` (SigMF 1.2.0, `rf64_le`, full
     ///   f64 precision at the exact fs_hz; capture `core:global_index` = first sample index,
     ///   `gyroemu:t0_s` = time origin, `gyroemu:channels` = names with units read from their
     ///   suffixes): `np.fromfile(path, dtype="<f8").reshape(-1, n_channels)`.
     ///
     /// The WAV size and the SigMF request are checked before any file is written. Returns the
-    /// four paths written (CSV, WAV, SigMF data, SigMF meta).
+    /// paths written (CSV, WAV when written, SigMF data, SigMF meta).
     pub fn write(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, IoError> {
         let csv_path = dir.join(format!("{stem}.csv"));
         let wav_path = dir.join(format!("{stem}.wav"));
-        let rate = self.fs_hz.round();
-        if !(rate >= 1.0 && rate <= f64::from(u32::MAX)) {
-            return Err(IoError::WavInvalid {
-                path: wav_path,
-                reason: format!(
-                    "fs_hz = {} does not round to a WAV sample rate in 1..=2^32-1 Hz",
-                    self.fs_hz
-                ),
-            });
-        }
-        let rate = rate as u32;
         let ch = self.names.len();
         let frames = self.len();
-        check_wav_f32_size(&wav_path, rate, ch as u64, frames as u64)?;
+        // No channels at all is refused by the size check (nothing to write).
+        let wav = ch == 0 || wav_f32_rate_problem(self.fs_hz, ch as u64).is_none();
+        if wav {
+            check_wav_f32_size(
+                &wav_path,
+                self.fs_hz.round() as u32,
+                ch as u64,
+                frames as u64,
+            )?;
+        }
         let meta = self.sigmf_meta(stem);
         check_request(&dir.join(format!("{stem}.sigmf-data")), &meta, ch)?;
 
         self.write_csv(&csv_path)?;
-        write_interleaved(&wav_path, rate, ch, frames, |i, k| self.data[i * ch + k])?;
+        let mut files = vec![csv_path];
+        if wav {
+            let rate = self.fs_hz.round() as u32;
+            write_interleaved(&wav_path, rate, ch, frames, |i, k| self.data[i * ch + k])?;
+            files.push(wav_path);
+        }
         let sigmf = write_sigmf_frames(dir, stem, &meta, ch, frames, |i, k| self.data[i * ch + k])?;
-        Ok(vec![csv_path, wav_path, sigmf.data_path, sigmf.meta_path])
+        files.extend([sigmf.data_path, sigmf.meta_path]);
+        Ok(files)
     }
 
     /// Writes only the CSV (columns `sample`, `time_s`, then one per name), atomically. The

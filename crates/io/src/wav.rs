@@ -11,6 +11,24 @@ pub const WAV_F32_HEADER_BYTES: u64 = 68;
 /// Largest sample payload a RIFF file can describe: its 32-bit size field counts the file minus 8 bytes.
 pub const WAV_F32_MAX_DATA_BYTES: u64 = u32::MAX as u64 - (WAV_F32_HEADER_BYTES - 8);
 
+/// Why a float WAV of `channels` channels cannot describe a rate of `fs_hz` (a WAV rate is a
+/// whole number of Hz in 1..=2^32-1, and its byte-rate field, rate x channels x 4, is 32-bit
+/// too), or `None` when it can. The CSV and SigMF beside it carry any rate.
+pub fn wav_f32_rate_problem(fs_hz: f64, channels: u64) -> Option<String> {
+    let rate = fs_hz.round();
+    if !(rate >= 1.0 && rate <= f64::from(u32::MAX)) {
+        return Some(format!(
+            "fs_hz = {fs_hz} does not round to a WAV sample rate in 1..=2^32-1 Hz"
+        ));
+    }
+    if rate * channels as f64 * 4.0 > f64::from(u32::MAX) {
+        return Some(format!(
+            "byte rate {rate} Hz x {channels} channels x 4 bytes overflows the 32-bit WAV byte-rate field"
+        ));
+    }
+    None
+}
+
 /// Checks a float-WAV request without touching memory or disk and returns its sample payload in
 /// bytes. hound keeps sizes in `u32` and wraps silently past 4 GiB, and computes
 /// `rate * channels * 4` in `u32` too, so both are checked here first.

@@ -275,3 +275,37 @@ fn recorder_with_no_channels_fails_before_writing() {
     assert!(r.write(dir.path(), "none").is_err());
     assert!(entries(dir.path()).is_empty());
 }
+
+/// A rate a WAV header cannot hold (below 0.5 Hz, or a byte rate past 2^32) loses only the
+/// WAV: the CSV and SigMF carry any rate, and the paths returned say what was written. Before,
+/// the refusal came after the whole emulation and every result was lost.
+#[test]
+fn a_rate_no_wav_can_hold_writes_the_csv_and_sigmf_only() {
+    use gyroemu_io::wav_f32_rate_problem;
+    // 0.4 Hz rounds to 0; 1e8 Hz x 12 channels x 4 bytes is 4.8e9 > 2^32 - 1.
+    for (fs_hz, ch) in [(0.4, 2usize), (1e8, 12)] {
+        let why = wav_f32_rate_problem(fs_hz, ch as u64).expect("no WAV rate");
+        assert!(why.contains("WAV"), "{why}");
+        let dir = tempfile::tempdir().unwrap();
+        let names = (0..ch).map(|k| format!("lp_i{k}")).collect();
+        let mut r = SignalRecorder::new(names, fs_hz, 0, 8);
+        for n in 0..8u64 {
+            r.record(n, &vec![n as f64; ch]);
+        }
+        let files = r.write(dir.path(), "d").unwrap();
+        assert_eq!(
+            entries(dir.path()),
+            ["d.csv", "d.sigmf-data", "d.sigmf-meta"],
+            "{fs_hz} Hz"
+        );
+        assert_eq!(files.len(), 3);
+        let meta: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("d.sigmf-meta")).unwrap())
+                .unwrap();
+        assert_eq!(meta["global"]["core:sample_rate"].as_f64(), Some(fs_hz));
+    }
+    // The edges: 0.5 Hz rounds to 1 Hz; 4 channels of 4 bytes fit up to (2^32 - 1)/16 Hz.
+    assert_eq!(wav_f32_rate_problem(0.5, 1), None);
+    assert_eq!(wav_f32_rate_problem(268_435_455.0, 4), None);
+    assert!(wav_f32_rate_problem(268_435_456.0, 4).is_some());
+}
