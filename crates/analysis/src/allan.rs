@@ -5,16 +5,40 @@
 use gyroemu_core::flicker::ADEV_PER_BIAS_INSTABILITY;
 use serde::Serialize;
 
-/// Independent differences (`n_terms / m`) a point must rest on to enter the bias-instability
-/// reading. With flicker noise an overlapping Allan deviation from them has relative standard
-/// error about `0.63 / sqrt(n_terms / m)` (NIST SP 1065, edf `5 N / (4 m)`), so 40 keeps it
-/// under 10 %: the last points of a curve (a third of the record, a handful of averages) scatter
-/// by 30 % and their dips would pass for the floor.
+/// Independent differences (`n_terms / m`) a point must rest on to enter either reading. With
+/// flicker noise an overlapping Allan deviation from them has relative standard error about
+/// `0.63 / sqrt(n_terms / m)` (NIST SP 1065, edf `5 N / (4 m)`), so 40 keeps it under 10 %:
+/// the last points of a curve (a third of the record, a handful of averages) scatter by 30 %,
+/// their dips would pass for the floor and their chance -1/2 pairs for the white region.
 const MIN_INDEPENDENT_DIFFERENCES: f64 = 40.0;
 
 /// Half-width, in decades of tau, of the window the floor is smoothed over before its minimum
 /// is taken (the minimum of a noisy flat curve reads low by about its scatter).
 const FLOOR_SMOOTHING_DECADES: f64 = 0.125;
+
+/// How far a slope may lie from -1/2 for its chord to count as white rate noise.
+const ARW_SLOPE_TOLERANCE: f64 = 0.1;
+
+/// The baseline, in decades of tau, of the chords whose slopes are tested against -1/2: twice
+/// the 1/8 decade between points, since adjacent points on a few hundred independent
+/// differences still give slopes scattered by +-0.1.
+const ARW_CHORD_DECADES: f64 = 0.25;
+
+/// The least span, in decades of tau, of the -1/2 chords the angle random walk is read on. A
+/// curve passing from one slope to another is within 0.1 of -1/2 over less: from white phase
+/// (-1) to a flicker floor (0) over 0.18 decade, where at most two quarter-decade chords pass
+/// (together 3/8 decade); chance -1/2 chords of a scattered floor do not run on for half a
+/// decade either.
+const MIN_ARW_SPAN_DECADES: f64 = 0.5;
+
+/// Without a settling time from the caller, a minimum this close (decades of tau) to a curve's
+/// first point is flagged: nothing shows the curve there is past a resonator's or filter's
+/// roll-off (a curve can dip at its first point and still be rising to its floor).
+const FIRST_POINTS_DECADES: f64 = 0.5;
+
+/// The reliable curve's log-log slope over its last half decade below which a minimum at its
+/// last point is a curve still falling (white noise: -1/2), not a floor (0).
+const STILL_FALLING_SLOPE: f64 = -0.25;
 
 /// One point of an Allan deviation curve.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -79,70 +103,257 @@ pub fn overlapping_adev(y: &[f64], tau0_s: f64, per_decade: usize) -> Vec<AllanP
         .collect()
 }
 
-/// The readings of an Allan deviation curve of a rate in deg/s.
+/// The readings of an Allan deviation curve of a rate in deg/s. A reading that cannot be
+/// trusted is NaN (null in JSON) or carries a warning: never a clean wrong number.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct NoiseReadings {
     /// Angle random walk, deg/sqrt(h): the -1/2 line sigma = N / sqrt(tau) read at tau = 1 s
-    /// (N in deg/s*sqrt(s), times 60).
+    /// (N in deg/s*sqrt(s), times 60). NaN when the curve has no trustworthy -1/2 region
+    /// (`arw_warning` says why).
     pub arw_deg_per_rt_h: f64,
+    /// The taus the angle random walk was read over, s (first and last point; NaN without one).
+    pub arw_tau_s: [f64; 2],
+    /// Why the angle random walk is absent (`None` when it was read).
+    pub arw_warning: Option<&'static str>,
     /// Bias instability, deg/h: the flat minimum of the curve divided by 0.664 (the flicker
-    /// floor `sqrt(2 ln 2 / pi) B`). Read where the curve is reliable (see [`noise_readings`]).
+    /// floor `sqrt(2 ln 2 / pi) B`). Read where the curve is reliable (see
+    /// [`noise_readings_settled`]).
+    /// NaN when the curve has no minimum past its initial rise.
     pub bias_instability_deg_per_h: f64,
-    /// Where the minimum lies, s.
+    /// Where the minimum lies, s (NaN without one).
     pub tau_at_min_s: f64,
+    /// Why the bias instability is absent, only a bound, or unreliable (`None` when it is the
+    /// flat floor of reliable points).
+    pub bias_instability_warning: Option<&'static str>,
 }
 
 /// Reads ARW and bias instability from an Allan deviation curve of a rate in deg/s (as
 /// [`overlapping_adev`] gives it: the first point at tau0, `n_terms` summed over pooled
-/// records). The random-walk coefficient N is the median of sigma*sqrt(tau) over the points
-/// whose local log-log slope is within 0.1 of -1/2 (the white-noise region), or over the first
-/// third of the curve if none is.
-///
-/// The bias instability is the flat minimum: over the points resting on at least 40
-/// independent differences (`n_terms tau0 / tau`; all points if none does), sigma^2 averaged
-/// over +-1/8 decade of tau, its minimum's square root divided by 0.664. Without a flicker
-/// floor the minimum is the last reliable point, and only bounds the bias instability from
-/// above.
+/// records), with no settling time known: [`noise_readings_settled`] with 0.
 pub fn noise_readings(curve: &[AllanPoint]) -> Option<NoiseReadings> {
+    noise_readings_settled(curve, 0.0)
+}
+
+/// Reads ARW and bias instability from an Allan deviation curve of a rate in deg/s, taking
+/// neither below `settled_tau_s` (e.g. ten mechanical time constants of a resonator whose
+/// bandwidth rolls the short taus off; 0 when unknown). `None` for fewer than two points.
+///
+/// Both readings use the points past the curve's initial rise (from the first point whose
+/// next point is not higher, and not below `settled_tau_s`) that rest on at least 40
+/// independent differences (`n_terms tau0 / tau`: a relative error under 10 %).
+///
+/// The random-walk coefficient N is read on the lowest-tau run of those points whose
+/// quarter-decade chords (each point to the first a quarter decade on) have log-log slopes
+/// within 0.1 of -1/2, and which spans at least half a decade: ln(sigma sqrt(tau)) averaged
+/// over the run (a least-squares fit of a -1/2 line), each point weighted by the inverse of its
+/// variance (from its independent differences) plus the square of its chords' departure from
+/// -1/2 (about the relative bias of sigma sqrt(tau) where a roll-off or a floor bends the line),
+/// so the well-averaged points on the straightest part count most. Without such a run the ARW
+/// is NaN with a warning: a curve with no white-noise region has no ARW to read (the -1/2
+/// pairs of a scattered tail, or of a slope crossing -1/2 on its way between others, are not
+/// one).
+///
+/// The bias instability is the flat minimum of the same points: sigma^2 averaged over +-1/8
+/// decade of tau, its minimum's square root divided by 0.664. It is NaN with a warning if no
+/// point is past the initial rise, and carries a warning when it is only an upper bound (the
+/// curve still falls at its last reliable point: no floor reached), when no point rests on 40
+/// independent differences (then all points past the rise count), or when, with no settling
+/// time given, the minimum lies within half a decade of the curve's first point.
+pub fn noise_readings_settled(curve: &[AllanPoint], settled_tau_s: f64) -> Option<NoiseReadings> {
     if curve.len() < 2 {
         return None;
     }
-    let slope = |i: usize| {
-        let (a, b) = (curve[i], curve[i + 1]);
+    let tau0 = curve[0].tau_s;
+    let slope = |i: usize, j: usize| {
+        let (a, b) = (curve[i], curve[j]);
         (b.adev.ln() - a.adev.ln()) / (b.tau_s.ln() - a.tau_s.ln())
     };
-    let mut ns: Vec<f64> = (0..curve.len() - 1)
-        .filter(|&i| (slope(i) + 0.5).abs() < 0.1)
-        .map(|i| curve[i].adev * curve[i].tau_s.sqrt())
-        .collect();
-    if ns.is_empty() {
-        ns = curve[..curve.len().div_ceil(3)]
-            .iter()
-            .map(|p| p.adev * p.tau_s.sqrt())
-            .collect();
-    }
-    ns.sort_by(f64::total_cmp);
-    let n_coef = ns[ns.len() / 2];
-    let (floor, tau_at_min_s) = flat_minimum(curve)?;
+    let independent = |p: &AllanPoint| p.n_terms as f64 * tau0 / p.tau_s;
+    // Independent differences fall with tau: the reliable points are a prefix of the curve.
+    let reliable_end = curve
+        .iter()
+        .take_while(|p| independent(p) >= MIN_INDEPENDENT_DIFFERENCES)
+        .count();
+    let any_reliable = reliable_end > 0;
+    let end = if any_reliable {
+        reliable_end
+    } else {
+        curve.len()
+    };
+    // Past the initial rise (a resonator's or filter's roll-off) and the settling time.
+    // (A NaN slope, of a curve of zeros, is no rise.)
+    let start = (0..curve.len() - 1)
+        .find(|&i| {
+            curve[i].tau_s >= settled_tau_s * (1.0 - 1e-12)
+                && slope(i, i + 1).partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater)
+        })
+        .unwrap_or(curve.len());
+
+    let (arw_deg_per_rt_h, arw_tau_s, arw_warning) = match (any_reliable, start < end) {
+        (false, _) => (
+            f64::NAN,
+            [f64::NAN; 2],
+            Some(
+                "no point of the Allan curve rests on 40 independent differences: the record is \
+                 too short to read an angle random walk",
+            ),
+        ),
+        (true, false) => (
+            f64::NAN,
+            [f64::NAN; 2],
+            Some(
+                "the Allan curve rises over all its reliable points (40 independent differences \
+                 or more): no white-noise (-1/2) region to read an angle random walk from",
+            ),
+        ),
+        (true, true) => match white_run(curve, start, end, &slope) {
+            Some((i, j, chords)) => {
+                // Each point weighted by the inverse of its error budget in ln(sigma sqrt(tau)):
+                // its variance, 1 / (2 edf) with edf no less than its independent differences,
+                // plus the square of the slope departure from -1/2 of the run's chords over it
+                // (their mean), which is about the relative bias of sigma sqrt(tau) at the
+                // run's edges (a roll-off below, a floor above).
+                let (mut sw, mut sl) = (0.0, 0.0);
+                for (k, p) in curve.iter().enumerate().take(j + 1).skip(i) {
+                    let over: Vec<f64> = chords
+                        .iter()
+                        .filter(|c| c.0 <= k && k <= c.1)
+                        .map(|c| c.2 + 0.5)
+                        .collect();
+                    let off = over.iter().sum::<f64>() / over.len().max(1) as f64;
+                    let w = 1.0 / (0.5 / independent(p) + off * off);
+                    sw += w;
+                    sl += w * (p.adev * p.tau_s.sqrt()).ln();
+                }
+                (
+                    60.0 * (sl / sw).exp(),
+                    [curve[i].tau_s, curve[j].tau_s],
+                    None,
+                )
+            }
+            None => (
+                f64::NAN,
+                [f64::NAN; 2],
+                Some(
+                    "no half decade of the reliable Allan curve (40 independent differences \
+                     or more, past its initial rise) follows the -1/2 slope within 0.1: no \
+                     white-noise region to read an angle random walk from",
+                ),
+            ),
+        },
+    };
+
+    let (bias_instability_deg_per_h, tau_at_min_s, bias_instability_warning) =
+        match flat_minimum(&curve[start.min(end)..end]) {
+            None if any_reliable => (
+                f64::NAN,
+                f64::NAN,
+                Some(
+                    "the Allan curve rises over all its reliable points (40 independent \
+                     differences or more): no floor to read a bias instability from",
+                ),
+            ),
+            None => (
+                f64::NAN,
+                f64::NAN,
+                Some(
+                    "the Allan curve rises over all its points, none of which rests on 40 \
+                     independent differences: no floor to read a bias instability from",
+                ),
+            ),
+            Some((floor, tau_min)) => {
+                let warning = if !any_reliable {
+                    Some(
+                        "no point of the Allan curve rests on 40 independent differences: the \
+                         bias instability is the minimum of scattered points and may read low",
+                    )
+                } else if start == 0
+                    && settled_tau_s <= tau0
+                    && (tau_min / tau0).log10() < FIRST_POINTS_DECADES
+                {
+                    Some(
+                        "the Allan minimum lies within half a decade of the curve's first \
+                         point, where a resonator's or filter's settling may still roll the \
+                         curve off: the bias instability is unreliable and may read low",
+                    )
+                } else if still_falling(curve, start, end, tau_min) {
+                    Some(
+                        "the Allan curve still falls at its last reliable point (40 \
+                         independent differences): no flat floor was reached, the bias \
+                         instability is only an upper bound",
+                    )
+                } else {
+                    None
+                };
+                (floor / ADEV_PER_BIAS_INSTABILITY * 3600.0, tau_min, warning)
+            }
+        };
     Some(NoiseReadings {
-        arw_deg_per_rt_h: 60.0 * n_coef,
-        bias_instability_deg_per_h: floor / ADEV_PER_BIAS_INSTABILITY * 3600.0,
+        arw_deg_per_rt_h,
+        arw_tau_s,
+        arw_warning,
+        bias_instability_deg_per_h,
         tau_at_min_s,
+        bias_instability_warning,
     })
 }
 
-/// The flat minimum of a curve and where it lies: see [`noise_readings`].
-fn flat_minimum(curve: &[AllanPoint]) -> Option<(f64, f64)> {
-    let tau0 = curve.first()?.tau_s;
-    let reliable: Vec<&AllanPoint> = curve
-        .iter()
-        .filter(|p| p.n_terms as f64 * tau0 / p.tau_s >= MIN_INDEPENDENT_DIFFERENCES)
-        .collect();
-    let pts: Vec<&AllanPoint> = if reliable.is_empty() {
-        curve.iter().collect()
-    } else {
-        reliable
+/// A chord of the curve: first and last point, slope.
+type Chord = (usize, usize, f64);
+
+/// The lowest-tau white region among the points `start..end`: the consecutive chords (from
+/// each point to the first a quarter decade on, [`ARW_CHORD_DECADES`]) whose slopes lie within
+/// [`ARW_SLOPE_TOLERANCE`] of -1/2, together spanning [`MIN_ARW_SPAN_DECADES`]. Returns its
+/// first and last point and its chords.
+fn white_run(
+    curve: &[AllanPoint],
+    start: usize,
+    end: usize,
+    slope: &dyn Fn(usize, usize) -> f64,
+) -> Option<(usize, usize, Vec<Chord>)> {
+    let chord = |i: usize| -> Option<Chord> {
+        let j = (i + 1..end)
+            .find(|&j| (curve[j].tau_s / curve[i].tau_s).log10() >= ARW_CHORD_DECADES - 1e-9)?;
+        Some((i, j, slope(i, j)))
     };
+    let white = |c: &Chord| (c.2 + 0.5).abs() < ARW_SLOPE_TOLERANCE;
+    let mut run: Vec<Chord> = Vec::new();
+    for i in start..end {
+        match chord(i).filter(white) {
+            Some(c) => run.push(c),
+            None => run.clear(),
+        }
+        if let (Some(first), Some(last)) = (run.first(), run.last()) {
+            let (a, b) = (first.0, last.1);
+            let next_white = chord(i + 1).filter(white).is_some();
+            if !next_white
+                && (curve[b].tau_s / curve[a].tau_s).log10() >= MIN_ARW_SPAN_DECADES - 1e-9
+            {
+                return Some((a, b, run));
+            }
+        }
+    }
+    None
+}
+
+/// Whether a minimum at `tau_min` is the last point of `start..end` on a curve still falling
+/// there: its slope over the last half decade (at least from the point before) below
+/// [`STILL_FALLING_SLOPE`].
+fn still_falling(curve: &[AllanPoint], start: usize, end: usize, tau_min: f64) -> bool {
+    let last = end - 1;
+    if tau_min < curve[last].tau_s || last == start {
+        return false;
+    }
+    let from = (start..last)
+        .find(|&k| (curve[last].tau_s / curve[k].tau_s).log10() <= 0.5 + 1e-9)
+        .unwrap_or(last - 1);
+    let (a, b) = (curve[from], curve[last]);
+    (b.adev.ln() - a.adev.ln()) / (b.tau_s.ln() - a.tau_s.ln()) < STILL_FALLING_SLOPE
+}
+
+/// The flat minimum of `pts` and where it lies: sigma^2 smoothed over +-1/8 decade of tau
+/// (see [`noise_readings_settled`]). `None` for no point.
+fn flat_minimum(pts: &[AllanPoint]) -> Option<(f64, f64)> {
     pts.iter()
         .map(|p| {
             let near: Vec<f64> = pts
@@ -225,6 +436,9 @@ mod tests {
         // N = s sqrt(tau0) deg/s*sqrt(s): ARW = 60 N.
         let n_expected = s * 0.01f64.sqrt();
         assert!((r.arw_deg_per_rt_h / (60.0 * n_expected) - 1.0).abs() < 0.03);
+        assert_eq!((r.arw_tau_s[0], r.arw_warning), (0.01, None));
+        // The curve never flattens: its minimum only bounds a bias instability, and says so.
+        assert!(r.bias_instability_warning.is_some());
     }
 
     #[test]
@@ -253,6 +467,7 @@ mod tests {
         assert!(
             (r.bias_instability_deg_per_h / 3600.0 * ADEV_PER_BIAS_INSTABILITY - 2.0).abs() < 1e-12
         );
+        assert_eq!(r.bias_instability_warning, None);
         assert!(
             r.tau_at_min_s >= 10.0 && r.tau_at_min_s <= 200.0,
             "{}",
@@ -267,6 +482,9 @@ mod tests {
         assert!(
             (r.bias_instability_deg_per_h / 3600.0 * ADEV_PER_BIAS_INSTABILITY - 0.5).abs() < 1e-12
         );
+        // ... flagged, and no ARW read from such points.
+        assert!(r.bias_instability_warning.is_some());
+        assert!(r.arw_deg_per_rt_h.is_nan() && r.arw_warning.is_some());
     }
 
     #[test]

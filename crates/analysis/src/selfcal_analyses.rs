@@ -2,7 +2,7 @@
 //! the Allan deviation of the zero-rate phase output, the self-calibration error against the
 //! averaging time (one long rotating run read at checkpoints), and a temperature drift.
 
-use crate::allan::{noise_readings, overlapping_adev, AllanPoint, NoiseReadings};
+use crate::allan::{noise_readings_settled, overlapping_adev, AllanPoint, NoiseReadings};
 use crate::selfcal::{drifted, linearised_slope, run_selfcal_core, sweep_configs};
 use crate::selfcal_combined::combined_slope;
 use gyroemu_board::{lane_groups, max_lanes, GroupBoard, LaneResult, Point, RunOptions};
@@ -35,6 +35,26 @@ pub struct AllanResult {
     pub readings: Option<NoiseReadings>,
     /// The scale factor used, deg of phase per deg/s.
     pub scale_deg_per_dps: f64,
+}
+
+impl AllanResult {
+    /// Why a reading is absent, only a bound, or unreliable: one line each, for the run's
+    /// warnings (a null in `selfcal.json` alone is easy to miss).
+    pub fn warnings(&self) -> Vec<String> {
+        let Some(r) = self.readings else {
+            return vec!["Allan deviation: too few points for any reading".into()];
+        };
+        let mut w = Vec::new();
+        if let Some(why) = r.arw_warning {
+            w.push(format!(
+                "Allan deviation: angle random walk not read: {why}"
+            ));
+        }
+        if let Some(why) = r.bias_instability_warning {
+            w.push(format!("Allan deviation: bias instability: {why}"));
+        }
+        w
+    }
 }
 
 /// Runs `record_s` of the board at zero rate (Coriolis drive) on four streams and reads the
@@ -114,7 +134,8 @@ pub fn allan_analysis(
     Ok(AllanResult {
         tau0_s: tau0,
         record_s: n_avg as f64 / fs_out,
-        readings: noise_readings(&rate),
+        // Below ten mechanical time constants the resonator still rolls the curve off.
+        readings: noise_readings_settled(&rate, 10.0 * cor.slowest_tau_s()),
         phase_deg: phase,
         rate_dps: rate,
         scale_deg_per_dps,

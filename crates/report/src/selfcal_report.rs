@@ -107,7 +107,7 @@ fn write_selfcal_files(
             "coriolis": health_json(&core.coriolis.health),
         },
         "problems": core.rotating.problems.iter().chain(&core.coriolis.problems).collect::<Vec<_>>(),
-        "warnings": core.rotating.warnings.iter().chain(&core.coriolis.warnings).collect::<Vec<_>>(),
+        "warnings": core.rotating.warnings.iter().cloned().chain(core.coriolis.warnings.iter().cloned()).chain(allan.iter().flat_map(|a| a.warnings())).collect::<Vec<_>>(),
         "allan": allan,
         "error_vs_averaging_time": taus,
         "drift": drift,
@@ -289,10 +289,19 @@ fn log_series(name: &str, style: SeriesStyle, pts: &[AllanPoint], scale: f64) ->
 }
 
 fn allan_figure(a: &AllanResult) -> Figure {
+    // A reading that could not be taken says so instead of printing NaN.
+    let read = |v: f64, unit: &str| {
+        if v.is_finite() {
+            format!("{v:.3e} {unit}")
+        } else {
+            "not read (see warnings)".to_string()
+        }
+    };
     let title = match a.readings {
         Some(r) => format!(
-            "Allan deviation at zero rate: ARW {:.3e} deg/sqrt(h), bias instability {:.3e} deg/h",
-            r.arw_deg_per_rt_h, r.bias_instability_deg_per_h
+            "Allan deviation at zero rate: ARW {}, bias instability {}",
+            read(r.arw_deg_per_rt_h, "deg/sqrt(h)"),
+            read(r.bias_instability_deg_per_h, "deg/h")
         ),
         None => "Allan deviation at zero rate".to_string(),
     };
@@ -305,7 +314,7 @@ fn allan_figure(a: &AllanResult) -> Figure {
             &a.rate_dps,
             3600.0,
         ));
-    if let Some(r) = a.readings {
+    if let Some(r) = a.readings.filter(|r| r.arw_deg_per_rt_h.is_finite()) {
         // The -1/2 line of the ARW reading: sigma = N / sqrt(tau), N = ARW / 60 deg/s*sqrt(s).
         let n = r.arw_deg_per_rt_h / 60.0;
         let ends: Vec<f64> = [a.rate_dps[0].tau_s, a.rate_dps[a.rate_dps.len() - 1].tau_s].into();

@@ -41,12 +41,15 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
             names.join(", ")
         );
     }
+    let allan = report.allan.iter().flat_map(|a| a.warnings());
     for w in report
         .core
         .rotating
         .warnings
         .iter()
-        .chain(&report.core.coriolis.warnings)
+        .cloned()
+        .chain(report.core.coriolis.warnings.iter().cloned())
+        .chain(allan)
     {
         eprintln!("warning: {w}");
     }
