@@ -87,6 +87,29 @@ fn the_pll_locks_the_carrier_where_the_chain_phase_says_resonance() {
 }
 
 #[test]
+fn the_pll_locks_onto_mode_2_through_the_phase_shifter() {
+    // Mode 2 sits 2 Hz above mode 1 (Q 1950) and is driven through a shifter 0.5 deg off
+    // quadrature: its phasor lags mode 1's by 90.5 deg. The lock must land on mode 2's own
+    // resonance (it used to run off downwards, seeking +90 deg).
+    let mut base = fork();
+    base.device.mode2_f0_offset_hz = 2.0;
+    base.device.q_mode2 = Some(1950.0);
+    base.board.phase_shifter_error_deg = 0.5;
+    let f2 = 15e3 + 2.0;
+    let half_bw = f2 / (2.0 * 1950.0);
+    let mut c = with_pll(base, 2.0 + 3.0 * half_bw);
+    c.pll.as_mut().unwrap().mode = 2;
+    c.validate().unwrap();
+    let lock = lock_config_carrier(&c, &c).unwrap().unwrap();
+    assert_eq!(lock.resonance_hz, f2);
+    assert!(
+        (lock.carrier_hz - f2).abs() < 2e-3 * half_bw,
+        "locked {} Hz, mode 2 resonates at {f2} Hz",
+        lock.carrier_hz
+    );
+}
+
+#[test]
 fn a_sweep_with_a_pll_reads_like_a_tuned_board() {
     // Started 4 half-bandwidths off, open loop would read a fifth of the tuned slope (see
     // detuned_carrier.rs); locked, the phases are the tuned board's to 1e-3 of their size.

@@ -28,7 +28,8 @@ pub struct CarrierLock {
 /// The PLL that `design` (the config whose `[pll]`, device and board define the loop) puts on
 /// the board of `cfg`: its nominal carrier `cfg`'s, its update rate the decimated rate, its
 /// gains from the locked mode's nominal tau, its phase offset the chain's phase at the carrier
-/// (the DAC hold and the TIA: the velocity is in phase with the force at resonance), limits
+/// (the DAC hold and the TIA: the velocity is in phase with the force at resonance; for mode 2
+/// also the phase shifter's lag), limits
 /// of a fifth of the carrier either side. `None` without a `[pll]`.
 pub fn pll_params(cfg: &Config, design: &Config) -> ParamResult<Option<PllParams>> {
     let Some(pll) = &design.pll else {
@@ -52,7 +53,15 @@ pub fn pll_params(cfg: &Config, design: &Config) -> ParamResult<Option<PllParams
         pll.damping,
         PllParams::tau_s_of(f0, q),
     );
-    p.phase_offset_rad = (chain.dac_hold(fc) * chain.tia(fc)).arg();
+    // Mode 2 is driven through the phase shifter, F2 cos(w t - 90 deg - error): at its
+    // resonance its phasor lags mode 1's by that shift (without it the loop sought +90 deg
+    // and ran off the resonance).
+    let shift = if pll.mode == 2 {
+        (90.0 + cfg.board.phase_shifter_error_deg).to_radians()
+    } else {
+        0.0
+    };
+    p.phase_offset_rad = (chain.dac_hold(fc) * chain.tia(fc)).arg() - shift;
     p.lowpass_delay_s = lowpass.latency_samples() / cfg.fs_hz();
     p.min_hz = Some(0.8 * fc);
     p.max_hz = Some((1.2 * fc).min(0.49 * cfg.fs_hz()));
