@@ -17,9 +17,11 @@ pub enum RunError {
     /// Stopped by Ctrl-C or SIGTERM after saving the finished points: rerun to resume.
     #[error("{0}")]
     Interrupted(String),
-    /// The emulation failed after validation (e.g. the chain overflowed).
+    /// The emulation failed after validation (e.g. the chain overflowed). Its text is in the
+    /// message, so it is not also the error's `source()` (a chain printer such as anyhow's
+    /// `{:#}` would print it twice).
     #[error("emulation failed: {0}")]
-    Sweep(#[from] SweepError),
+    Sweep(SweepError),
     /// Writing the outputs failed, or they hold numbers that cannot be trusted
     /// ([`ReportError::Unreliable`]: written as null, the run exits non-zero).
     #[error(transparent)]
@@ -33,19 +35,57 @@ pub enum RunError {
         why: String,
     },
     /// A file of the output folder could not be read, written or removed.
-    #[error("{context}: {source}")]
+    #[error("{context}: {reason}")]
     Io {
         /// What was being done, with the path.
         context: String,
-        /// The system's reason.
-        source: std::io::Error,
+        /// The system's reason: in the message, so not the error's `source()` (not named
+        /// `source`, which would make it one and print it twice in a chain).
+        reason: std::io::Error,
     },
+}
+
+impl From<SweepError> for RunError {
+    fn from(e: SweepError) -> Self {
+        RunError::Sweep(e)
+    }
 }
 
 impl RunError {
     /// A file-system failure while doing `context`.
     pub(crate) fn io(context: impl Into<String>) -> impl FnOnce(std::io::Error) -> Self {
         let context = context.into();
-        move |source| RunError::Io { context, source }
+        move |reason| RunError::Io { context, reason }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The message followed by every `source()` below it, as anyhow's `{:#}` prints it.
+    fn chain(e: &dyn std::error::Error) -> String {
+        let mut text = e.to_string();
+        let mut next = e.source();
+        while let Some(s) = next {
+            text += &format!(": {s}");
+            next = s.source();
+        }
+        text
+    }
+
+    #[test]
+    fn a_chain_names_each_cause_once() {
+        let os = std::io::Error::new(std::io::ErrorKind::PermissionDenied, "Permission denied");
+        let io = RunError::io("cannot create `o/gyroemu.lock`")(os);
+        assert_eq!(
+            chain(&io),
+            "cannot create `o/gyroemu.lock`: Permission denied"
+        );
+        let sweep = RunError::from(SweepError::Output("disk full".into()));
+        assert_eq!(
+            chain(&sweep),
+            "emulation failed: writing the outputs failed: disk full"
+        );
     }
 }

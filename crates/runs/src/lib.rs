@@ -30,5 +30,5 @@ pub use lot_run::{check_lot_size, run_lot, LotOutcome, MAX_DEVICES};
 pub use manifest::RunKind;
 pub use merge::merge;
 pub use resume::{previous_devices, previous_points};
-pub use run::{prepare_out, run, RunOutcome, RunRequest};
-pub use shard::{resolve_shard, Shard};
+pub use run::{check_run, prepare_out, run, RunOutcome, RunRequest};
+pub use shard::{check_split, resolve_shard, Shard, ShardFrom};

@@ -156,11 +156,14 @@ fn acquire(path: &Path, text: &str, reporter: &dyn Reporter) -> Result<(), RunEr
         match create_with(path, text) {
             Ok(()) => return Ok(()),
             Err(e) if e.kind() == ErrorKind::AlreadyExists => {}
+            // Like `prepare_out`'s probe, a folder this command cannot write into is the
+            // user's to fix (exit 2), not a failure of the command.
             Err(e) => {
-                return Err(RunError::Io {
-                    context: format!("cannot create the lock `{}`", path.display()),
-                    source: e,
-                })
+                return Err(RunError::BadInput(format!(
+                    "output folder `{}` is not writable: cannot create the lock `{}`: {e}",
+                    out.display(),
+                    path.display()
+                )))
             }
         }
         if let Some(holder) = live_holder(path, reporter)? {
@@ -182,7 +185,7 @@ fn live_holder(path: &Path, reporter: &dyn Reporter) -> Result<Option<LockInfo>,
         Err(e) => {
             return Err(RunError::Io {
                 context: format!("cannot read the lock `{}`", path.display()),
-                source: e,
+                reason: e,
             })
         }
     };

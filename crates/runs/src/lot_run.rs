@@ -11,7 +11,7 @@ use crate::points::canonical_toml;
 use crate::records::write_record;
 use crate::resume::previous_devices;
 use crate::run::RunRequest;
-use crate::shard::Shard;
+use crate::shard::{check_split, Shard};
 use gyroemu_analysis::montecarlo::{lot_work, run_device, DeviceResult, LotSummary};
 use gyroemu_experiment::work::measured_throughput;
 use gyroemu_experiment::{Reporter, SweepError};
@@ -73,6 +73,16 @@ pub fn run_lot(
     check_lot_size(n).map_err(RunError::BadInput)?;
     let hash = lot_hash(cfg);
     let config_toml = canonical_toml(cfg);
+    if let Some(s) = &req.shard {
+        s.check_count(n, "device")?;
+    }
+    let split_warning = check_split(
+        out,
+        req.shard.as_ref(),
+        RunKind::Montecarlo,
+        &hash,
+        "device",
+    )?;
     let mine = Shard::items(req.shard.as_ref(), n);
     let prev = previous_devices(out, cfg, n, req.force, reporter)?;
     let todo: Vec<u64> = mine
@@ -106,6 +116,9 @@ pub fn run_lot(
             work.describe(Some(measured_throughput(cfg)))
         )
     });
+    if let Some(w) = split_warning {
+        reporter.warn(&w);
+    }
     let ledger = Ledger::start(
         RunKind::Montecarlo,
         &hash,

@@ -6,12 +6,13 @@
 use crate::config_diff::{config_diff_for, describe_diff};
 use crate::error::RunError;
 use crate::manifest::{read_manifest, shard_manifest_paths, Manifest, RunKind, RUN_MANIFEST};
-use crate::points::{config_hash, scan_points, PointFile};
+use crate::points::{config_hash, PointFile};
 use crate::records::{scan_records, RecordFile};
+use crate::shard::absent_shards;
 use gyroemu_config::parse_config;
 use gyroemu_experiment::{finish_sweep, resolve_lock, Reporter};
 use gyroemu_report::{check_problems, run_title, write_run};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 pub(crate) fn bad(msg: String) -> RunError {
@@ -75,6 +76,15 @@ fn read_split(dir: &Path) -> Result<Split, RunError> {
                 id.count
             )));
         }
+        // The count of the missing shards below is `count` minus those present.
+        if id.index >= id.count {
+            return Err(bad(format!(
+                "`{}` describes shard {}/{}: a shard's index is below its count",
+                p.display(),
+                id.index,
+                id.count
+            )));
+        }
         shards.push((name, m));
     }
     // One split, one kind, one config.
@@ -119,15 +129,12 @@ fn read_split(dir: &Path) -> Result<Split, RunError> {
         .into_iter()
         .filter_map(|(name, m)| m.shard.map(|s| (s.index, (name, m))))
         .collect();
-    let absent: Vec<String> = (0..count)
-        .filter(|i| !by_index.contains_key(i))
-        .map(|i| format!("{i}/{count}"))
-        .collect();
-    if !absent.is_empty() {
+    // `count` comes from a file: the absent shards are listed without walking 0..count.
+    let present: BTreeSet<usize> = by_index.keys().copied().collect();
+    if let Some(absent) = absent_shards(&present, count) {
         return Err(bad(format!(
-            "shard {} of `{}` missing (no shard-I-of-{count}.json): run it with --shard I/{count} \
-             --out {}",
-            absent.join(", "),
+            "shard {absent} of `{}` missing (no shard-I-of-{count}.json): run it with --shard \
+             I/{count} --out {}",
             dir.display(),
             dir.display()
         )));
@@ -324,10 +331,24 @@ fn merge_run(dir: &Path, split: Split, reporter: &dyn Reporter) -> Result<Vec<Pa
         reporter.warn(&format!("{first_name}: {w}"));
     }
     let n = cfg.emulated_rates_dps().len();
-    split.records::<PointFile>(dir, n, false)?;
-    let lanes = scan_points(dir)
-        .and_then(|s| s.lanes(&split.hash, n))
-        .map_err(bad)?;
+    let records = split.records::<PointFile>(dir, n, false)?;
+    let owner = split.owners(n)?;
+    // A damaged value is refused here (a run would recompute it): naming the shard to rerun.
+    let lanes = records
+        .into_iter()
+        .map(|(i, (p, f))| {
+            let lane = f.lane().map_err(|e| {
+                bad(format!(
+                    "`{}` does not decode ({e}): rerun its shard with --shard {}/{} to compute \
+                     point {i} again",
+                    p.display(),
+                    owner[&i],
+                    split.count
+                ))
+            })?;
+            Ok((i, lane))
+        })
+        .collect::<Result<BTreeMap<_, _>, RunError>>()?;
     // The shards swept at the carrier a [pll] locked: lock again (the same bits) to read out.
     let (held, lock) = resolve_lock(&cfg)?;
     if let Some(l) = &lock {

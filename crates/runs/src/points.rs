@@ -232,6 +232,32 @@ impl Scan<PointFile> {
     }
 }
 
+/// A point file whose data do not decode: its path and why.
+pub type Undecodable = (std::path::PathBuf, String);
+
+impl Scan<PointFile> {
+    /// Like [`Scan::lanes`], but a file whose data do not decode (a damaged value) is returned
+    /// apart instead of failing the whole scan: for a resume, which recomputes it as it does a
+    /// truncated file, where the point's shard runs (another shard just leaves it alone).
+    pub fn decodable_lanes(
+        &self,
+        hash: &str,
+        n_points: usize,
+    ) -> Result<(BTreeMap<usize, LaneResult>, Vec<Undecodable>), String> {
+        let mut lanes = BTreeMap::new();
+        let mut damaged = Vec::new();
+        for (i, (path, f)) in self.by_index(hash, n_points, false)? {
+            match f.lane() {
+                Ok(l) => {
+                    lanes.insert(i, l);
+                }
+                Err(e) => damaged.push((path.to_path_buf(), e)),
+            }
+        }
+        Ok((lanes, damaged))
+    }
+}
+
 /// Reads every `*.json` file in `out/points/` (none when the folder does not exist; hidden
 /// temporary files of an interrupted write are skipped).
 pub fn scan_points(out: &Path) -> Result<PointScan, String> {

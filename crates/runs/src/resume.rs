@@ -54,7 +54,19 @@ pub fn previous_points(
     }
     let scan = scan_points(out).map_err(RunError::BadInput)?;
     warn_bad::<PointFile>(&scan.bad, reporter);
-    scan.lanes(&id.hash, n_points).map_err(RunError::BadInput)
+    // A damaged value is a damaged file like a truncated one: recomputed by the point's own
+    // run or shard, not a refusal of every shard of the folder.
+    let (lanes, damaged) = scan
+        .decodable_lanes(&id.hash, n_points)
+        .map_err(RunError::BadInput)?;
+    for (p, why) in &damaged {
+        reporter.warn(&format!(
+            "ignoring `{}` (its data do not decode: {why}); the run or shard of that point \
+             computes it again",
+            p.display()
+        ));
+    }
+    Ok(lanes)
 }
 
 /// The devices of a previous lot in `out` for `cfg` (by its [`lot_hash`]) below `n_devices`,

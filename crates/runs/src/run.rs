@@ -9,7 +9,7 @@ use crate::ledger::Ledger;
 use crate::manifest::{manifest_path, RunKind};
 use crate::points::{canonical_toml, config_hash, scan_points, write_point, POINTS_DIR};
 use crate::resume::previous_points;
-use crate::shard::Shard;
+use crate::shard::{check_split, Shard};
 use gyroemu_board::LaneResult;
 use gyroemu_config::Config;
 use gyroemu_experiment::work::measured_throughput;
@@ -80,6 +80,34 @@ pub fn prepare_out(out: &Path) -> Result<(), RunError> {
         })
 }
 
+/// The refusals of [`run`] that need nothing computed: a shard count far above the points, a
+/// scheduler's split that disagrees with the shards already in `out` ([`check_split`]), an
+/// absurd plan without `force`. A program calls it before it creates `out`, so a refused run
+/// leaves no folder behind; `run` calls it again under the folder's lock. Returns the work of
+/// this run's share and a warning (a `--shard` of another split than `out`'s).
+pub fn check_run(
+    cfg: &Config,
+    out: &Path,
+    shard: Option<&Shard>,
+    force: bool,
+) -> Result<(Work, Option<String>), RunError> {
+    let n = cfg.emulated_rates_dps().len();
+    if let Some(s) = shard {
+        s.check_count(n, "point")?;
+    }
+    let mine = shard.map_or(n, |s| s.points(n).len());
+    // Refuse an absurd run unless forced.
+    let whole = sweep_work(cfg);
+    let share = Work {
+        points: mine,
+        point_samples: (whole.point_samples as f64 * mine as f64 / n as f64) as u64,
+        ..whole
+    };
+    share.check_cap(force).map_err(RunError::BadInput)?;
+    let warning = check_split(out, shard, RunKind::Run, &config_hash(cfg), "point")?;
+    Ok((share, warning))
+}
+
 /// Runs the points of `req` not yet saved in `req.out`, saving each as it finishes; then (a
 /// whole sweep) writes the results. The manifest ends `complete`, `interrupted` or `failed`
 /// (with the cause in `next`), also when writing the results fails.
@@ -90,15 +118,12 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     let rates = cfg.emulated_rates_dps();
     let n = rates.len();
     let mine = Shard::items(req.shard.as_ref(), n);
-    // Say what this will cost before anything runs; refuse an absurd run unless forced.
-    let whole = sweep_work(cfg);
-    let share = Work {
-        points: mine.len(),
-        point_samples: (whole.point_samples as f64 * mine.len() as f64 / n as f64) as u64,
-        ..whole
-    };
-    share.check_cap(req.force).map_err(RunError::BadInput)?;
+    // Say what this will cost before anything runs.
+    let (share, split_warning) = check_run(cfg, out, req.shard.as_ref(), req.force)?;
     reporter.note(&share.describe(Some(measured_throughput(cfg))));
+    if let Some(w) = split_warning {
+        reporter.warn(&w);
+    }
     let manifest_path = manifest_path(out, req.shard.as_ref());
     let mut prev = previous_points(out, cfg, n, req.force, reporter)?;
     let owns_dump = req.shard.is_none() || dump_point(cfg).is_some_and(|i| mine.contains(&i));
@@ -174,7 +199,8 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
             // What finished is saved; the manifest says the rest is missing.
             let done = scan_points(out)
                 .ok()
-                .and_then(|s| s.lanes(&hash, n).ok())
+                .and_then(|s| s.decodable_lanes(&hash, n).ok())
+                .map(|(lanes, _)| lanes)
                 .unwrap_or_default();
             return Err(ledger.fail(e.into(), &done));
         }

@@ -1,0 +1,376 @@
+//! Splits as a library: a scheduler's split that the output folder contradicts (a Slurm task
+//! resubmitted alone, an array of another size) is refused before anything is computed or
+//! written, naming both splits and the `--shard` to give, and the shard given that way merges
+//! to the one-machine bytes; a shard count far past the items is refused; merge lists a huge
+//! split's missing shards briefly; a point file with a damaged value is recomputed by its own
+//! shard and blocks no other, while merge refuses it naming that shard; a folder the lock
+//! cannot be created in is refused as bad input naming the folder.
+
+mod common;
+
+use common::*;
+use gyroemu_config::presets::preset;
+use gyroemu_config::{parse_config, Config};
+use gyroemu_experiment::Quiet;
+use gyroemu_runs::shard::parse_shard;
+use gyroemu_runs::{
+    lock_out, merge, prepare_out, resolve_shard, run, run_lot, LockScope, RunError, RunOutcome,
+    RunRequest, Shard,
+};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+/// A Coriolis sweep with noise (each point's random stream matters): ten points.
+const NOISY: &str = r#"
+[device]
+f0_hz = 15000.0
+q = 1000.0
+angular_gain = 1.0
+[drive]
+f1 = 1.0
+f2 = 1.0
+[board]
+fs_hz = 240000.0
+lpf_cutoff_hz = 200.0
+decimation = 100
+adc_bits = 14
+adc_full_scale_v = 0.1
+[experiment]
+kind = "coriolis"
+rates_dps = [25.0, 50.0, 75.0, 100.0, 125.0, 150.0, 175.0, 200.0, 225.0]
+average_s = 0.2
+settle_s = 0.05
+[noise]
+seed = 7
+effective_mass_kg = 1e-9
+tia_current_noise_a_per_rthz = 1e-13
+tia_voltage_noise_v_per_rthz = 2e-8
+"#;
+
+fn config() -> Config {
+    let c = parse_config(NOISY).unwrap();
+    c.validate().unwrap();
+    c
+}
+
+/// Runs `cfg` (shard `shard`) into `out`; returns the outcome and what the run reported.
+fn run_shard(
+    cfg: &Config,
+    out: &Path,
+    shard: Option<Shard>,
+) -> (Result<RunOutcome, RunError>, String) {
+    prepare_out(out).unwrap();
+    let req = RunRequest {
+        config: cfg,
+        out,
+        shard,
+        force: false,
+        cancel: Arc::new(AtomicBool::new(false)),
+        on_saved: None,
+    };
+    let rec = Record::default();
+    let r = run(&req, &rec);
+    (r, rec.0.into_inner().unwrap().join("\n"))
+}
+
+/// The shard a Slurm array task gets from its variables (no `--shard`).
+fn slurm(id: &str, min: &str, max: &str, count: &str) -> Shard {
+    let vars: BTreeMap<&str, &str> = [
+        ("SLURM_ARRAY_TASK_ID", id),
+        ("SLURM_ARRAY_TASK_MIN", min),
+        ("SLURM_ARRAY_TASK_MAX", max),
+        ("SLURM_ARRAY_TASK_COUNT", count),
+        ("SLURM_ARRAY_TASK_STEP", "1"),
+    ]
+    .into();
+    let env = |k: &str| vars.get(k).map(|v| v.to_string());
+    resolve_shard(None, None, &env).unwrap().unwrap()
+}
+
+fn refusal(r: Result<RunOutcome, RunError>) -> String {
+    match r {
+        Err(RunError::BadInput(m)) => m,
+        other => panic!("not refused: {other:?}"),
+    }
+}
+
+/// Every file of a folder with its bytes, by path inside it.
+fn tree(out: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut files = BTreeMap::new();
+    let mut dirs = vec![out.to_path_buf()];
+    while let Some(d) = dirs.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                dirs.push(p);
+            } else {
+                files.insert(
+                    p.strip_prefix(out).unwrap().to_path_buf(),
+                    std::fs::read(&p).unwrap(),
+                );
+            }
+        }
+    }
+    files
+}
+
+fn assert_same_results(a: &Path, b: &Path) {
+    for f in gyroemu_report::RUN_FILES {
+        let (x, y) = (
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+        );
+        assert!(x == y, "{f} differs");
+    }
+}
+
+#[test]
+fn a_resubmitted_slurm_task_is_refused_and_its_shard_given_merges() {
+    let cfg = config();
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole");
+    run_shard(&cfg, &whole, None).0.unwrap();
+    // An array 0-3 whose task 2 did not finish.
+    let out = dir.path().join("sl");
+    for id in ["0", "1", "3"] {
+        run_shard(&cfg, &out, Some(slurm(id, "0", "3", "4")))
+            .0
+            .unwrap();
+    }
+    let before = tree(&out);
+
+    // `sbatch --array=2`: before, shard 0/1 of the same points, unmergeable beside the rest.
+    let m = refusal(run_shard(&cfg, &out, Some(slurm("2", "2", "2", "1"))).0);
+    for needle in [
+        "SLURM_ARRAY_TASK_ID = 2",
+        "shard 0/1",
+        "split into 4",
+        "not complete there: 2/4",
+        "--shard 2/4",
+    ] {
+        assert!(m.contains(needle), "`{needle}` missing from: {m}");
+    }
+    // A resubmitted pair (`--array=2,3`) is a whole array of 2: it contradicts the folder.
+    let m = refusal(run_shard(&cfg, &out, Some(slurm("2", "2", "3", "2"))).0);
+    for needle in [
+        "shard 0/2",
+        "split into 4",
+        "--shard 2/4",
+        "delete the shard-I-of-N.json",
+    ] {
+        assert!(m.contains(needle), "`{needle}` missing from: {m}");
+    }
+    assert!(tree(&out) == before, "a refused task wrote into the folder");
+
+    // Given as the refusal says, it runs its own shard and the split merges.
+    run_shard(&cfg, &out, Some(parse_shard("2/4").unwrap()))
+        .0
+        .unwrap();
+    merge(&out, &Quiet).unwrap();
+    assert_same_results(&whole, &out);
+
+    // A `--shard` the user wrote is obeyed, with a warning that merge needs one split.
+    let (r, notes) = run_shard(&cfg, &out, Some(parse_shard("0/3").unwrap()));
+    r.unwrap();
+    assert!(
+        notes.contains("warning: ") && notes.contains("split into 4"),
+        "{notes}"
+    );
+
+    // A lone Slurm task in a folder without a split is refused too: it would run every point
+    // as a split of one.
+    let fresh = dir.path().join("fresh");
+    let m = refusal(run_shard(&cfg, &fresh, Some(slurm("5", "5", "5", "1"))).0);
+    assert!(
+        m.contains("only task of its job array") && m.contains("--shard 5/N"),
+        "{m}"
+    );
+    assert!(tree(&fresh).is_empty());
+}
+
+#[test]
+fn a_lot_checks_its_split_against_the_folder_too() {
+    let mut cfg = preset("m2tfg-montecarlo").unwrap();
+    cfg.device.q = 200.0;
+    cfg.experiment.rates_dps = vec![900.0, 1800.0, 2700.0];
+    cfg.experiment.average_s = 0.2;
+    cfg.experiment.settle_s = Some(0.1);
+    cfg.validate().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("lot");
+    prepare_out(&out).unwrap();
+    let lot = |shard: Shard| {
+        let req = RunRequest {
+            config: &cfg,
+            out: &out,
+            shard: Some(shard),
+            force: false,
+            cancel: Arc::new(AtomicBool::new(false)),
+            on_saved: None,
+        };
+        run_lot(&req, 4, &Quiet)
+    };
+    lot(parse_shard("1/3").unwrap()).unwrap();
+    let before = tree(&out);
+    let Err(RunError::BadInput(m)) = lot(slurm("2", "2", "2", "1")) else {
+        panic!("a lone task of a lot accepted");
+    };
+    assert!(
+        m.contains("split into 3") && m.contains("--shard 2/3"),
+        "{m}"
+    );
+    let Err(RunError::BadInput(m)) = lot(parse_shard("0/2000").unwrap()) else {
+        panic!("2000 shards of 4 devices accepted");
+    };
+    assert!(m.contains("2000 shards of 4 devices"), "{m}");
+    assert!(tree(&out) == before, "a refused lot wrote into the folder");
+}
+
+#[test]
+fn a_shard_count_far_past_the_points_is_refused_before_anything() {
+    let cfg = config();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("huge");
+    for text in ["1/1000000", "0/9223372036854775807"] {
+        let m = refusal(run_shard(&cfg, &out, Some(parse_shard(text).unwrap())).0);
+        assert!(m.contains(text) && m.contains("of 10 points"), "{m}");
+    }
+    assert!(tree(&out).is_empty());
+    // A uniform array larger than the sweep: its empty shards merge.
+    let sparse = dir.path().join("sparse");
+    for i in 0..12 {
+        run_shard(
+            &cfg,
+            &sparse,
+            Some(parse_shard(&format!("{i}/12")).unwrap()),
+        )
+        .0
+        .unwrap();
+    }
+    merge(&sparse, &Quiet).unwrap();
+}
+
+/// Merge's refusal of `dir`.
+fn merge_refusal(dir: &Path) -> String {
+    match merge(dir, &Quiet) {
+        Err(RunError::BadInput(m)) => m,
+        other => panic!("merge not refused: {other:?}"),
+    }
+}
+
+#[test]
+fn merge_lists_the_missing_shards_of_a_huge_split_briefly() {
+    let cfg = config();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("two");
+    for s in ["0/2", "1/2"] {
+        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
+            .0
+            .unwrap();
+    }
+    // A manifest edited (or written by an older gyroemu) to claim a huge split: before, merge
+    // built a line naming each of its missing shards (16 MB for a million; without end for
+    // the largest).
+    let shard1 = json(&out.join("shard-1-of-2.json"));
+    std::fs::remove_file(out.join("shard-0-of-2.json")).unwrap();
+    std::fs::remove_file(out.join("shard-1-of-2.json")).unwrap();
+    for count in [1_000_000u64, u64::MAX] {
+        let mut m = shard1.clone();
+        m["shard"]["count"] = count.into();
+        let name = out.join(format!("shard-1-of-{count}.json"));
+        std::fs::write(&name, serde_json::to_string(&m).unwrap()).unwrap();
+        let e = merge_refusal(&out);
+        assert!(e.len() < 600, "{} bytes", e.len());
+        let more = format!("and {} more", count - 6);
+        assert!(
+            e.contains(&format!("0/{count}, 2/{count}")) && e.contains(&more),
+            "{e}"
+        );
+        std::fs::remove_file(&name).unwrap();
+    }
+    // An index at or past its count.
+    let mut m = shard1.clone();
+    m["shard"]["index"] = 5.into();
+    std::fs::write(
+        out.join("shard-5-of-2.json"),
+        serde_json::to_string(&m).unwrap(),
+    )
+    .unwrap();
+    let e = merge_refusal(&out);
+    assert!(
+        e.contains("shard-5-of-2.json") && e.contains("below its count"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_damaged_point_file_is_recomputed_by_its_shard_and_blocks_no_other() {
+    let cfg = config();
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole");
+    run_shard(&cfg, &whole, None).0.unwrap();
+    let out = dir.path().join("c2");
+    for s in ["0/2", "1/2"] {
+        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
+            .0
+            .unwrap();
+    }
+    let p3 = out.join("points/point-3.json");
+    let mut f = json(&p3);
+    f["z"][0] = "xyz".into();
+    std::fs::write(&p3, serde_json::to_string_pretty(&f).unwrap()).unwrap();
+    let damaged = std::fs::read(&p3).unwrap();
+
+    // Shard 0 does not own point 3: before, it was refused over it.
+    let (r, notes) = run_shard(&cfg, &out, Some(parse_shard("0/2").unwrap()));
+    r.unwrap();
+    assert!(
+        notes.contains("point-3.json") && notes.contains("xyz"),
+        "{notes}"
+    );
+    assert_eq!(
+        std::fs::read(&p3).unwrap(),
+        damaged,
+        "not shard 0's to rewrite"
+    );
+
+    let e = merge_refusal(&out);
+    assert!(
+        e.contains("point-3.json") && e.contains("--shard 1/2"),
+        "{e}"
+    );
+
+    // Its own shard computes it again; then the split merges to the one-machine bytes.
+    let (r, notes) = run_shard(&cfg, &out, Some(parse_shard("1/2").unwrap()));
+    r.unwrap();
+    assert!(notes.contains("point-3.json"), "{notes}");
+    assert_eq!(
+        std::fs::read(&p3).unwrap(),
+        std::fs::read(whole.join("points/point-3.json")).unwrap()
+    );
+    merge(&out, &Quiet).unwrap();
+    assert_same_results(&whole, &out);
+}
+
+#[test]
+fn a_folder_the_lock_cannot_be_created_in_is_bad_input_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    std::fs::create_dir(&out).unwrap();
+    // The lock is first written under this temporary name: a folder there makes the write
+    // fail whoever runs the test (root ignores permission bits).
+    let tmp = out.join(format!(".gyroemu.lock.{}.tmp", std::process::id()));
+    std::fs::create_dir(&tmp).unwrap();
+    match lock_out(&out, "gyroemu merge o", LockScope::Folder, &Quiet) {
+        Err(RunError::BadInput(m)) => {
+            assert!(
+                m.contains(&format!("output folder `{}`", out.display())),
+                "{m}"
+            );
+            assert!(m.contains("gyroemu.lock"), "{m}");
+        }
+        other => panic!("not bad input: {other:?}"),
+    }
+}
