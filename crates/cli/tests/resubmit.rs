@@ -166,3 +166,33 @@ fn merge_into_a_folder_it_cannot_write_is_bad_input_said_once() {
     // Before, exit 1 with the system's reason twice (in the message and as its source).
     assert_eq!(stderr(&o).matches("os error").count(), 1, "{}", stderr(&o));
 }
+
+#[test]
+fn a_refused_lot_leaves_no_output_folder() {
+    // The lot's shard count and split are checked before its folder is created, as `run`'s.
+    let dir = tempfile::tempdir().unwrap();
+    let preset = gyroemu(&["config", "--preset", "m2tfg-montecarlo"], &[]);
+    let cfg = config(
+        dir.path(),
+        "lot.toml",
+        &String::from_utf8_lossy(&preset.stdout),
+    );
+    let lot = |out: &Path, extra: &[&str], env: &[(&str, &str)]| {
+        let mut args = vec!["--threads", "1", "montecarlo", s(&cfg), "--devices", "10"];
+        args.extend(["--out", s(out)]);
+        args.extend(extra);
+        gyroemu(&args, env)
+    };
+    let out = dir.path().join("huge");
+    refused(
+        &lot(&out, &["--shard", "0/5000"], &[]),
+        &["5000 shards of 10 devices"],
+    );
+    assert!(!out.exists(), "`{}` created", out.display());
+    let out = dir.path().join("lone");
+    refused(
+        &lot(&out, &[], &slurm("5", "5", "5", "1")),
+        &["only task of its job array"],
+    );
+    assert!(!out.exists(), "`{}` created", out.display());
+}

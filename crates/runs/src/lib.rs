@@ -26,7 +26,7 @@ pub use config_diff::{config_diff, config_diff_for};
 pub use dumps::dump_files;
 pub use error::RunError;
 pub use lock::{lock_out, utc_text, LockInfo, LockScope, OutLock, LOCK_FILE};
-pub use lot_run::{check_lot_size, run_lot, LotOutcome, MAX_DEVICES};
+pub use lot_run::{check_lot, check_lot_size, run_lot, LotOutcome, MAX_DEVICES};
 pub use manifest::RunKind;
 pub use merge::merge;
 pub use resume::{previous_devices, previous_points};

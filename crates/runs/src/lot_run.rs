@@ -13,12 +13,13 @@ use crate::resume::previous_devices;
 use crate::run::RunRequest;
 use crate::shard::{check_split, Shard};
 use gyroemu_analysis::montecarlo::{lot_work, run_device, DeviceResult, LotSummary};
+use gyroemu_config::Config;
 use gyroemu_experiment::work::measured_throughput;
 use gyroemu_experiment::{Reporter, SweepError};
 use gyroemu_report::{write_lot, ReportError};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
@@ -56,6 +57,22 @@ pub fn check_lot_size(n: usize) -> Result<(), String> {
     Ok(())
 }
 
+/// The lot's size, its shard count and its split against the folder's shards, checked
+/// before the folder is created or locked (so a refusal leaves nothing behind); the split's
+/// warning, if any (see [`check_split`]).
+pub fn check_lot(
+    cfg: &Config,
+    out: &Path,
+    shard: Option<&Shard>,
+    n: usize,
+) -> Result<Option<String>, RunError> {
+    check_lot_size(n).map_err(RunError::BadInput)?;
+    if let Some(s) = shard {
+        s.check_count(n, "device")?;
+    }
+    check_split(out, shard, RunKind::Montecarlo, &lot_hash(cfg), "device")
+}
+
 /// Runs the devices of the lot of `n` devices of `req` not yet saved in `req.out`, saving
 /// each as it finishes; then (a whole lot) writes its files. The manifest ends `complete`,
 /// `interrupted` or `failed` (with the cause in `next`).
@@ -70,19 +87,9 @@ pub fn run_lot(
             "the config has no [montecarlo] section: a lot draws its devices from it".into(),
         ));
     }
-    check_lot_size(n).map_err(RunError::BadInput)?;
+    let split_warning = check_lot(cfg, out, req.shard.as_ref(), n)?;
     let hash = lot_hash(cfg);
     let config_toml = canonical_toml(cfg);
-    if let Some(s) = &req.shard {
-        s.check_count(n, "device")?;
-    }
-    let split_warning = check_split(
-        out,
-        req.shard.as_ref(),
-        RunKind::Montecarlo,
-        &hash,
-        "device",
-    )?;
     let mine = Shard::items(req.shard.as_ref(), n);
     let prev = previous_devices(out, cfg, n, req.force, reporter)?;
     let todo: Vec<u64> = mine

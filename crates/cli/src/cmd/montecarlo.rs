@@ -9,7 +9,7 @@ use gyroemu_analysis::montecarlo::{
     device_config, draw_device, validate_lot, validate_lot_capped, LotRefusal, LotSummary,
 };
 use gyroemu_runs::shard::Shard;
-use gyroemu_runs::{check_lot_size, run_lot, LotOutcome, RunRequest};
+use gyroemu_runs::{check_lot, run_lot, LotOutcome, RunRequest};
 use std::path::Path;
 
 /// The arguments of `gyroemu montecarlo`.
@@ -45,8 +45,9 @@ pub fn montecarlo_command(a: &MonteCarloArgs) -> Result<()> {
     let n = a
         .devices
         .ok_or_else(|| BadInput("--devices N is required".into()))?;
-    check_lot_size(n).map_err(BadInput)?;
     let shard = a.out.shard()?;
+    // Size, shard count and split before the folder exists: a refusal leaves nothing.
+    check_lot(&cfg, &a.out.out, shard.as_ref(), n)?;
     let mine: Vec<u64> = Shard::items(shard.as_ref(), n)
         .into_iter()
         .map(|i| i as u64)
