@@ -54,7 +54,7 @@ pub fn load_config(path: &Path) -> Result<Config> {
     let (cfg, text) = read_config(path)?;
     let warnings = cfg.validate().map_err(|e| refused(path, &text, e))?;
     for w in warnings {
-        eprintln!("warning: {}: {w}", path.display());
+        note!("warning: {}: {w}", path.display());
     }
     Ok(cfg)
 }
@@ -85,9 +85,9 @@ pub fn command_line() -> String {
 
 /// Lists the files a command wrote, one per line on stderr, relative to `out` where inside it.
 pub fn list_written(out: &Path, files: &[std::path::PathBuf]) {
-    eprintln!("wrote {} files in `{}`:", files.len(), out.display());
+    note!("wrote {} files in `{}`:", files.len(), out.display());
     for f in files {
         let shown = f.strip_prefix(out).unwrap_or(f);
-        eprintln!("  {}", shown.display());
+        note!("  {}", shown.display());
     }
 }

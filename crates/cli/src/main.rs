@@ -2,6 +2,23 @@
 //! figures of Casinovi et al., "Electrostatic Self-Calibration of Vibratory Gyroscopes"
 //! (MEMS 2012).
 
+/// `eprintln!` that never panics: a closed stderr (`2>&-`, or a pipe whose reader has left)
+/// must not turn a finished run into a panic's exit code 101.
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
+/// `println!` that never panics, for the same reason (`gyroemu selfcal ... | head -1`).
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod cmd;
 mod input;
 mod progress;
@@ -195,7 +212,7 @@ fn run_cli() -> ExitCode {
     if let Some(t) = cli.threads {
         if !(1..=MAX_THREADS).contains(&t) {
             // A mistyped count would otherwise start that many OS threads before anything.
-            eprintln!("error: --threads = {t}: must be from 1 to {MAX_THREADS}");
+            note!("error: --threads = {t}: must be from 1 to {MAX_THREADS}");
             return ExitCode::from(EXIT_BAD_INPUT);
         }
         // No pool exists this early, so only the OS can refuse the threads.
@@ -203,13 +220,13 @@ fn run_cli() -> ExitCode {
             .num_threads(t)
             .build_global()
         {
-            eprintln!("error: --threads = {t}: the worker threads could not be started ({e})");
+            note!("error: --threads = {t}: the worker threads could not be started ({e})");
             return ExitCode::from(EXIT_BAD_INPUT);
         }
     }
     if let Some(n) = cli.lanes {
         if let Err(e) = gyroemu_board::set_max_lanes(n) {
-            eprintln!("error: {e}");
+            note!("error: {e}");
             return ExitCode::from(EXIT_BAD_INPUT);
         }
     }
@@ -250,7 +267,7 @@ fn run_cli() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            note!("error: {e:#}");
             ExitCode::from(exit_code(&e))
         }
     }

@@ -49,7 +49,7 @@ impl Progress {
         };
         if last.elapsed() >= Duration::from_secs(10) {
             *last = Instant::now();
-            eprintln!(
+            note!(
                 "{}: {:.0}% ({done} of {total} samples, {:.0} s)",
                 self.label,
                 100.0 * done as f64 / total.max(1) as f64,
@@ -65,7 +65,7 @@ impl Progress {
             b.finish_and_clear();
         }
         let s = (self.start.elapsed().as_secs_f64() - written.seconds).max(0.0);
-        eprintln!("{}", counted_line(&self.label, point_samples, s, written));
+        note!("{}", counted_line(&self.label, point_samples, s, written));
     }
 
     /// Closes the bar and prints the elapsed time (for runs whose size is not in point-samples).
@@ -73,7 +73,7 @@ impl Progress {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
         }
-        eprintln!(
+        note!(
             "{}: done in {:.1} s",
             self.label,
             self.start.elapsed().as_secs_f64()
@@ -124,9 +124,9 @@ impl Reporter for Terminal {
         Box::new(Progress::new(label))
     }
     fn note(&self, text: &str) {
-        eprintln!("{text}");
+        note!("{text}");
     }
     fn warn(&self, text: &str) {
-        eprintln!("warning: {text}");
+        note!("warning: {text}");
     }
 }

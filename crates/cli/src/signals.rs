@@ -21,7 +21,7 @@ pub fn install(graceful: bool) -> Arc<AtomicBool> {
             let f = flag.clone();
             let installed = ctrlc::set_handler(move || {
                 if graceful && !f.swap(true, Ordering::SeqCst) {
-                    eprintln!(
+                    note!(
                         "\ninterrupt: saving the finished points and stopping \
                          (Ctrl-C again to quit at once)"
                     );
@@ -29,13 +29,13 @@ pub fn install(graceful: bool) -> Arc<AtomicBool> {
                 }
                 let marked = gyroemu_runs::abort_now();
                 for m in &marked {
-                    eprintln!("\ninterrupted: `{}` marked interrupted", m.display());
+                    note!("\ninterrupted: `{}` marked interrupted", m.display());
                 }
-                eprintln!("\ninterrupted: exiting now");
+                note!("\ninterrupted: exiting now");
                 std::process::exit(EXIT_INTERRUPTED.into());
             });
             if let Err(e) = installed {
-                eprintln!("warning: Ctrl-C will not save progress nor release the lock: {e}");
+                note!("warning: Ctrl-C will not save progress nor release the lock: {e}");
             }
             flag
         })

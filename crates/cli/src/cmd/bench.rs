@@ -32,7 +32,7 @@ pub fn bench_command(preset_name: &str, samples: u64, repeats: usize) -> Result<
     } else {
         "rows marked (f64x4): the same"
     };
-    eprintln!(
+    note!(
         "bench: preset {preset_name}, fs = {} Hz, {samples} input samples per lane group, best and median of {repeats} runs; \
          whole chain: {lanes} operating points per group in {} lanes (what a run uses on this CPU), {typed}; stages: 4 lanes",
         cfg.fs_hz(),

@@ -59,7 +59,7 @@ pub fn montecarlo_command(a: &MonteCarloArgs) -> Result<()> {
         LotRefusal::Cap(m) => BadInput(m),
     })?;
     for w in warnings {
-        eprintln!("warning: {}: {w}", a.config.display());
+        note!("warning: {}: {w}", a.config.display());
     }
     let (cancel, _lock) = a.out.open(shard.as_ref())?;
     let req = RunRequest {
@@ -75,7 +75,7 @@ pub fn montecarlo_command(a: &MonteCarloArgs) -> Result<()> {
             print_out(&summary_text(&summary))?;
             list_written(&a.out.out, &files);
         }
-        LotOutcome::ShardComplete { next } => eprintln!("shard complete; {next}"),
+        LotOutcome::ShardComplete { next } => note!("shard complete; {next}"),
     }
     Ok(())
 }

@@ -16,10 +16,10 @@ pub fn reproduce_command(out: &Path, quick: bool) -> Result<()> {
         e => e.into(),
     })?;
     for w in &plan.warnings {
-        eprintln!("warning: {w}");
+        note!("warning: {w}");
     }
     let rate = gyroemu_experiment::work::measured_throughput(plan.first_config());
-    eprintln!("{}", plan.work().describe(Some(rate)));
+    note!("{}", plan.work().describe(Some(rate)));
     signals::install(false);
     prepare_out(out)?;
     let _lock = lock_out(out, &command_line(), LockScope::Folder, &Terminal)?;

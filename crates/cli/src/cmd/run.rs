@@ -25,7 +25,7 @@ pub fn run_command(config: &Path, a: &OutArgs) -> Result<()> {
     };
     match run(&req, &Terminal)? {
         RunOutcome::Complete(files) => list_written(&a.out, &files),
-        RunOutcome::ShardComplete { next } => eprintln!("shard complete; {next}"),
+        RunOutcome::ShardComplete { next } => note!("shard complete; {next}"),
     }
     Ok(())
 }

@@ -19,11 +19,11 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
     let extra = validate_selfcal(&cfg).map_err(|e| refused(config, &text, e))?;
     let own = cfg.validate().map_err(|e| refused(config, &text, e))?;
     for w in own.iter().chain(&extra) {
-        eprintln!("warning: {}: {w}", config.display());
+        note!("warning: {}: {w}", config.display());
     }
     let work = selfcal_work(&cfg);
     work.check_cap(force).map_err(BadInput)?;
-    eprintln!("{}", work.describe(Some(measured_throughput(&cfg))));
+    note!("{}", work.describe(Some(measured_throughput(&cfg))));
     signals::install(false);
     prepare_out(out)?;
     let _lock = lock_out(out, &command_line(), LockScope::Folder, &Terminal)?;
@@ -35,7 +35,7 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
             .iter()
             .map(|p| p.strip_prefix(out).unwrap_or(p).display().to_string())
             .collect();
-        eprintln!(
+        note!(
             "deleted {} files of an earlier selfcal whose analyses this config does not run: {}",
             names.len(),
             names.join(", ")
@@ -51,10 +51,10 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
         .chain(report.core.coriolis.warnings.iter().cloned())
         .chain(allan)
     {
-        eprintln!("warning: {w}");
+        note!("warning: {w}");
     }
     let m = report.core.modes[0];
-    println!(
+    say!(
         "self-calibration (mode 1): rotating slope {:.9} deg per deg/s x lambda {} = predicted Coriolis {:.9}; \
          rate table measured {:.9}; relative error {:+.3e} +- {:.2e} (95 %), averaging {} s",
         m.rotating.slope_deg_per_dps,
@@ -66,7 +66,7 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
         cfg.experiment.average_s
     );
     let c = report.core.combined;
-    println!(
+    say!(
         "self-calibration (both modes, geometric mean): predicted Coriolis {:.9}; rate table measured {:.9}; \
          relative error {:+.3e} +- {:.2e} (95 %), mode 2 alone {:+.3e}",
         c.predicted_deg_per_dps,

@@ -18,7 +18,7 @@ pub fn sweep_command(config: &Path, out: &Path, force: bool) -> Result<()> {
         .validate_sweep()
         .map_err(|e| refused(config, &text, e))?;
     for w in warnings {
-        eprintln!("warning: {}: {w}", config.display());
+        note!("warning: {}: {w}", config.display());
     }
     let work = stepped_sine_work(&cfg);
     if !force && work.point_samples > MAX_POINT_SAMPLES {
@@ -29,7 +29,7 @@ pub fn sweep_command(config: &Path, out: &Path, force: bool) -> Result<()> {
         ))
         .into());
     }
-    eprintln!(
+    note!(
         "{} (each mode driven alone at {} frequencies)",
         work.describe(None),
         work.points / 2
@@ -40,7 +40,7 @@ pub fn sweep_command(config: &Path, out: &Path, force: bool) -> Result<()> {
     let r = run_frequency_response(&cfg, &Terminal)?;
     let files = write_freq_sweep(out, &cfg, &r)?;
     for w in &r.measured.warnings {
-        eprintln!("warning: {w}");
+        note!("warning: {w}");
     }
     let (split, split_sigma) = r.mode_split_hz();
     let part = |k: usize| {
@@ -59,7 +59,7 @@ pub fn sweep_command(config: &Path, out: &Path, force: bool) -> Result<()> {
             None => format!("mode {}: no resonance found", k + 1),
         }
     };
-    println!(
+    say!(
         "sweep: {}; {}; split {:.6} +- {:.1e} Hz (configured {})",
         part(0),
         part(1),

@@ -1,0 +1,44 @@
+//! A run whose stderr or stdout has no reader (`2>&-`, `| head -1`) still finishes, writes its
+//! files and exits 0: a failed write of a message is not a failure of the run (it was a
+//! panic's exit 101 after every file had been written).
+
+mod common;
+
+use common::*;
+use std::process::Stdio;
+
+const TINY: &str = r#"
+[device]
+f0_hz = 15000.0
+q = 200.0
+angular_gain = 1.0
+[drive]
+f1 = 1.0
+f2 = 1.0
+[experiment]
+kind = "coriolis"
+rates_dps = [25.0, 50.0]
+average_s = 0.05
+settle_s = 0.05
+"#;
+
+#[test]
+fn a_run_with_no_reader_on_stderr_or_stdout_finishes_and_exits_0() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = config(dir.path(), "tiny.toml", TINY);
+    for (k, closed_stderr) in [true, false].into_iter().enumerate() {
+        let out = dir.path().join(format!("out{k}"));
+        // A pipe whose reader is gone: every write to it fails (EPIPE).
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let mut c = command(&["--threads", "1", "run", s(&cfg), "--out", s(&out)], &[]);
+        if closed_stderr {
+            c.stderr(writer).stdout(Stdio::null());
+        } else {
+            c.stdout(writer).stderr(Stdio::null());
+        }
+        let status = c.status().unwrap();
+        assert_eq!(status.code(), Some(0), "stderr closed: {closed_stderr}");
+        assert!(out.join("results.csv").is_file());
+    }
+}
