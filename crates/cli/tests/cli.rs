@@ -127,6 +127,35 @@ fn bad_configs_exit_2_naming_key_value_and_rule_and_write_nothing() {
 }
 
 #[test]
+fn the_configs_warnings_reach_summary_json_beside_the_runs() {
+    // A 12-bit ADC with no noise: the validation's warning on its rounding (stderr, before any
+    // sample) is also in summary.json, where a script reading the results finds it.
+    let dir = tempfile::tempdir().unwrap();
+    let text = SMALL.replace("decimation = 100\n", "decimation = 100\nadc_bits = 12\n");
+    let o = run_config(&text, dir.path(), &["--threads", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let told = stderr(&o);
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("out/summary.json")).unwrap(),
+    )
+    .unwrap();
+    let w: Vec<&str> = summary["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert_eq!(
+        w.iter().filter(|w| w.contains("rounding error")).count(),
+        2,
+        "{w:?}"
+    );
+    for w in w {
+        assert!(told.contains(w), "{w} not in the log: {told}");
+    }
+}
+
+#[test]
 fn run_writes_results_and_is_deterministic_across_threads() {
     let dir = tempfile::tempdir().unwrap();
     let o = run_config(SMALL, dir.path(), &["--threads", "1"]);

@@ -2,7 +2,7 @@
 //! error_vs_tau.*, drift.* for the analyses that ran. Every file is written atomically.
 
 use crate::error::ReportError;
-use crate::sweep_report::health_json;
+use crate::sweep_report::{health_json, with_config_warnings};
 use gyroemu_analysis::allan::AllanPoint;
 use gyroemu_analysis::selfcal::SelfcalCore;
 use gyroemu_analysis::selfcal_analyses::{AllanResult, DriftCase, DriftPoint, TauPoint};
@@ -107,7 +107,7 @@ fn write_selfcal_files(
             "coriolis": health_json(&core.coriolis.health),
         },
         "problems": core.rotating.problems.iter().chain(&core.coriolis.problems).collect::<Vec<_>>(),
-        "warnings": core.rotating.warnings.iter().cloned().chain(core.coriolis.warnings.iter().cloned()).chain(allan.iter().flat_map(|a| a.warnings())).collect::<Vec<_>>(),
+        "warnings": with_config_warnings(cfg, &core.rotating.warnings.iter().cloned().chain(core.coriolis.warnings.iter().cloned()).chain(allan.iter().flat_map(|a| a.warnings())).collect::<Vec<_>>()),
         "allan": allan,
         "error_vs_averaging_time": taus,
         "drift": drift,
