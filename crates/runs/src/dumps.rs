@@ -32,7 +32,7 @@ pub(crate) fn remove_files(files: &[PathBuf]) -> Result<(), RunError> {
 }
 
 /// The `[dump]` table of a canonical config text (`None`: no dump).
-fn dump_table(config_toml: &str) -> Option<toml::Value> {
+pub(crate) fn dump_table(config_toml: &str) -> Option<toml::Value> {
     let t: toml::Table = toml::from_str(config_toml).ok()?;
     t.get("dump").cloned()
 }

@@ -4,6 +4,7 @@
 //! the results are built from the files exactly as one machine builds them.
 
 use crate::config_diff::{config_diff_for, describe_diff};
+use crate::dumps::dump_table;
 use crate::error::RunError;
 use crate::manifest::{read_manifest, shard_manifest_paths, Manifest, RunKind, RUN_MANIFEST};
 use crate::points::{config_hash, PointFile};
@@ -122,6 +123,13 @@ fn read_split(dir: &Path) -> Result<Split, RunError> {
                  {}){differs}: every shard must run the same config",
                 &m.config_sha256[..m.config_sha256.len().min(12)],
                 &hash[..hash.len().min(12)]
+            )));
+        }
+        // `[dump]` leaves the hash alone (it changes no result), but the folder holds one
+        // dump: shards of different dumps would leave files the merged manifest misdescribes.
+        if dump_table(&m.config_toml) != dump_table(&first.config_toml) {
+            return Err(bad(format!(
+                "`{name}` and `{first_name}` ran the same sweep with different [dump] sections:                  the folder holds one dump, so rerun the shards with one [dump] (a rerun only                  recomputes the dumped point)"
             )));
         }
     }

@@ -374,3 +374,27 @@ fn a_folder_the_lock_cannot_be_created_in_is_bad_input_naming_it() {
         other => panic!("not bad input: {other:?}"),
     }
 }
+
+#[test]
+fn merge_refuses_shards_of_different_dumps() {
+    // `[dump]` changes no result, hence not the hash; but the folder holds one dump, and a
+    // shard of another [dump] had replaced it while the merged manifest described the first.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("dumps");
+    let with_dump = |rate: f64| {
+        let text = format!(
+            "{NOISY}\n[dump]\nrate_dps = {rate}\nstart_s = 0.1\nduration_s = 0.002\nnodes = [\"tia\"]\n"
+        );
+        let c = parse_config(&text).unwrap();
+        c.validate().unwrap();
+        c
+    };
+    let shard = |i: usize| Some(parse_shard(&format!("{i}/2")).unwrap());
+    assert!(run_shard(&with_dump(25.0), &out, shard(0)).0.is_ok());
+    assert!(run_shard(&with_dump(50.0), &out, shard(1)).0.is_ok());
+    let why = merge_refusal(&out);
+    assert!(why.contains("different [dump] sections"), "{why}");
+    // One [dump] for both: the merge goes through.
+    assert!(run_shard(&with_dump(25.0), &out, shard(1)).0.is_ok());
+    merge(&out, &Quiet).unwrap();
+}
