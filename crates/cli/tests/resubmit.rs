@@ -11,33 +11,6 @@ use common::*;
 use std::path::Path;
 use std::process::Output;
 
-/// A Coriolis sweep with noise: ten points.
-const NOISY: &str = r#"
-[device]
-f0_hz = 15000.0
-q = 1000.0
-angular_gain = 1.0
-[drive]
-f1 = 1.0
-f2 = 1.0
-[board]
-fs_hz = 240000.0
-lpf_cutoff_hz = 200.0
-decimation = 100
-adc_bits = 14
-adc_full_scale_v = 0.1
-[experiment]
-kind = "coriolis"
-rates_dps = [25.0, 50.0, 75.0, 100.0, 125.0, 150.0, 175.0, 200.0, 225.0]
-average_s = 0.2
-settle_s = 0.05
-[noise]
-seed = 7
-effective_mass_kg = 1e-9
-tia_current_noise_a_per_rthz = 1e-13
-tia_voltage_noise_v_per_rthz = 2e-8
-"#;
-
 /// `gyroemu --threads 1 run CFG --out OUT EXTRA...` with `env`.
 fn run(cfg: &Path, out: &Path, extra: &[&str], env: &[(&str, &str)]) -> Output {
     let mut args = vec!["--threads", "1", "run", s(cfg), "--out", s(out)];

@@ -6,47 +6,13 @@
 mod common;
 
 use common::*;
-use gyroemu_config::{parse_config, Config};
+use gyroemu_config::Config;
 use gyroemu_experiment::Quiet;
 use gyroemu_runs::{prepare_out, run, RunError, RunOutcome, RunRequest};
 use serde_json::Value;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-
-/// A Coriolis sweep with every noise source (so each point's random stream matters): nine
-/// listed rates plus the implicit zero, three lane groups.
-const NOISY: &str = r#"
-[device]
-f0_hz = 15000.0
-q = 1000.0
-angular_gain = 1.0
-[drive]
-f1 = 1.0
-f2 = 1.0
-[board]
-fs_hz = 240000.0
-lpf_cutoff_hz = 200.0
-decimation = 100
-adc_bits = 14
-adc_full_scale_v = 0.1
-[experiment]
-kind = "coriolis"
-rates_dps = [25.0, 50.0, 75.0, 100.0, 125.0, 150.0, 175.0, 200.0, 225.0]
-average_s = 0.2
-settle_s = 0.25
-[noise]
-seed = 7
-effective_mass_kg = 1e-9
-tia_current_noise_a_per_rthz = 1e-13
-tia_voltage_noise_v_per_rthz = 2e-8
-"#;
-
-fn config() -> Config {
-    let c = parse_config(NOISY).unwrap();
-    c.validate().unwrap();
-    c
-}
 
 /// Runs `cfg` into `out` on one worker thread (lane groups in turn), raising the cancel flag
 /// once `stop_after` points are saved.

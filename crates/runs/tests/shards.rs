@@ -22,39 +22,6 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
-/// A Coriolis sweep with noise (each point's random stream matters): ten points.
-const NOISY: &str = r#"
-[device]
-f0_hz = 15000.0
-q = 1000.0
-angular_gain = 1.0
-[drive]
-f1 = 1.0
-f2 = 1.0
-[board]
-fs_hz = 240000.0
-lpf_cutoff_hz = 200.0
-decimation = 100
-adc_bits = 14
-adc_full_scale_v = 0.1
-[experiment]
-kind = "coriolis"
-rates_dps = [25.0, 50.0, 75.0, 100.0, 125.0, 150.0, 175.0, 200.0, 225.0]
-average_s = 0.2
-settle_s = 0.05
-[noise]
-seed = 7
-effective_mass_kg = 1e-9
-tia_current_noise_a_per_rthz = 1e-13
-tia_voltage_noise_v_per_rthz = 2e-8
-"#;
-
-fn config() -> Config {
-    let c = parse_config(NOISY).unwrap();
-    c.validate().unwrap();
-    c
-}
-
 /// Runs `cfg` (shard `shard`) into `out`; returns the outcome and what the run reported.
 fn run_shard(
     cfg: &Config,
