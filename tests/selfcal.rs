@@ -126,9 +126,8 @@ fn averaging_time_reading_at_the_sweep_time_equals_the_sweep() {
         tau_analysis(
             &c,
             14.4,
-            m.coriolis.slope_deg_per_dps,
-            m.theory_coriolis_deg_per_dps,
-            core.combined.coriolis.slope_deg_per_dps,
+            &m.coriolis,
+            &core.combined.coriolis,
             group_threads,
             &quiet,
         )
@@ -156,6 +155,59 @@ fn averaging_time_reading_at_the_sweep_time_equals_the_sweep() {
 }
 
 #[test]
+fn an_averaging_time_reading_carries_the_rate_tables_error_and_its_own_theory() {
+    // Noisy, with unequal drives and Q: at the sweep's own averaging time the reading is the
+    // self-calibration itself, so it must carry the same interval (it left out the rate-table
+    // slope's error, and covered the noiseless value in 3 of 12 seeds).
+    let mut c = fast_cfg(&[100.0, 125.0, 150.0, 175.0], 3.6);
+    c.drive.f2 = Some(1.01);
+    c.device.q_mode2 = Some(1950.0);
+    c.noise = Some(NoiseConfig {
+        seed: 3,
+        temperature_k: 300.0,
+        effective_mass_kg: None,
+        tia_current_noise_a_per_rthz: 3e-11,
+        tia_voltage_noise_v_per_rthz: 0.0,
+        ..Default::default()
+    });
+    let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
+    let (m, comb) = (core.modes[0], core.combined);
+    let taus = tau_analysis(&c, 7.2, &m.coriolis, &comb.coriolis, None, &quiet).unwrap();
+    let at = taus
+        .iter()
+        .find(|p| p.tau_s == 3.6)
+        .expect("3.6 s is on the grid");
+    let same = |a: f64, b: f64| (a / b - 1.0).abs() < 1e-9;
+    assert!(
+        same(at.relative_error_ci95, m.relative_error_ci95),
+        "{at:?} against {m:?}"
+    );
+    assert!(same(
+        at.combined_relative_error_ci95,
+        comb.relative_error_ci95
+    ));
+    // Noiseless, the reading against the rotating sweep's own theory is noise and truncation
+    // only: about 0, where the small-angle Coriolis theory it was compared with gave
+    // F1/F2 - 1 = -0.0099 (the drive ratio the rotating reading never sees).
+    c.noise = None;
+    let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
+    let m = core.modes[0];
+    let taus = tau_analysis(&c, 7.2, &m.coriolis, &core.combined.coriolis, None, &quiet).unwrap();
+    for p in &taus {
+        assert!(p.relative_error_vs_theory.abs() < 1e-6, "{p:?}");
+    }
+    // Mode 1's Coriolis phase follows mode 2's response: 2 lambda Q2 F2 / (F1 w0), which the
+    // noiseless rate table measures (with Q1 instead it was 2.6 % off).
+    let w0 = 2.0 * std::f64::consts::PI * c.device.f0_hz;
+    let theory = 2.0 * 1950.0 * c.device.angular_gain / w0 * 1.01;
+    assert!((m.theory_coriolis_deg_per_dps / theory - 1.0).abs() < 1e-15);
+    assert!(
+        (m.coriolis.slope_deg_per_dps / theory - 1.0).abs() < 1e-3,
+        "{m:?}"
+    );
+}
+
+#[test]
 fn averaging_time_progress_ends_at_its_total_whatever_the_lane_groups() {
     // Five points on one thread: one lane group of eight where the CPU has AVX-512, two of
     // four elsewhere; the canonical grouping the results report is two of four either way.
@@ -163,8 +215,11 @@ fn averaging_time_progress_ends_at_its_total_whatever_the_lane_groups() {
     let c = fast_cfg(&[25.0, 50.0, 100.0, 150.0, 175.0], 2.0);
     let seen = std::sync::Mutex::new(Vec::new());
     let record = |d: u64, t: u64| seen.lock().unwrap().push((d, t));
-    // 2 s: the shortest averaging-time run validation lets through.
-    let taus = tau_analysis(&c, 2.0, 1.0, 1.0, 1.0, Some(1), &record).unwrap();
+    // 2 s: the shortest averaging-time run validation lets through. The slopes it compares
+    // with do not matter here.
+    let core = run_selfcal_core(&c, &quiet, &quiet, Some(1)).unwrap();
+    let (cor, comb) = (core.modes[0].coriolis, core.combined.coriolis);
+    let taus = tau_analysis(&c, 2.0, &cor, &comb, Some(1), &record).unwrap();
     assert_eq!(taus.len(), 2, "read at 1 and 2 s: {taus:?}");
     let seen = seen.into_inner().unwrap();
     // Groups report side by side, so the highest report, not the last one, is the total.
@@ -253,4 +308,20 @@ fn selfcal_refuses_too_few_distinct_rates_naming_the_key() {
         );
     }
     validate_selfcal(&fast_cfg(&[50.0, 100.0, 150.0], 7.2)).unwrap();
+}
+
+#[test]
+fn a_too_short_averaging_time_run_is_refused_under_its_own_key() {
+    // The run of tau_max_s must span half a modulation period of the slowest rate (25 deg/s:
+    // 7.2 s); the refusal named experiment.average_s, which the user had set right.
+    let mut c = fast_cfg(&[25.0, 100.0, 150.0], 7.2);
+    c.selfcal = Some(SelfcalConfig {
+        tau_max_s: Some(7.0),
+        ..Default::default()
+    });
+    let e = validate_selfcal(&c).unwrap_err();
+    assert_eq!(e.key.as_deref(), Some("selfcal.tau_max_s"), "{e}");
+    assert!(e.detail.contains("7.2 s"), "{e}");
+    c.selfcal.as_mut().unwrap().tau_max_s = Some(7.2);
+    validate_selfcal(&c).unwrap();
 }

@@ -95,10 +95,13 @@ pub fn mode_selfcal(cfg: &Config, rot: &SweepResult, cor: &SweepResult, k: usize
     let ci = t95(rotating.dof.min(coriolis.dof)) * ratio * rel(&rotating).hypot(rel(&coriolis));
     let predicted_paper = lambda * rotating_paper_i.slope_deg_per_dps;
     let d = &cfg.device;
-    let (own, other) = if k == 0 {
-        (cfg.drive.f1, cfg.f2())
+    let q2 = d.q_mode2.unwrap_or(d.q);
+    // A mode's Coriolis phase is driven by the other mode's response: 2 lambda Omega Q_other
+    // F_other / (F_own w0) at small angles (docs/selfcal.md).
+    let (own, other, q_other) = if k == 0 {
+        (cfg.drive.f1, cfg.f2(), q2)
     } else {
-        (cfg.f2(), cfg.drive.f1)
+        (cfg.f2(), cfg.drive.f1, d.q)
     };
     let w0 = core::f64::consts::TAU * d.f0_hz;
     ModeSelfcal {
@@ -111,7 +114,7 @@ pub fn mode_selfcal(cfg: &Config, rot: &SweepResult, cor: &SweepResult, k: usize
         relative_error_theory,
         predicted_paper_i_deg_per_dps: predicted_paper,
         relative_error_paper_i: predicted_paper / measured - 1.0,
-        theory_coriolis_deg_per_dps: 2.0 * d.q * d.angular_gain / w0 * other / own,
+        theory_coriolis_deg_per_dps: 2.0 * q_other * d.angular_gain / w0 * other / own,
     }
 }
 
@@ -219,7 +222,21 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
         if let Some(t) = s.tau_max_s {
             let mut r = rot.clone();
             r.experiment.average_s = t;
-            add("averaging-time analysis", r.validate());
+            // That run's averaging time is selfcal.tau_max_s: its refusal names the key set.
+            let v = r.validate().map_err(|e| {
+                let list = e
+                    .problems()
+                    .into_iter()
+                    .map(|mut p| {
+                        if p.key.as_deref() == Some("experiment.average_s") {
+                            p.key = Some("selfcal.tau_max_s".into());
+                        }
+                        p
+                    })
+                    .collect();
+                ConfigError::from_problems(list).unwrap_or(e)
+            });
+            add("averaging-time analysis", v);
         }
     }
     match ConfigError::from_problems(problems) {

@@ -3,8 +3,8 @@
 //! averaging time (one long rotating run read at checkpoints), and a temperature drift.
 
 use crate::allan::{noise_readings_settled, overlapping_adev, AllanPoint, NoiseReadings};
-use crate::selfcal::{drifted, linearised_slope, run_selfcal_core, sweep_configs};
-use crate::selfcal_combined::combined_slope;
+use crate::selfcal::{drifted, linearised_slope, run_selfcal_core, sweep_configs, SlopeFit};
+use crate::selfcal_combined::{combined_slope, CombinedSlope};
 use gyroemu_board::{lane_groups, max_lanes, GroupBoard, LaneResult, Point, RunOptions};
 use gyroemu_config::{Config, PllConfig};
 use gyroemu_experiment::post_process;
@@ -153,8 +153,8 @@ pub struct TauPoint {
     /// Predicted over the measured Coriolis slope, minus one.
     pub relative_error: f64,
     pub relative_error_ci95: f64,
-    /// Predicted over the small-angle theory of an ideal device, minus one (noise and
-    /// truncation only, without the rate table's own error).
+    /// Predicted over lambda times the slope of the rotating sweep's exact theory phases,
+    /// minus one: the rotating reading's noise and truncation only, without the rate table.
     pub relative_error_vs_theory: f64,
     /// Both modes together: lambda times the geometric mean of their rotating slopes.
     pub combined_predicted_deg_per_dps: f64,
@@ -181,17 +181,20 @@ pub fn tau_grid(tau_max_s: f64, average_s: f64) -> Vec<f64> {
 
 /// One rotating run of `tau_max_s`, read at every averaging time of [`tau_grid`] (each point
 /// averaged over whole half periods once tau spans one, as the sweep does), compared with
-/// the measured Coriolis slope of mode 1, and the two modes' combined prediction with their
-/// combined measured slope (`combined_measured_deg_per_dps`, NaN to leave it out).
+/// the measured Coriolis slope of mode 1 (`coriolis`), and the two modes' combined prediction
+/// with their combined measured slope (`combined_coriolis`, a NaN slope leaves it out). Each
+/// interval counts both slopes' errors, as the main self-calibration's does: the rate-table
+/// slope is measured once, and its error is in every reading.
 pub fn tau_analysis(
     cfg: &Config,
     tau_max_s: f64,
-    measured_deg_per_dps: f64,
-    theory_deg_per_dps: f64,
-    combined_measured_deg_per_dps: f64,
+    coriolis: &SlopeFit,
+    combined_coriolis: &CombinedSlope,
     group_threads: Option<usize>,
     progress: Progress,
 ) -> Result<Vec<TauPoint>, SweepError> {
+    let measured_deg_per_dps = coriolis.slope_deg_per_dps;
+    let combined_measured_deg_per_dps = combined_coriolis.slope_deg_per_dps;
     let (mut rot, _) = sweep_configs(cfg);
     let grid = tau_grid(tau_max_s, cfg.experiment.average_s);
     rot.experiment.average_s = tau_max_s;
@@ -286,13 +289,20 @@ pub fn tau_analysis(
                 [0, 1].map(|k| res.points.iter().map(|p| p.phase_deg[k]).collect());
             let s = linearised_slope(&xs, &ys);
             let comb = combined_slope(&xs, [&ys, &ys2]);
+            let t95 = gyroemu_experiment::fit::t95;
             let comb_predicted = lambda * comb.slope_deg_per_dps;
             let comb_ratio = comb_predicted / combined_measured_deg_per_dps;
-            let comb_ci = gyroemu_experiment::fit::t95(comb.dof) * comb_ratio * comb.rel_std_err;
+            let comb_ci = t95(comb.dof.min(combined_coriolis.dof))
+                * comb_ratio
+                * comb.rel_std_err.hypot(combined_coriolis.rel_std_err);
             let predicted = lambda * s.slope_deg_per_dps;
             let ratio = predicted / measured_deg_per_dps;
-            let ci = gyroemu_experiment::fit::t95(s.dof) * ratio * s.std_err_deg_per_dps
-                / s.slope_deg_per_dps;
+            let rel = |f: &SlopeFit| f.std_err_deg_per_dps / f.slope_deg_per_dps;
+            let ci = t95(s.dof.min(coriolis.dof)) * ratio * rel(&s).hypot(rel(coriolis));
+            // The rotating sweep's own exact theory, read the same way: what a noiseless,
+            // untruncated reading gives.
+            let theory: Vec<f64> = res.points.iter().map(|p| p.theory_deg[0]).collect();
+            let theory_deg_per_dps = lambda * linearised_slope(&xs, &theory).slope_deg_per_dps;
             Ok(TauPoint {
                 tau_s: tau,
                 averaged_s: res.points.iter().map(|p| p.averaged_s).fold(0.0, f64::max),

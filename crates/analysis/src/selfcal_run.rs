@@ -70,9 +70,8 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
         let r = tau_analysis(
             &held,
             t,
-            m.coriolis.slope_deg_per_dps,
-            m.theory_coriolis_deg_per_dps,
-            core.combined.coriolis.slope_deg_per_dps,
+            &m.coriolis,
+            &core.combined.coriolis,
             share,
             &|d, n| p.update(d, n),
         )?;

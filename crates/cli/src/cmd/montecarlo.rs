@@ -82,7 +82,16 @@ pub fn montecarlo_command(a: &MonteCarloArgs) -> Result<()> {
 
 /// The lot's figures for the terminal.
 fn summary_text(s: &LotSummary) -> String {
-    let pct = |x: f64| format!("{:.3} %", 100.0 * x);
+    // Three decimals of a percent, or four significant digits below 0.1 % (a 1 ppm spec
+    // printed as 0.000 %).
+    let pct = |x: f64| {
+        let v = 100.0 * x;
+        if v != 0.0 && v.abs() < 0.1 {
+            format!("{v:.3e} %")
+        } else {
+            format!("{v:.3} %")
+        }
+    };
     let y = &s.yield_within_spec;
     let mut t = format!(
         "lot of {} devices, self-calibration error `{}`:\n",
@@ -114,4 +123,18 @@ fn summary_text(s: &LotSummary) -> String {
         pct(y.ci95_high)
     );
     t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_small_spec_keeps_its_digits() {
+        // 1 ppm is 1e-4 %: it printed as 0.000 %.
+        let text = summary_text(&LotSummary::of(&[], 1e-6));
+        assert!(text.contains("|error| <= 1.000e-4 %"), "{text}");
+        let text = summary_text(&LotSummary::of(&[], 0.02));
+        assert!(text.contains("|error| <= 2.000 %"), "{text}");
+    }
 }
