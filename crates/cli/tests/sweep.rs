@@ -198,3 +198,29 @@ fn bad_sweep_keys_are_refused_before_anything_is_written() {
         assert!(!out.exists(), "{edit}: wrote {}", out.display());
     }
 }
+
+#[test]
+fn the_configs_warnings_reach_sweep_json() {
+    // A settling far below 10.6 time constants: the validation's warning (stderr, before any
+    // sample) is also in sweep.json, where a script reading the fit finds it.
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = config(dir.path(), &format!("{DEVICE}settle_s = 0.01\n"));
+    let out = dir.path().join("out");
+    let o = gyroemu(&["sweep", s(&cfg), "--out", s(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("sweep.json")).unwrap()).unwrap();
+    let w: Vec<&str> = summary["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert!(
+        w.iter()
+            .any(|w| w.contains("sweep.settle_s = 0.01 is shorter")),
+        "{w:?}"
+    );
+    let told = stderr(&o);
+    assert!(w.iter().all(|w| told.contains(w)), "{w:?} against {told}");
+}

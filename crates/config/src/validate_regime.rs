@@ -225,14 +225,9 @@ impl Config {
                 Shape::Rotating => vec![0.0, rate.abs() / 360.0],
                 Shape::RateTable { freq_hz } => (0..=15).map(|h| h as f64 * freq_hz).collect(),
             };
-            for f in refs {
-                for df in [alias - f, alias + f] {
-                    let gain = window.response(df / fs_out).norm();
-                    let e = (leak * gain).min(1.0).asin();
-                    if e > worst {
-                        (worst, at) = (e, f);
-                    }
-                }
+            let (e, f) = mixer_product_bound_rad(&chain, fc, fs_out, &window, &refs);
+            if e > worst {
+                (worst, at) = (e, f);
             }
         }
         let worst_mdeg = worst.to_degrees() * 1e3;
@@ -243,6 +238,40 @@ impl Config {
                 2.0 * fc,
                 leak,
                 alias.abs()
+            ));
+        }
+    }
+
+    /// The stepped sine's own mixer products: each frequency is the carrier of its reading
+    /// (DC demodulated over `sweep.average_s`). Near fs/2 the 2 f product folds into the
+    /// low-pass (`|L(2 f)|` of the sampled filter says so), and the decimation can fold what
+    /// is left onto DC: both moved Bode points by up to 99.9 % with no warning.
+    pub(crate) fn validate_sweep_mixer_products(&self, warnings: &mut Vec<String>) {
+        let Ok(chain) = gyroemu_board::ChainResponse::new(&self.board_params()) else {
+            return;
+        };
+        let fs_out = self.fs_out_hz();
+        let average = self.sweep_resolved().average_s.unwrap_or(f64::NAN);
+        let n = (average * fs_out).floor();
+        if n.is_nan() || n < 1.0 {
+            return;
+        }
+        let window = gyroemu_lpf::Window::Boxcar {
+            n: n as u64,
+            frac: 0.0,
+        };
+        let (mut worst, mut at) = (0.0f64, f64::NAN);
+        for f in self.sweep_frequencies_hz() {
+            let (e, _) = mixer_product_bound_rad(&chain, f, fs_out, &window, &[0.0]);
+            if e > worst {
+                (worst, at) = (e, f);
+            }
+        }
+        let worst_mdeg = worst.to_degrees() * 1e3;
+        if worst_mdeg > WARN_HOLD_ERROR_MDEG {
+            warnings.push(format!(
+                "sweep: at {at} Hz the stage-1 mixer's 2 f product, as the low-pass leaves it and the decimation folds it, is not averaged away: it can move that Bode point by up to {worst_mdeg:.3e} mdeg in phase ({:.1e} of its magnitude); keep sweep.stop_hz below (fs_hz - lpf_cutoff_hz)/2 and choose a decimation whose output rate does not divide 2 f, or raise board.lpf_order",
+                worst.sin()
             ));
         }
     }
@@ -313,4 +342,29 @@ impl Config {
             ));
         }
     }
+}
+
+/// The largest phase error, rad, the stage-1 mixer's 2 `fc` product leaves on a reading
+/// demodulated at each of `refs` over `window`: |L(2 fc)| of the sampled low-pass times the
+/// window's response at the distance of the product's alias at `fs_out` from each reference;
+/// with the reference it is largest at.
+fn mixer_product_bound_rad(
+    chain: &gyroemu_board::ChainResponse,
+    fc: f64,
+    fs_out: f64,
+    window: &gyroemu_lpf::Window,
+    refs: &[f64],
+) -> (f64, f64) {
+    let leak = chain.lowpass(2.0 * fc).norm();
+    let alias = 2.0 * fc - fs_out * (2.0 * fc / fs_out).round();
+    let (mut worst, mut at) = (0.0f64, 0.0);
+    for &f in refs {
+        for df in [alias - f, alias + f] {
+            let e = (leak * window.response(df / fs_out).norm()).min(1.0).asin();
+            if e > worst {
+                (worst, at) = (e, f);
+            }
+        }
+    }
+    (worst, at)
 }

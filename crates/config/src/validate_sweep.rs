@@ -148,5 +148,14 @@ impl Config {
                 }
             }
         }
+        let swept = [
+            "sweep.start_hz",
+            "sweep.stop_hz",
+            "sweep.points",
+            "sweep.average_s",
+        ];
+        if rates_ok && p.clean(&swept) && p.section_clean("board") {
+            self.validate_sweep_mixer_products(warnings);
+        }
     }
 }

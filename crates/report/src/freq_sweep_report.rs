@@ -182,7 +182,7 @@ pub fn freq_sweep_summary(cfg: &Config, r: &FrequencyResponse) -> serde_json::Va
         "sweep": cfg.sweep_resolved(),
         "converter_counts": health_json(&counts),
         "problems": r.measured.problems,
-        "warnings": r.measured.warnings,
+        "warnings": with_sweep_config_warnings(cfg, &r.measured.warnings),
         "config": cfg,
     })
 }
@@ -276,4 +276,12 @@ pub fn write_freq_sweep(
     write_json(&paths[1], &freq_sweep_summary(cfg, r))?;
     render_panels_png(&bode_title(r), &bode_panels(r), 1, 1400, 1300, &paths[2])?;
     Ok(paths)
+}
+
+/// The sweep config's warnings (validation's, printed before the run) followed by the run's,
+/// as `summary.json` lists them.
+fn with_sweep_config_warnings(cfg: &Config, run: &[String]) -> Vec<String> {
+    let mut w = cfg.validate_sweep().unwrap_or_default();
+    w.extend(run.iter().cloned());
+    w
 }
