@@ -91,6 +91,34 @@ impl Config {
             s.points,
             format!("must be an integer from {MIN_SWEEP_POINTS} (the resonance fit has four parameters) to {MAX_SWEEP_POINTS}"),
         );
+        if p.clean(&[
+            "sweep.start_hz",
+            "sweep.stop_hz",
+            "sweep.points",
+            "board.fs_hz",
+        ]) {
+            // The frequencies the carrier NCO realises: a span of a few ulps gave two distinct
+            // ones for ten points, and fits that counted the copies as data.
+            let fs = self.fs_hz();
+            let mut realised: Vec<u64> = self
+                .sweep_frequencies_hz()
+                .into_iter()
+                .filter_map(|f| gyroemu_nco::Nco::new(f, fs, 0.0).ok())
+                .map(|n| n.f_hz().to_bits())
+                .collect();
+            realised.sort_unstable();
+            realised.dedup();
+            p.check(
+                realised.len() >= MIN_SWEEP_POINTS,
+                "sweep.stop_hz",
+                stop,
+                format!(
+                    "start_hz .. stop_hz ({start} .. {stop} Hz) holds only {} distinct frequencies the carrier NCO can realise, of the {} asked: the resonance fit needs {MIN_SWEEP_POINTS}; widen the span",
+                    realised.len(),
+                    s.points
+                ),
+            );
+        }
         let device_ok = p.clean(&DEVICE_KEYS);
         if p.non_negative("sweep.settle_s", settle) && device_ok {
             let tau = self.slowest_tau_s();

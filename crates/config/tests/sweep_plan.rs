@@ -154,3 +154,17 @@ fn mixer_products_the_sweep_cannot_remove_are_stated() {
     let w = said(&edited(&nyquist));
     assert!(w.len() == 1 && w[0].contains("at 119999 Hz"), "{w:?}");
 }
+
+/// A span of a few ulps yields ten frequencies but two distinct ones (the fits then took the
+/// copies for data): refused under `sweep.stop_hz`, before any sample.
+#[test]
+fn a_span_with_too_few_distinct_frequencies_is_refused() {
+    let mut c = sweep_preset();
+    let s = c.sweep.as_mut().unwrap();
+    (s.start_hz, s.stop_hz, s.points) = (Some(15000.0), Some(15000.000000000004), 10);
+    let e = c.validate_sweep().unwrap_err();
+    assert_eq!(e.key.as_deref(), Some("sweep.stop_hz"), "{e}");
+    assert!(e.detail.contains("only 2 distinct frequencies"), "{e}");
+    c.sweep.as_mut().unwrap().stop_hz = Some(15000.1);
+    assert!(c.validate_sweep().is_ok());
+}
