@@ -81,8 +81,7 @@ impl FrequencyResponse {
 /// The natural frequency (Hz) and Q of each mode of the plant `p` at rest, from the eigenvalues
 /// `s` of its state matrix (`f0 = |s| / 2 pi`, `Q = |s| / (2 Re(-s))`). With quadrature
 /// coupling the two eigenmodes mix the configured modes; each is named for the mode that
-/// dominates it: the lower eigenvalue is mode 1's when `f0_1 <= f0_2`. NaN if the matrix has
-/// no two oscillatory eigenvalue pairs.
+/// dominates its mode shape. NaN if the matrix has no two oscillatory eigenvalue pairs.
 pub fn coupled_modes(p: &ResonatorParams) -> [(f64, f64); 2] {
     let tau = core::f64::consts::TAU;
     let (w1, w2) = (tau * p.mode1.f0_hz, tau * p.mode2.f0_hz);
@@ -108,18 +107,24 @@ pub fn coupled_modes(p: &ResonatorParams) -> [(f64, f64); 2] {
     if upper.len() != 2 {
         return [(f64::NAN, f64::NAN); 2];
     }
-    upper.sort_by(|x, y| x.norm().total_cmp(&y.norm()));
-    let modes: [(f64, f64); 2] = core::array::from_fn(|i| {
+    // An eigenvector's mode shape: d1(s) q1 = -k q2 and d2(s) q2 = -k q1, d_i(s) = s^2 + g_i s +
+    // r_i^2, so |q2 / q1|^2 = |d1(s)| / |d2(s)|: mode 1 dominates the eigenvalue with the
+    // smaller ratio. (Sorting by |s| swapped them on a mode-matched device, where |s| differs
+    // only through the damping.)
+    let share = |s: Complex64| {
+        let d = |r: f64, g: f64| (s * s + s * g + r * r).norm();
+        d(r1, g1) / d(r2, g2)
+    };
+    let (a1, a2) = (share(upper[0]), share(upper[1]));
+    if a1 > a2 || (a1 == a2 && upper[0].norm() > upper[1].norm()) {
+        upper.swap(0, 1);
+    }
+    core::array::from_fn(|i| {
         (
             upper[i].norm() * wr / tau,
             upper[i].norm() / (-2.0 * upper[i].re),
         )
-    });
-    if w1 <= w2 {
-        modes
-    } else {
-        [modes[1], modes[0]]
-    }
+    })
 }
 
 /// The velocity of both modes per unit force on mode `m` at `f_hz` under the held drive,

@@ -329,3 +329,18 @@ fn a_noisy_matrix_fit_is_near_the_device_or_not_read() {
     }
     assert!(read >= 6, "{read} read, {nulled} not");
 }
+
+/// On a mode-matched device |s| is the same for both eigenvalues up to the damping, so sorting
+/// by it named them at random (mode 1's Q was given mode 2's). Weakly coupled, each coupled
+/// mode is its configured one; coupled below the exceptional point, the eigenmode mode 1
+/// dominates keeps the lighter damping when Q1 > Q2.
+#[test]
+fn coupled_modes_are_named_by_their_mode_shape_on_a_matched_device() {
+    let weak = coupled_modes(&config(0.0, 1500.0, 1.0, 21, "").resonator_params());
+    for (k, q) in [2000.0, 1500.0].into_iter().enumerate() {
+        assert!((weak[k].0 / 15e3 - 1.0).abs() < 1e-9, "{weak:?}");
+        assert!((weak[k].1 / q - 1.0).abs() < 1e-6, "{weak:?}");
+    }
+    let strong = coupled_modes(&config(0.0, 1500.0, 2e4, 21, "").resonator_params());
+    assert!(strong[0].1 > strong[1].1, "{strong:?}");
+}
