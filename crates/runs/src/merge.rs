@@ -151,8 +151,9 @@ fn read_split(dir: &Path) -> Result<Split, RunError> {
     for (i, (_, m)) in &by_index {
         if m.status != "complete" {
             return Err(bad(format!(
-                "shard {i}/{count} is {} ({} of its {} {item}s missing): rerun it with --shard \
-                 {i}/{count} to finish it",
+                "shard {i}/{count} is {} (its manifest, as last written, lists {} of its {} \
+                 {item}s as not done; a killed shard's manifest stops there): rerun it with \
+                 --shard {i}/{count} to finish it (it reuses every {item} saved)",
                 m.status,
                 m.points_missing.len(),
                 m.points.len()
