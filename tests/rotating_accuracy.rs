@@ -141,3 +141,50 @@ fn psi_is_right_up_to_the_largest_accepted_rate() {
     let top = r.points.iter().find(|p| p.rate_dps == 71_900.0).unwrap();
     assert!(top.raw_psi_deg.unwrap()[0].abs() > 90.0, "{top:?}");
 }
+
+#[test]
+fn mode_2_psi_keeps_the_phase_shifters_error_past_90_degrees() {
+    // Mode 2's psi is the plant's psi plus the shifter's error x (THEORY.md section 4 with the
+    // drive sin(w t - x)): with x = 5 deg a plant psi of 86 degrees makes 91, which was folded
+    // into (-90, 90] and printed 180 degrees off; x = 89 was refused as a 1.8e5 mdeg hold error.
+    let rates = [5000.0, 20_000.0, -70_000.0, 70_000.0];
+    for x in [5.0, 89.0, -60.0] {
+        let mut cfg = config("rotating", 15e3, 2000.0, 1.0, 1.0, &rates, 0.2);
+        cfg.board.phase_shifter_error_deg = x;
+        cfg.validate().unwrap();
+        let r = run(&cfg);
+        for p in &r.points {
+            let psi = psi_deg(15e3, 2000.0, p.rate_dps);
+            let want = [psi, psi + x];
+            for k in 0..2 {
+                let err = (p.phase_deg[k] - want[k]) * 1e3;
+                assert!(
+                    err.abs() < 0.01,
+                    "x {x}, rate {}, mode {}: {} vs {} deg",
+                    p.rate_dps,
+                    k + 1,
+                    p.phase_deg[k],
+                    want[k]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn a_hann_window_over_few_periods_reads_psi_exactly() {
+    // 1.39 modulation periods of 25 deg/s (20 s): the window's leak is computed and removed,
+    // so psi stays within 0.001 mdeg of THEORY.md section 4 (validation used to warn of more
+    // than 0.1 mdeg, and the guide quoted a 95 mdeg leak).
+    let mut cfg = config("rotating", 15e3, 2000.0, 1.0, 1.0, &[25.0, 100.0], 20.0);
+    cfg.experiment.window = gyroemu::config::WindowKind::Hann;
+    let w = cfg.validate().unwrap();
+    assert!(!w.iter().any(|w| w.contains("hann")), "{w:?}");
+    let r = run(&cfg);
+    for p in &r.points {
+        let psi = psi_deg(15e3, 2000.0, p.rate_dps);
+        for k in 0..2 {
+            assert!((p.phase_deg[k] - psi).abs() * 1e3 < 1e-3, "{p:?}");
+        }
+    }
+}

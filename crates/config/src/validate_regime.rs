@@ -339,7 +339,11 @@ impl Config {
                 ),
             };
             for k in 0..2 {
-                let e = ((held[k] - exact[k]) / deg * 1e3).abs();
+                // A phase and the same plus 180 degrees read alike (the sidebands' branch):
+                // only the difference within a half turn is the hold's.
+                let d = held[k] - exact[k];
+                let d = d - core::f64::consts::PI * (d / core::f64::consts::PI).round();
+                let e = (d / deg * 1e3).abs();
                 // A NaN (an unbuildable plant) is reported by the other rules.
                 if e.is_finite() {
                     worst = worst.max(e);

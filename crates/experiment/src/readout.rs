@@ -359,8 +359,15 @@ pub fn post_process_with(
                     // (psi, alpha) and (psi + pi, alpha + pi) give the same sidebands. The
                     // plant's psi lies in (-90, 90) degrees and the chain adds up to 180 more
                     // (the low-pass near its cutoff), so the branch is chosen once the chain
-                    // is removed, not before.
-                    let (psi, turned) = fold_half_turn(est.psi_rad - total);
+                    // is removed, not before. Mode 2's psi also carries the phase shifter's
+                    // error x (psi_plant + x): its branch is centred there (at 20000 deg/s
+                    // and x = 5 deg it was read 180 degrees off).
+                    let shift = match mode {
+                        Mode::One => 0.0,
+                        Mode::Two => cfg.board.phase_shifter_error_deg * DEG,
+                    };
+                    let (psi, turned) = fold_half_turn(est.psi_rad - total - shift);
+                    let psi = psi + shift;
                     let a = if turned {
                         wrap_pi(est.alpha_rad + core::f64::consts::PI)
                     } else {
