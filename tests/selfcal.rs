@@ -325,3 +325,18 @@ fn a_too_short_averaging_time_run_is_refused_under_its_own_key() {
     c.selfcal.as_mut().unwrap().tau_max_s = Some(7.2);
     validate_selfcal(&c).unwrap();
 }
+
+#[test]
+fn rate_0_is_refused_in_a_rotating_run_and_left_out_of_selfcals_rotating_sweep() {
+    // A rotating run at rate 0 has no sidebands: it ran and came out NaN, blamed on an
+    // overflow. Refused before any sample; selfcal's rotating sweep leaves it out.
+    let c = fast_cfg(&[0.0, 50.0, 100.0, 150.0], 7.2);
+    let e = c.validate().unwrap_err();
+    assert_eq!(e.key.as_deref(), Some("experiment.rates_dps[0]"), "{e}");
+    let mut cor = c.clone();
+    cor.experiment.kind = gyroemu::config::ExperimentKind::Coriolis;
+    let (rot, table) = gyroemu::analysis::selfcal::sweep_configs(&cor);
+    assert_eq!(rot.experiment.rates_dps, [50.0, 100.0, 150.0]);
+    assert_eq!(table.experiment.rates_dps, [0.0, 50.0, 100.0, 150.0]);
+    validate_selfcal(&cor).unwrap();
+}

@@ -128,6 +128,9 @@ pub fn sweep_configs(cfg: &Config) -> (Config, Config) {
     rot.dump = None;
     let mut cor = rot.clone();
     cor.experiment.kind = ExperimentKind::Coriolis;
+    // Rate 0 has no sidebands to read: the rotating sweep leaves it out (the Coriolis sweep
+    // keeps it; its zero-rate reference is emulated anyway).
+    rot.experiment.rates_dps.retain(|&r| r != 0.0);
     (rot, cor)
 }
 

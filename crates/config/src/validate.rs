@@ -2,10 +2,10 @@
 //! and every broken rule of a config is reported (a rule whose inputs already broke one is
 //! skipped: see [`Rules`]).
 
-use crate::config::{Config, ExperimentKind, RateTable, WindowKind};
+use crate::config::{Config, ExperimentKind, RateTable};
 use crate::error::ConfigError;
 use crate::rules::Rules;
-use gyroemu_board::{Shape, DUMP_NODES};
+use gyroemu_board::DUMP_NODES;
 use gyroemu_theory::mechanical_tau_s;
 
 /// Most input samples one operating point may run: 2^53, so every sample index and count
@@ -226,10 +226,19 @@ impl Config {
         );
         for (i, &r) in e.rates_dps.iter().enumerate() {
             let key = format!("experiment.rates_dps[{i}]");
-            if p.finite(&key, r)
-                && e.kind == ExperimentKind::Rotating
-                && p.clean(&["board.lpf_cutoff_hz"])
-            {
+            let rotating = e.kind == ExperimentKind::Rotating;
+            if rotating && r == 0.0 {
+                // Refused here, not after the run: its read-out came out NaN, blamed on an
+                // overflow.
+                p.check(
+                    false,
+                    &key,
+                    r,
+                    "a rotating run reads psi from the sidebands at +-Omega, and rate 0 has none: leave it out",
+                );
+                continue;
+            }
+            if p.finite(&key, r) && rotating && p.clean(&["board.lpf_cutoff_hz"]) {
                 let f_mod = r.abs() / 360.0;
                 p.check(
                     f_mod < cutoff_hz,
@@ -353,26 +362,9 @@ impl Config {
                 }
             },
         }
-        if e.window == WindowKind::Hann {
-            let slowest_hz = match self.shape() {
-                Shape::Rotating => e
-                    .rates_dps
-                    .iter()
-                    .map(|r| r.abs() / 360.0)
-                    .filter(|&f| f > 0.0)
-                    .reduce(f64::min),
-                Shape::RateTable { freq_hz } => Some(freq_hz),
-                Shape::Coriolis => None,
-            };
-            if let Some(f) = slowest_hz {
-                if e.average_s * f < 10.0 {
-                    warnings.push(format!(
-                        "experiment.window = \"hann\" spans only {:.2} periods of the slowest modulation ({f} Hz): below 10 periods it leaks more than 0.1 mdeg; use boxcar or average longer",
-                        e.average_s * f
-                    ));
-                }
-            }
-        }
+        // A Hann window over few modulation periods is read exactly: its leak is computed from
+        // the window and removed (the stage-2 and table leaks), so no warning is due (one
+        // claimed "more than 0.1 mdeg" where the reading was within 2e-6 mdeg).
     }
 
     /// The dump's rules. Its window is weighed against the point's run only when the rest of

@@ -796,18 +796,6 @@ fn cases() -> Vec<Case> {
                 "10.6 mechanical time constants",
             ],
         ),
-        case(
-            "hann over few modulation periods warns",
-            set(
-                &set(&r, "experiment", "window", "\"hann\"").0,
-                "experiment",
-                "average_s",
-                "20.0",
-            )
-            .0,
-            Warning,
-            &["experiment.window", "hann", "10 periods"],
-        ),
         invalid(
             "rotating rate above the cutoff",
             set(&r, "experiment", "rates_dps", "[25.0, 1e5]"),
