@@ -33,7 +33,7 @@ fn temp_sibling(path: &Path, suffix: &str) -> Result<NamedTempFile, IoError> {
         .tempfile_in(&dir)
         .map_err(|source| IoError::TempCreate {
             path: path.to_path_buf(),
-            source,
+            reason: source,
         })
 }
 
@@ -42,7 +42,7 @@ fn temp_sibling(path: &Path, suffix: &str) -> Result<NamedTempFile, IoError> {
 fn persist(tmp: NamedTempFile, path: &Path) -> Result<(), IoError> {
     let write_err = |source| IoError::Write {
         path: path.to_path_buf(),
-        source,
+        reason: source,
     };
     // Re-open by path: a producer may have recreated the file instead of writing our handle.
     File::open(tmp.path())
@@ -57,7 +57,7 @@ fn persist(tmp: NamedTempFile, path: &Path) -> Result<(), IoError> {
     }
     tmp.persist(path).map_err(|e| IoError::Persist {
         path: path.to_path_buf(),
-        source: e.error,
+        reason: e.error,
     })?;
     #[cfg(unix)]
     if let Ok((dir, _)) = split(path) {
@@ -79,7 +79,7 @@ where
         fill(&mut w)?;
         w.flush().map_err(|source| IoError::Write {
             path: path.to_path_buf(),
-            source,
+            reason: source,
         })?;
     }
     persist(tmp, path)
@@ -90,7 +90,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
     atomic_stream(path, |w| {
         w.write_all(bytes).map_err(|source| IoError::Write {
             path: path.to_path_buf(),
-            source,
+            reason: source,
         })
     })
 }
@@ -110,7 +110,7 @@ where
     let tmp = temp_sibling(path, &suffix)?;
     produce(tmp.path()).map_err(|source| IoError::Producer {
         path: path.to_path_buf(),
-        source,
+        reason: source,
     })?;
     persist(tmp, path)
 }

@@ -61,7 +61,7 @@ impl<W: std::io::Write> CsvSink<W> {
     fn err(&self, source: csv::Error) -> IoError {
         IoError::Csv {
             path: self.path.clone(),
-            source,
+            reason: source,
         }
     }
 
@@ -80,7 +80,7 @@ impl<W: std::io::Write> CsvSink<W> {
         format_f64(x, &mut self.buf);
         self.wtr.write_field(&self.buf).map_err(|e| IoError::Csv {
             path: self.path.clone(),
-            source: e,
+            reason: e,
         })
     }
 
@@ -90,7 +90,7 @@ impl<W: std::io::Write> CsvSink<W> {
         let _ = write!(self.buf, "{i}");
         self.wtr.write_field(&self.buf).map_err(|e| IoError::Csv {
             path: self.path.clone(),
-            source: e,
+            reason: e,
         })
     }
 
@@ -105,7 +105,7 @@ impl<W: std::io::Write> CsvSink<W> {
     pub(crate) fn finish(mut self) -> Result<(), IoError> {
         self.wtr.flush().map_err(|source| IoError::Write {
             path: self.path.clone(),
-            source,
+            reason: source,
         })
     }
 }

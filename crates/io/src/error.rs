@@ -13,44 +13,44 @@ pub enum IoError {
         path: PathBuf,
     },
     /// The temporary file next to the target could not be created (missing directory, permissions).
-    #[error("cannot create a temporary file next to {}: {source}", .path.display())]
+    #[error("cannot create a temporary file next to {}: {reason}", .path.display())]
     TempCreate {
         /// Requested target.
         path: PathBuf,
         /// Underlying OS error.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// Writing, flushing or syncing the temporary file failed.
-    #[error("cannot write data for {}: {source}", .path.display())]
+    #[error("cannot write data for {}: {reason}", .path.display())]
     Write {
         /// Requested target.
         path: PathBuf,
         /// Underlying OS error.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// Renaming the finished temporary file over the target failed.
-    #[error("cannot move the finished temporary file onto {}: {source}", .path.display())]
+    #[error("cannot move the finished temporary file onto {}: {reason}", .path.display())]
     Persist {
         /// Requested target.
         path: PathBuf,
         /// Underlying OS error.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// JSON serialisation failed (e.g. a map with non-string keys).
-    #[error("cannot serialise JSON for {}: {source}", .path.display())]
+    #[error("cannot serialise JSON for {}: {reason}", .path.display())]
     Json {
         /// Requested target.
         path: PathBuf,
         /// serde_json's error.
-        source: serde_json::Error,
+        reason: serde_json::Error,
     },
     /// The csv crate failed while writing a record.
-    #[error("cannot write CSV {}: {source}", .path.display())]
+    #[error("cannot write CSV {}: {reason}", .path.display())]
     Csv {
         /// Requested target.
         path: PathBuf,
         /// csv's error.
-        source: csv::Error,
+        reason: csv::Error,
     },
     /// A CSV row does not have as many cells as the header.
     #[error("cannot write CSV {}: row {row} has {got} cells but the header has {expected}", .path.display())]
@@ -65,12 +65,12 @@ pub enum IoError {
         expected: usize,
     },
     /// hound failed while writing the WAV.
-    #[error("cannot write WAV {}: {source}", .path.display())]
+    #[error("cannot write WAV {}: {reason}", .path.display())]
     Wav {
         /// Requested target.
         path: PathBuf,
         /// hound's error.
-        source: hound::Error,
+        reason: hound::Error,
     },
     /// The WAV request is malformed (no channels, unequal lengths, zero rate...).
     #[error("cannot write WAV {}: {reason}", .path.display())]
@@ -107,12 +107,12 @@ pub enum IoError {
         reason: String,
     },
     /// A caller-supplied producer (e.g. a PNG renderer) failed while filling the temporary file.
-    #[error("cannot produce {}: {source}", .path.display())]
+    #[error("cannot produce {}: {reason}", .path.display())]
     Producer {
         /// Requested target.
         path: PathBuf,
         /// The producer's error.
-        source: Box<dyn std::error::Error + Send + Sync>,
+        reason: Box<dyn std::error::Error + Send + Sync>,
     },
     /// A recording cannot be read back (missing, malformed, or not what its metadata says).
     #[error("cannot read {}: {reason}", .path.display())]

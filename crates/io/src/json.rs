@@ -11,11 +11,11 @@ pub fn write_json<T: serde::Serialize + ?Sized>(path: &Path, value: &T) -> Resul
     atomic_stream(path, |w| {
         serde_json::to_writer_pretty(&mut *w, value).map_err(|source| IoError::Json {
             path: path.to_path_buf(),
-            source,
+            reason: source,
         })?;
         w.write_all(b"\n").map_err(|source| IoError::Write {
             path: path.to_path_buf(),
-            source,
+            reason: source,
         })
     })
 }

@@ -198,7 +198,7 @@ impl SignalRecorder {
         headers.extend(self.names.iter().cloned());
         let io_err = |source| IoError::Write {
             path: csv_path.to_path_buf(),
-            source,
+            reason: source,
         };
         atomic_stream(csv_path, |w| {
             // The header through the csv crate (its quoting rules), the rows by hand.
@@ -207,7 +207,7 @@ impl SignalRecorder {
                 .and_then(|_| head.flush().map_err(csv::Error::from))
                 .map_err(|source| IoError::Csv {
                     path: csv_path.to_path_buf(),
-                    source,
+                    reason: source,
                 })?;
             let head = head.into_inner().map_err(|e| io_err(e.into_error()))?;
             w.write_all(&head).map_err(io_err)?;

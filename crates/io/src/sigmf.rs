@@ -264,7 +264,7 @@ where
         };
         fill(&mut sink).map_err(|source| IoError::Write {
             path: path.to_path_buf(),
-            source,
+            reason: source,
         })?;
         digest = to_hex(&sink.hasher.finalize());
         Ok(())

@@ -110,7 +110,7 @@ pub(crate) fn write_interleaved<F: Fn(usize, usize) -> f64>(
     };
     let wav_err = |source| IoError::Wav {
         path: path.to_path_buf(),
-        source,
+        reason: source,
     };
     atomic_stream(path, |w| {
         let mut ww = hound::WavWriter::new(w, spec).map_err(wav_err)?;

@@ -176,3 +176,22 @@ fn recorder_gaps_are_nan_and_a_rate_no_wav_holds_writes_no_wav() {
         ["x.csv", "x.sigmf-data", "x.sigmf-meta"]
     );
 }
+
+/// An error's reason is said once: in its message, not again as its source (a CLI printing
+/// the chain showed every disk error twice).
+#[test]
+fn an_io_error_says_its_reason_once() {
+    use std::error::Error;
+    let e = IoError::Write {
+        path: "out/x.csv".into(),
+        reason: std::io::Error::other("No space left on device"),
+    };
+    assert!(e.source().is_none());
+    let mut chain = e.to_string();
+    let mut s = e.source();
+    while let Some(x) = s {
+        chain += &format!(": {x}");
+        s = x.source();
+    }
+    assert_eq!(chain.matches("No space left").count(), 1, "{chain}");
+}

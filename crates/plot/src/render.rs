@@ -102,7 +102,7 @@ where
     })();
     drawn.map_err(|source| gyroemu_io::IoError::Producer {
         path: "<memory>".into(),
-        source,
+        reason: source,
     })?;
     Ok(if k == 1 {
         buf

@@ -12,7 +12,7 @@ pub enum ReportError {
     #[error(transparent)]
     Config(#[from] ConfigError),
     /// The emulation failed.
-    #[error("emulation failed: {0}")]
+    #[error(transparent)]
     Sweep(#[from] SweepError),
     /// Writing a file failed.
     #[error(transparent)]
@@ -25,28 +25,28 @@ pub enum ReportError {
     #[error("{0}")]
     Unreliable(String),
     /// Deleting a stale file failed.
-    #[error("cannot delete `{path}`: {source}")]
+    #[error("cannot delete `{path}`: {reason}")]
     Remove {
         /// The file.
         path: std::path::PathBuf,
         /// Why.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// Creating a folder failed.
-    #[error("cannot create `{path}`: {source}")]
+    #[error("cannot create `{path}`: {reason}")]
     Dir {
         /// The folder.
         path: std::path::PathBuf,
         /// Why.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
 }
 
 /// Creates `dir` (and its parents).
 pub(crate) fn create_dir(dir: &std::path::Path) -> Result<(), ReportError> {
-    std::fs::create_dir_all(dir).map_err(|source| ReportError::Dir {
+    std::fs::create_dir_all(dir).map_err(|reason| ReportError::Dir {
         path: dir.to_path_buf(),
-        source,
+        reason,
     })
 }
 

@@ -49,7 +49,7 @@ pub fn write_selfcal(
         }
         std::fs::remove_file(&p).map_err(|source| ReportError::Remove {
             path: p.clone(),
-            source,
+            reason: source,
         })?;
         removed.push(p);
     }
