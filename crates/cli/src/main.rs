@@ -140,7 +140,7 @@ enum Command {
         #[arg(long)]
         preset: Option<String>,
         /// List the presets.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "preset")]
         list: bool,
         /// Print FILE with every key filled in: the derived defaults and their rules.
         #[arg(long, value_name = "FILE", conflicts_with_all = ["preset", "list"])]

@@ -55,6 +55,13 @@ fn every_preset_prints_a_config_that_parses_and_validates() {
         gyroemu(&["config", "--preset", "nope"]).status.code(),
         Some(2)
     );
+    // With --list the preset was ignored, an unknown one included (exit 0).
+    assert_eq!(
+        gyroemu(&["config", "--preset", "nope", "--list"])
+            .status
+            .code(),
+        Some(2)
+    );
 }
 
 fn run_config(text: &str, dir: &Path, extra: &[&str]) -> Output {
@@ -456,4 +463,52 @@ fn config_resolved_prints_the_complete_config_with_its_rules() {
         assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
         assert!(stderr(&o).contains(needle), "{}", stderr(&o));
     }
+}
+
+#[test]
+fn reproduce_refuses_preset_folders_it_cannot_own_before_any_sample() {
+    // A file where a preset's folder goes: named, exit 2, and no folder made (it exited 1
+    // after making three).
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("baw-rotating"), "x").unwrap();
+    let o = gyroemu(&["reproduce", "--quick", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("baw-rotating` is a file"),
+        "{}",
+        stderr(&o)
+    );
+    let mut left: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["baw-rotating"]);
+    // A preset folder locked by a live gyroemu (this test's own pid, this host): refused, its
+    // files untouched (reproduce wrote into it).
+    let out = dir.path().join("locked");
+    let preset = out.join("m2tfg-rotating");
+    std::fs::create_dir_all(&preset).unwrap();
+    let host = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap_or_default();
+    let lock = format!(
+        r#"{{"pid": {}, "host": "{}", "command": "gyroemu run x.toml", "since_unix_s": 0, "since_utc": "1970-01-01 00:00:00 UTC"}}"#,
+        std::process::id(),
+        host.trim()
+    );
+    std::fs::write(preset.join("gyroemu.lock"), &lock).unwrap();
+    let o = gyroemu(&["reproduce", "--quick", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("in use by another gyroemu"),
+        "{}",
+        stderr(&o)
+    );
+    let mut left: Vec<_> = std::fs::read_dir(&preset)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["gyroemu.lock"]);
 }

@@ -77,6 +77,11 @@ impl ReproducePlan {
     }
 
     /// A config of the plan (to measure the chain's throughput on).
+    /// The folders, below the output folder, that each preset's files go into.
+    pub fn preset_folders(&self) -> Vec<&'static str> {
+        self.jobs.iter().map(|j| j.preset).collect()
+    }
+
     pub fn first_config(&self) -> &Config {
         &self.jobs[0].cfg
     }
