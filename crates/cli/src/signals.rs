@@ -28,10 +28,14 @@ pub fn install(graceful: bool) -> Arc<AtomicBool> {
                     return;
                 }
                 let marked = gyroemu_runs::abort_now();
+                let removed = gyroemu_io::remove_temporaries();
                 for m in &marked {
                     note!("\ninterrupted: `{}` marked interrupted", m.display());
                 }
-                note!("\ninterrupted: exiting now");
+                note!(
+                    "\ninterrupted: exiting now; the files already written are complete, and the \
+                     {removed} being written were removed (none is left half-written)"
+                );
                 std::process::exit(EXIT_INTERRUPTED.into());
             });
             if let Err(e) = installed {

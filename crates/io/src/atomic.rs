@@ -23,6 +23,40 @@ fn split(path: &Path) -> Result<(PathBuf, String), IoError> {
     Ok((dir, name))
 }
 
+/// The temporary files being written, so that an abort (Ctrl-C exits at once, skipping the
+/// destructors that delete them) can remove them: they were left behind as `.x.tmpXXXXXX`.
+static LIVE: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Keeps a temporary file's path in [`LIVE`] while it exists.
+struct Registered(PathBuf);
+
+impl Registered {
+    fn new(path: &Path) -> Self {
+        live().push(path.to_path_buf());
+        Self(path.to_path_buf())
+    }
+}
+
+impl Drop for Registered {
+    fn drop(&mut self) {
+        live().retain(|p| p != &self.0);
+    }
+}
+
+fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    // A writer that panicked left the list as it was: still the right list.
+    LIVE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Deletes every temporary file this process is writing (for an exit that skips their
+/// destructors); returns how many. The targets are untouched.
+pub fn remove_temporaries() -> usize {
+    let list = live();
+    list.iter()
+        .filter(|p| std::fs::remove_file(p).is_ok())
+        .count()
+}
+
 /// Creates `.<name>.tmpXXXXXX<suffix>` in the target's directory (same filesystem, so the final
 /// rename is atomic). The temp file is deleted on drop unless persisted.
 fn temp_sibling(path: &Path, suffix: &str) -> Result<NamedTempFile, IoError> {
@@ -74,6 +108,7 @@ where
     F: FnOnce(&mut BufWriter<&mut File>) -> Result<(), IoError>,
 {
     let mut tmp = temp_sibling(path, "")?;
+    let _live = Registered::new(tmp.path());
     {
         let mut w = BufWriter::new(tmp.as_file_mut());
         fill(&mut w)?;
@@ -108,6 +143,7 @@ where
         .map(|e| format!(".{}", e.to_string_lossy()))
         .unwrap_or_default();
     let tmp = temp_sibling(path, &suffix)?;
+    let _live = Registered::new(tmp.path());
     produce(tmp.path()).map_err(|source| IoError::Producer {
         path: path.to_path_buf(),
         reason: source,
