@@ -340,3 +340,21 @@ fn rate_0_is_refused_in_a_rotating_run_and_left_out_of_selfcals_rotating_sweep()
     assert_eq!(table.experiment.rates_dps, [0.0, 50.0, 100.0, 150.0]);
     validate_selfcal(&cor).unwrap();
 }
+
+#[test]
+fn selfcal_lists_its_sweeps_problems_with_the_configs_own() {
+    // A low-pass above the output Nyquist (the config's own problem) and an averaging time
+    // shorter than half a period of 25 deg/s (the rotating sweep's): one message with both;
+    // the second used to appear only once the first was fixed.
+    let mut c = fast_cfg(&[25.0, 100.0, 150.0], 2.0);
+    c.experiment.kind = gyroemu::config::ExperimentKind::Coriolis;
+    c.board.lpf_cutoff_hz = Some(1e6);
+    let e = validate_selfcal(&c).unwrap_err();
+    let keys: Vec<Option<String>> = e.problems().into_iter().map(|p| p.key).collect();
+    assert!(keys.contains(&Some("board.lpf_cutoff_hz".into())), "{e}");
+    assert!(keys.contains(&Some("experiment.average_s".into())), "{e}");
+    assert!(
+        e.to_string().contains("in the rotating sweep of selfcal"),
+        "{e}"
+    );
+}

@@ -153,8 +153,8 @@ pub fn drifted(cfg: &Config, delta_t_k: f64) -> Config {
 
 /// Validates every config `selfcal` will run (both sweeps, and each drifted device) before
 /// any sample is computed; returns the warnings they add to those of `cfg.validate()`, or
-/// every problem in one error. The derived configs are validated only once `cfg` itself is
-/// valid (they would repeat its problems).
+/// every problem in one error (the sweeps' under keys `cfg`'s own problems do not name; the
+/// analyses' configs only once `cfg` is valid).
 pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
     let base = cfg.validate();
     // A slope needs two distinct rates besides zero, and its 95 % interval a third (the
@@ -177,17 +177,29 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
     });
     let base = match (base, rates) {
         (Ok(w), None) => w,
-        (Ok(_), Some(e)) => return Err(e),
-        // Its own problems first; the rates rule only if it names another key's problem.
-        (Err(e), rates) => {
-            let mut list = e.problems();
+        // Its own problems first; the rates rule only if it names another key's problem; then
+        // those of the two sweeps under keys not named yet, so that every problem is in one
+        // message (fixing the low-pass used to reveal the sweeps' refusal only afterwards).
+        (base, rates) => {
+            let mut list = base.err().map(|e| e.problems()).unwrap_or_default();
             if !list
                 .iter()
                 .any(|p| p.key.as_deref() == Some("experiment.rates_dps"))
             {
                 list.extend(rates);
             }
-            return Err(ConfigError::from_problems(list).unwrap_or(e));
+            let (rot, cor) = sweep_configs(cfg);
+            for (what, r) in [
+                ("rotating sweep", rot.validate()),
+                ("rate-table sweep", cor.validate()),
+            ] {
+                for p in r.err().map(|e| e.problems()).unwrap_or_default() {
+                    if !list.iter().any(|q| q.key == p.key) {
+                        list.push(p.map_details(|d| format!("{d} (in the {what} of selfcal)")));
+                    }
+                }
+            }
+            return Err(ConfigError::from_problems(list).expect("a problem was found"));
         }
     };
     let mut warnings = Vec::new();
