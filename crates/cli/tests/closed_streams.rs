@@ -1,6 +1,7 @@
 //! A run whose stderr or stdout has no reader (`2>&-`, `| head -1`) still finishes, writes its
 //! files and exits 0: a failed write of a message is not a failure of the run (it was a
-//! panic's exit 101 after every file had been written).
+//! panic's exit 101 after every file had been written). A full stdout and a dangling --out
+//! link are named in their errors.
 
 mod common;
 
@@ -41,4 +42,32 @@ fn a_run_with_no_reader_on_stderr_or_stdout_finishes_and_exits_0() {
         assert_eq!(status.code(), Some(0), "stderr closed: {closed_stderr}");
         assert!(out.join("results.csv").is_file());
     }
+}
+
+#[test]
+fn a_full_standard_output_and_a_dangling_out_link_are_named() {
+    // stdout on a full device: the error names the standard output (it said only "No space
+    // left on device").
+    if let Ok(full) = std::fs::File::create("/dev/full") {
+        let o = command(&["config", "--list"], &[])
+            .stdout(full)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1));
+        assert!(stderr(&o).contains("standard output"), "{}", stderr(&o));
+    }
+    // --out a symbolic link to nothing: named as such, exit 2 (it said "File exists").
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = config(dir.path(), "tiny.toml", TINY);
+    let link = dir.path().join("out");
+    std::os::unix::fs::symlink(dir.path().join("nowhere/x"), &link).unwrap();
+    let o = command(&["run", s(&cfg), "--out", s(&link)], &[])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("symbolic link to nothing"),
+        "{}",
+        stderr(&o)
+    );
 }

@@ -56,10 +56,16 @@ pub enum RunOutcome {
 
 /// Makes sure the output folder exists and is writable before any sample is computed.
 pub fn prepare_out(out: &Path) -> Result<(), RunError> {
-    // `create_dir_all` on a file says only "File exists".
+    // `create_dir_all` on a file, or on a symlink to nothing, says only "File exists".
     if out.exists() && !out.is_dir() {
         return Err(RunError::BadInput(format!(
             "output folder `{}` is a file, not a folder: choose another --out",
+            out.display()
+        )));
+    }
+    if !out.exists() && out.symlink_metadata().is_ok() {
+        return Err(RunError::BadInput(format!(
+            "output folder `{}` is a symbolic link to nothing: create its target or choose another --out",
             out.display()
         )));
     }
