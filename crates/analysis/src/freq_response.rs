@@ -174,8 +174,11 @@ pub fn frequency_response_from(cfg: &Config, mut measured: SteppedSine) -> Frequ
         }
         let why = match fit_resonance(&freqs, &h) {
             None => Err("no resonance is found in the data (a fitted f0^2 or damping that is not positive, or fewer than three finite points)".to_string()),
-            Some(fit) => unsupported(&fit, &freqs).map_or(Ok(fit), Err),
+            Some(fit) => unsupported(&fit).map_or(Ok(fit), Err),
         };
+        if let Some(caveat) = why.as_ref().ok().and_then(|f| unresolved(f, &freqs)) {
+            measured.warnings.push(format!("mode {}: {caveat}", m + 1));
+        }
         let fit = why
             .map_err(|why| {
                 measured.warnings.push(format!(
@@ -247,30 +250,33 @@ fn continuous(p: &ResonatorParams, f_hz: &[f64], m: usize) -> Vec<Complex64> {
         .collect()
 }
 
-/// Why a fit is not the resonance the data show, if it is not: its half-bandwidth shorter
-/// than the frequency step around its f0 (no swept point resolves it: a noisy fit ran away to
-/// Q = 7e20 with an f0 sigma of 0.4 Hz, 39 sigma off), or its gain far from the 1 the board's
-/// division by the chain leaves (-0.17 in that fit).
-fn unsupported(fit: &ResonanceFit, freqs: &[f64]) -> Option<String> {
+/// Why a fit is not the resonance the data show, if it is not: its gain far from the 1 the
+/// board's division by the chain leaves (a noisy fit ran away to Q = 7e20 with gain -0.17
+/// and an f0 sigma of 0.4 Hz, 39 sigma off).
+fn unsupported(fit: &ResonanceFit) -> Option<String> {
+    let gain = Complex64::new(fit.gain_re, fit.gain_im).norm();
+    (!(0.5..=2.0).contains(&gain)).then(|| {
+        format!(
+            "its gain is {gain:.3} where dividing out the chain leaves about 1: the model does not describe the data (noise or a response outside the mode model)"
+        )
+    })
+}
+
+/// The caveat of a fit narrower than the frequency step at its f0: no swept point resolves
+/// it, so its f0 and Q rest on the skirts (exact without noise, fragile with it).
+fn unresolved(fit: &ResonanceFit, freqs: &[f64]) -> Option<String> {
     let (f0, bw) = (fit.f0_hz, fit.f0_hz / (2.0 * fit.q));
     let step = freqs
         .windows(2)
         .filter(|w| w[0] <= f0 && f0 <= w[1])
         .map(|w| w[1] - w[0])
         .fold(0.0, f64::max);
-    if bw < step {
-        return Some(format!(
-            "its half-bandwidth ({bw:.3e} Hz, Q {:.3e}) is shorter than the frequency step at its f0 ({step:.3e} Hz at {f0} Hz), so no swept point resolves it; raise sweep.points, narrow the span or lower the noise",
+    (bw < step).then(|| {
+        format!(
+            "its half-bandwidth ({bw:.3e} Hz, Q {:.3e}) is shorter than the frequency step at its f0 ({step:.3e} Hz at {f0} Hz): no swept point resolves it, so its f0 and Q rest on the skirts; raise sweep.points or narrow the span",
             fit.q
-        ));
-    }
-    let gain = Complex64::new(fit.gain_re, fit.gain_im).norm();
-    if !(0.5..=2.0).contains(&gain) {
-        return Some(format!(
-            "its gain is {gain:.3} where dividing out the chain leaves about 1: the model does not describe the data (noise or a response outside the mode model)"
-        ));
-    }
-    None
+        )
+    })
 }
 
 /// Runs `gyroemu sweep` on `cfg` (validated with `validate_sweep`): the measurement as one
