@@ -296,7 +296,11 @@ fn selfcal_refuses_too_few_distinct_rates_naming_the_key() {
         &[50.0, 100.0],
         &[0.0, 50.0, 100.0, 50.0],
     ] {
-        let e = validate_selfcal(&fast_cfg(rates, 7.2)).unwrap_err();
+        // selfcal runs both sweeps whatever the kind; as a Coriolis config rate 0 is not the
+        // rotating run's own refusal.
+        let mut c = fast_cfg(rates, 7.2);
+        c.experiment.kind = gyroemu::config::ExperimentKind::Coriolis;
+        let e = validate_selfcal(&c).unwrap_err();
         assert_eq!(
             e.key.as_deref(),
             Some("experiment.rates_dps"),
