@@ -13,7 +13,7 @@ use crate::stepped_sine::{run_stepped_sine, SteppedSine};
 use gyroemu_config::Config;
 use gyroemu_core::Complex64;
 use gyroemu_experiment::{Reporter, SweepError};
-use gyroemu_resonator::{hold_response, Resonator, ResonatorParams};
+use gyroemu_resonator::{continuous_steady_state, hold_response, Resonator, ResonatorParams};
 use nalgebra::Matrix4;
 use serde::Serialize;
 
@@ -231,22 +231,13 @@ pub fn frequency_response_from(cfg: &Config, mut measured: SteppedSine) -> Frequ
 /// and the continuous-drive responses, the hold's bias is stated.
 pub const HOLD_BIAS_WARNED: f64 = 1e-2;
 
-/// Mode `m`'s velocity per force on mode `m` under a continuous drive at each of `f_hz`: the
-/// 2 x 2 plant `j w (K - w^2 + j w C)^-1` (unit masses, the coupling in K), for the hold's bias.
+/// Mode `m`'s velocity per force on mode `m` under a continuous drive at each of `f_hz` (the
+/// plant at rest, no hold), for the hold's bias: `held_response` without the hold.
 fn continuous(p: &ResonatorParams, f_hz: &[f64], m: usize) -> Vec<Complex64> {
-    let tau = core::f64::consts::TAU;
-    let (w1, w2) = (tau * p.mode1.f0_hz, tau * p.mode2.f0_hz);
-    let k = p.quadrature_coupling_rad2_s2;
+    let mut force = [Complex64::new(0.0, 0.0); 2];
+    force[m] = Complex64::new(1.0, 0.0);
     f_hz.iter()
-        .map(|&f| {
-            let w = tau * f;
-            let jw = Complex64::new(0.0, w);
-            let d1 = Complex64::new(w1 * w1 - w * w, w * w1 / p.mode1.q);
-            let d2 = Complex64::new(w2 * w2 - w * w, w * w2 / p.mode2.q);
-            // The diagonal of the inverse of [[d1, k], [k, d2]].
-            let det = d1 * d2 - k * k;
-            jw * if m == 0 { d2 } else { d1 } / det
-        })
+        .map(|&f| continuous_steady_state(p, 0.0, f, force)[2 + m])
         .collect()
 }
 
