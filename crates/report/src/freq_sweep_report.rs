@@ -4,7 +4,7 @@
 //! written atomically.
 
 use crate::error::{create_dir, ReportError};
-use crate::sweep_report::health_json;
+use crate::sweep_report::{health_json, with_config_warnings};
 use gyroemu_analysis::freq_response::{FrequencyResponse, ModeCheck};
 use gyroemu_analysis::resonance_fit::ResonanceFit;
 use gyroemu_board::Health;
@@ -182,7 +182,7 @@ pub fn freq_sweep_summary(cfg: &Config, r: &FrequencyResponse) -> serde_json::Va
         "sweep": cfg.sweep_resolved(),
         "converter_counts": health_json(&counts),
         "problems": r.measured.problems,
-        "warnings": with_sweep_config_warnings(cfg, &r.measured.warnings),
+        "warnings": with_config_warnings(cfg.validate_sweep(), &r.measured.warnings),
         "config": cfg,
     })
 }
@@ -276,12 +276,4 @@ pub fn write_freq_sweep(
     write_json(&paths[1], &freq_sweep_summary(cfg, r))?;
     render_panels_png(&bode_title(r), &bode_panels(r), 1, 1400, 1300, &paths[2])?;
     Ok(paths)
-}
-
-/// The sweep config's warnings (validation's, printed before the run) followed by the run's,
-/// as `summary.json` lists them.
-fn with_sweep_config_warnings(cfg: &Config, run: &[String]) -> Vec<String> {
-    let mut w = cfg.validate_sweep().unwrap_or_default();
-    w.extend(run.iter().cloned());
-    w
 }

@@ -107,7 +107,7 @@ fn write_selfcal_files(
             "coriolis": health_json(&core.coriolis.health),
         },
         "problems": core.rotating.problems.iter().chain(&core.coriolis.problems).collect::<Vec<_>>(),
-        "warnings": with_config_warnings(cfg, &core.rotating.warnings.iter().cloned().chain(core.coriolis.warnings.iter().cloned()).chain(allan.iter().flat_map(|a| a.warnings())).collect::<Vec<_>>()),
+        "warnings": with_config_warnings(cfg.validate(), &core.rotating.warnings.iter().cloned().chain(core.coriolis.warnings.iter().cloned()).chain(allan.iter().flat_map(|a| a.warnings())).collect::<Vec<_>>()),
         "allan": allan,
         "error_vs_averaging_time": taus,
         "drift": drift,

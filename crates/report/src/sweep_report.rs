@@ -107,16 +107,19 @@ pub fn summary(cfg: &Config, r: &SweepResult) -> serde_json::Value {
         "point_samples_emulated": r.point_samples,
         "converter_counts": health_json(&r.health),
         "problems": r.problems,
-        "warnings": with_config_warnings(cfg, &r.warnings),
+        "warnings": with_config_warnings(cfg.validate(), &r.warnings),
         "config": cfg,
     })
 }
 
-/// The config's own warnings (validation's, printed before the run) followed by `run`'s: a
-/// results file read without the terminal's log still carries every caveat on its numbers
-/// (an ADC's rounding, a folded mixer product, the DAC's hold).
-pub fn with_config_warnings(cfg: &Config, run: &[String]) -> Vec<String> {
-    let mut w = cfg.validate().unwrap_or_default();
+/// The config's own warnings (`validated`: what its validation, printed before the run, gave)
+/// followed by `run`'s: a results file read without the terminal's log still carries every
+/// caveat on its numbers (an ADC's rounding, a folded mixer product, the DAC's hold).
+pub fn with_config_warnings(
+    validated: Result<Vec<String>, gyroemu_config::ConfigError>,
+    run: &[String],
+) -> Vec<String> {
+    let mut w = validated.unwrap_or_default();
     w.extend(run.iter().cloned());
     w
 }
