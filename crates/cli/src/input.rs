@@ -16,13 +16,8 @@ pub const MAX_CONFIG_BYTES: u64 = 16 << 20;
 
 /// Reads a config file's text: readable, at most [`MAX_CONFIG_BYTES`], UTF-8.
 pub fn read_config_text(path: &Path) -> Result<String> {
-    use std::io::Read;
-    let cannot =
-        |e: std::io::Error| BadInput(format!("cannot read config `{}`: {e}", path.display()));
-    let mut bytes = Vec::new();
-    std::fs::File::open(path)
-        .and_then(|f| f.take(MAX_CONFIG_BYTES + 1).read_to_end(&mut bytes))
-        .map_err(cannot)?;
+    let bytes = gyroemu_io::read_capped(path, MAX_CONFIG_BYTES)
+        .map_err(|e| BadInput(format!("cannot read config `{}`: {e}", path.display())))?;
     if bytes.len() as u64 > MAX_CONFIG_BYTES {
         return Err(BadInput(format!(
             "config `{}` is larger than {} MiB: not a gyroemu config (a preset is about 3 kB)",

@@ -132,26 +132,41 @@ fn read_bytes(path: &Path, cap: u64, beyond: &str) -> Result<Vec<u8>, IoError> {
     let io = |e: std::io::Error| read_err(path, e.to_string());
     let too_big = || read_err(path, format!("more than {cap} bytes: {beyond}"));
     // Stat before opening: opening a device may block or act.
-    let kind = std::fs::metadata(path).map_err(io)?.file_type();
-    if !(kind.is_file() || is_fifo(&kind)) {
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !(meta.is_file() || is_fifo(&meta.file_type())) {
         return Err(read_err(
             path,
             "not a regular file (nor a FIFO): a device such as /dev/zero may never end",
         ));
     }
-    let file = std::fs::File::open(path).map_err(io)?;
-    let size = file.metadata().map_err(io)?.len();
-    if size > cap {
+    // A regular file is refused by its size, unread.
+    if meta.len() > cap {
         return Err(too_big());
     }
-    let mut bytes = Vec::new();
-    bytes
-        .try_reserve_exact(usize::try_from(size).unwrap_or(usize::MAX))
-        .map_err(|_| read_err(path, format!("{size} bytes do not fit in memory")))?;
-    std::io::Read::read_to_end(&mut std::io::Read::take(file, cap + 1), &mut bytes).map_err(io)?;
+    let bytes = read_capped(path, cap).map_err(io)?;
     if bytes.len() as u64 > cap {
         return Err(too_big());
     }
+    Ok(bytes)
+}
+
+/// Reads `path` up to `cap` + 1 bytes: a longer file, or a stream that never ends, comes back
+/// one byte over `cap`, which tells the caller it is too long without reading the rest. Room
+/// for a regular file's bytes is reserved at once (out of memory is an error, not an abort).
+pub fn read_capped(path: &Path, cap: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let file = std::fs::File::open(path)?;
+    let want = file.metadata()?.len().min(cap.saturating_add(1));
+    let mut bytes = Vec::new();
+    bytes
+        .try_reserve_exact(usize::try_from(want).unwrap_or(usize::MAX))
+        .map_err(|_| {
+            std::io::Error::new(
+                std::io::ErrorKind::OutOfMemory,
+                format!("{want} bytes do not fit in memory"),
+            )
+        })?;
+    file.take(cap.saturating_add(1)).read_to_end(&mut bytes)?;
     Ok(bytes)
 }
 

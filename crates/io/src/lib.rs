@@ -18,7 +18,7 @@ mod wav;
 
 pub use atomic::{remove_temporaries, write_atomic, write_atomic_via};
 pub use csv_table::{format_f64, write_csv, CsvCell, CsvTable};
-pub use dump::{dump_source, read_csv_dump, read_dump, read_sigmf, Dump, DumpSource};
+pub use dump::{dump_source, read_capped, read_csv_dump, read_dump, read_sigmf, Dump, DumpSource};
 pub use error::IoError;
 pub use json::write_json;
 pub use recorder::SignalRecorder;
