@@ -227,15 +227,15 @@ impl Config {
         for (i, &r) in e.rates_dps.iter().enumerate() {
             let key = format!("experiment.rates_dps[{i}]");
             let rotating = e.kind == ExperimentKind::Rotating;
-            if rotating && r == 0.0 {
-                // Refused here, not after the run: its read-out came out NaN, blamed on an
-                // overflow.
-                p.check(
-                    false,
+            // Refused here, not after the run: its read-out came out NaN, blamed on an overflow.
+            if rotating
+                && !p.check(
+                    r != 0.0,
                     &key,
                     r,
                     "a rotating run reads psi from the sidebands at +-Omega, and rate 0 has none: leave it out",
-                );
+                )
+            {
                 continue;
             }
             if p.finite(&key, r) && rotating && p.clean(&["board.lpf_cutoff_hz"]) {
