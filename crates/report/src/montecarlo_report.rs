@@ -86,6 +86,7 @@ pub fn lot_json(cfg: &Config, devices: &[DeviceResult], s: &LotSummary) -> Value
             warnings.push(w);
         }
     }
+    warnings.extend(spread_gaps(s));
     json!({
         "gyroemu_version": env!("CARGO_PKG_VERSION"),
         "devices": s.devices,
@@ -103,6 +104,24 @@ pub fn lot_json(cfg: &Config, devices: &[DeviceResult], s: &LotSummary) -> Value
         "warnings": warnings,
         "config": cfg,
     })
+}
+
+/// One line per error column whose spread leaves out reliable devices (their value there is
+/// not finite): its `n` alone would not tell a reader why it is short of the lot.
+fn spread_gaps(s: &LotSummary) -> Vec<String> {
+    let reliable = s.devices - s.unreliable.len();
+    s.errors
+        .iter()
+        .filter(|(_, sp)| sp.n < reliable)
+        .map(|(name, sp)| {
+            format!(
+                "{name}: {} of the {reliable} reliable devices have no finite value and are left \
+                 out of its spread (n = {})",
+                reliable - sp.n,
+                sp.n
+            )
+        })
+        .collect()
 }
 
 /// The finite headline errors of the reliable devices, in %.
@@ -271,4 +290,55 @@ pub fn write_lot(
     render_png(&histogram_figure(devices, &s), &hist)?;
     render_png(&percentiles_figure(devices, &s), &cdf)?;
     Ok((vec![csv, json, hist, cdf], s))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gyroemu_analysis::montecarlo::HEADLINE;
+
+    fn device(index: u64, values: Vec<f64>, problem: bool) -> DeviceResult {
+        DeviceResult {
+            index,
+            values,
+            problems: if problem {
+                vec!["refused".into()]
+            } else {
+                vec![]
+            },
+            warnings: vec![],
+            point_samples: 0,
+        }
+    }
+
+    #[test]
+    fn a_column_short_of_the_reliable_devices_is_named_with_its_count() {
+        let finite = vec![0.01; COLUMNS.len()];
+        // Device 1 is reliable but has no combined error; device 2 is unreliable (refused).
+        let other = COLUMNS
+            .iter()
+            .position(|c| c.name == "board_combined_relative_error")
+            .unwrap();
+        let mut gap = finite.clone();
+        gap[other] = f64::NAN;
+        let lot = [
+            device(0, finite.clone(), false),
+            device(1, gap, false),
+            device(2, finite.clone(), true),
+            device(3, finite, false),
+        ];
+        let s = LotSummary::of(&lot, 0.02);
+        let w = spread_gaps(&s);
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(
+            w[0].starts_with("board_combined_relative_error: 1 of the 3 reliable devices")
+                && w[0].contains("(n = 2)"),
+            "{}",
+            w[0]
+        );
+        // The unreliable device alone shortens no column: the lot's own count says so.
+        let whole = LotSummary::of(&lot[2..], 0.02);
+        assert!(spread_gaps(&whole).is_empty());
+        assert!(s.errors.iter().any(|(n, _)| *n == HEADLINE));
+    }
 }
