@@ -25,6 +25,24 @@ impl Rules {
         self.links.push((key, source));
     }
 
+    /// What a broken rule on `key` adds when its value is a derived default: parsing fills
+    /// such keys in, so the user may never have written the value the message quotes.
+    fn default_note(&self, key: &str) -> String {
+        let sources: Vec<&str> = self
+            .links
+            .iter()
+            .filter(|&&(d, _)| d == key)
+            .map(|&(_, s)| s)
+            .collect();
+        if sources.is_empty() {
+            return String::new();
+        }
+        format!(
+            " (this is the default derived from {}: set {key}, or change those)",
+            sources.join(", ")
+        )
+    }
+
     /// Whether `key` itself (exactly) has a problem.
     fn failed(&self, key: &str) -> bool {
         self.list.iter().any(|e| e.key.as_deref() == Some(key))
@@ -75,6 +93,7 @@ impl Rules {
             return false;
         }
         if !ok {
+            let rule = format!("{rule}{}", self.default_note(key));
             self.list.push(ConfigError::key(key, value, rule));
         }
         ok

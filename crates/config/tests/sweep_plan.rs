@@ -83,16 +83,27 @@ fn sweep_rules_apply_to_the_sweep_command_even_without_the_section() {
     assert!(c.validate().is_ok());
     let e = c.validate_sweep().unwrap_err();
     assert_eq!(e.key.as_deref(), Some("sweep.start_hz"), "{e}");
-}
-
-#[test]
-fn a_bad_device_key_is_reported_once_not_again_through_the_derived_sweep() {
-    let text = preset_text("m2tfg-sweep")
-        .unwrap()
-        .replace("q = 36000.0 ", "q = -1.0 ");
-    let e = parse_config(&text).unwrap().validate_sweep().unwrap_err();
-    let keys: Vec<String> = e.problems().into_iter().filter_map(|p| p.key).collect();
-    assert_eq!(keys, ["device.q"], "{e}");
+    // The user never wrote the value the message quotes: it says where it came from.
+    let text = e.to_string();
+    assert!(
+        text.contains("the default derived from") && text.contains("device.q"),
+        "{text}"
+    );
+    // A value of the user's own that breaks the rule is not called a default.
+    let own = parse_config(&format!(
+        "{}\n[sweep]\nstart_hz = -1.0\n",
+        preset_text("m2tfg-coriolis")
+            .unwrap()
+            .replace("q = 2000.0 ", "q = 5.0 ")
+    ))
+    .unwrap();
+    let e = own.validate_sweep().unwrap_err();
+    assert_eq!(e.key.as_deref(), Some("sweep.start_hz"), "{e}");
+    let start = e
+        .problems()
+        .into_iter()
+        .find(|p| p.key.as_deref() == Some("sweep.start_hz"));
+    assert!(!start.unwrap().to_string().contains("default"), "{e}");
 }
 
 /// A stepped sine whose mixer products the low-pass and the decimation do not remove is
