@@ -158,17 +158,21 @@ fn table(headers: &[&str], rows: Vec<Vec<f64>>) -> CsvTable {
 }
 
 fn points_table(core: &SelfcalCore) -> CsvTable {
+    // One row per rate-table point. The rotating sweep leaves rate 0 out (it has no sidebands),
+    // so its points are matched by rate, in order; a rate it did not run reads NaN there.
+    let mut rotating = core.rotating.points.iter().peekable();
     let rows = core
-        .rotating
+        .coriolis
         .points
         .iter()
-        .zip(&core.coriolis.points)
-        .map(|(r, c)| {
-            let paper = r.paper_i_deg.unwrap_or([f64::NAN; 2]);
+        .map(|c| {
+            let r = rotating.next_if(|r| r.rate_dps.to_bits() == c.rate_dps.to_bits());
+            let psi = r.map_or([f64::NAN; 2], |r| r.phase_deg);
+            let paper = r.and_then(|r| r.paper_i_deg).unwrap_or([f64::NAN; 2]);
             vec![
-                r.rate_dps,
-                r.phase_deg[0],
-                r.phase_deg[1],
+                c.rate_dps,
+                psi[0],
+                psi[1],
                 paper[0],
                 paper[1],
                 c.phase_deg[0],
@@ -508,4 +512,43 @@ fn drift_figures(d: &[DriftPoint]) -> [Figure; 2] {
         &|p| Some(pct(p.open_loop.stale_relative_error)),
     ));
     [selfcal, stale]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gyroemu_analysis::selfcal::run_selfcal_core;
+    use gyroemu_config::presets::preset;
+
+    fn quiet(_: u64, _: u64) {}
+
+    #[test]
+    fn each_csv_row_holds_one_rate_from_both_sweeps_when_rate_0_is_listed() {
+        // The rotating sweep leaves rate 0 out; the rows had paired each rotating point with
+        // the rate-table point before it and lost the last one.
+        let mut c = preset("m2tfg-rotating").unwrap();
+        c.experiment.rates_dps = vec![0.0, 50.0, 100.0, 175.0];
+        c.experiment.average_s = 3.6;
+        c.experiment.settle_s = Some(0.8);
+        let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
+        assert_eq!(core.rotating.points.len(), 3);
+        let t = points_table(&core);
+        assert_eq!(t.rows.len(), 4);
+        let num = |cell: &CsvCell| match cell {
+            CsvCell::F64(v) => *v,
+            other => panic!("{other:?}"),
+        };
+        for (row, c) in t.rows.iter().zip(&core.coriolis.points) {
+            let rate = num(&row[0]);
+            assert_eq!(rate, c.rate_dps);
+            assert_eq!(num(&row[5]).to_bits(), c.phase_deg[0].to_bits());
+            match core.rotating.points.iter().find(|r| r.rate_dps == rate) {
+                Some(r) => assert_eq!(num(&row[1]).to_bits(), r.phase_deg[0].to_bits()),
+                None => assert!(rate == 0.0 && num(&row[1]).is_nan()),
+            }
+        }
+        // The rotating psi grows with the rate it was read at (about 2 Q Omega / w0).
+        let psi: Vec<f64> = t.rows[1..].iter().map(|r| num(&r[1])).collect();
+        assert!(psi.windows(2).all(|w| w[1] > w[0]), "{psi:?}");
+    }
 }
