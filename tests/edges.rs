@@ -125,6 +125,25 @@ fn a_dead_drive_refuses_both_modes_naming_the_dac_setting() {
 }
 
 #[test]
+fn a_dead_coriolis_channel_has_no_single_mixer_reading_either() {
+    // The same dead drive in a Coriolis run: the single-mixer DC of a refused channel was
+    // written as a clean 0 (read by Python as 0.0) beside the NaN phases.
+    let mut c = config("coriolis", 15e3, 2000.0, 1.0, 1.0, &[50.0, 100.0], 0.2);
+    c.board.dac_bits = Some(8);
+    c.drive.f1 = 1e-3;
+    c.drive.f2 = Some(1e-3);
+    let r = run(&c);
+    assert!(!r.problems.is_empty());
+    for p in &r.points {
+        assert!(p.phase_deg.iter().all(|x| x.is_nan()), "{p:?}");
+        assert!(
+            p.single_mixer_dc_v.unwrap().iter().all(|x| x.is_nan()),
+            "{p:?}"
+        );
+    }
+}
+
+#[test]
 fn an_underflowing_chain_gives_no_phase_instead_of_zero() {
     // Far below the refused range the products of the read-out underflow to exact zeros, and
     // atan2(0, 0) would read as a clean 0 degrees.

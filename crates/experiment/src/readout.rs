@@ -185,17 +185,18 @@ fn clipping_warnings(h: &Health) -> Vec<String> {
     w
 }
 
-/// `x` moved by a whole number of half turns into `(-pi/2, pi/2]`, and whether that number
-/// was odd.
-fn fold_half_turn(x: f64) -> (f64, bool) {
+/// `x` moved by a whole number of half turns into `(centre - pi/2, centre + pi/2]`, and
+/// whether that number was odd. `x` itself is moved (not `x - centre`), so a reading already on
+/// its branch keeps its bits.
+fn fold_half_turn(x: f64, centre: f64) -> (f64, bool) {
     use core::f64::consts::{FRAC_PI_2, PI};
-    let k = (x / PI).round();
+    let k = ((x - centre) / PI).round();
     let mut y = x - k * PI;
     let mut odd = k.rem_euclid(2.0) == 1.0;
-    if y <= -FRAC_PI_2 {
+    if y - centre <= -FRAC_PI_2 {
         y += PI;
         odd = !odd;
-    } else if y > FRAC_PI_2 {
+    } else if y - centre > FRAC_PI_2 {
         y -= PI;
         odd = !odd;
     }
@@ -356,18 +357,22 @@ pub fn post_process_with(
                         r.phase_deg[k] = f64::NAN;
                         continue;
                     }
-                    // (psi, alpha) and (psi + pi, alpha + pi) give the same sidebands. The
-                    // plant's psi lies in (-90, 90) degrees and the chain adds up to 180 more
-                    // (the low-pass near its cutoff), so the branch is chosen once the chain
-                    // is removed, not before. Mode 2's psi also carries the phase shifter's
-                    // error x (psi_plant + x): its branch is centred there (at 20000 deg/s
-                    // and x = 5 deg it was read 180 degrees off).
-                    let shift = match mode {
-                        Mode::One => 0.0,
-                        Mode::Two => cfg.board.phase_shifter_error_deg * DEG,
+                    // (psi, alpha) and (psi + pi, alpha + pi) give the same sidebands, so the
+                    // read-out fixes psi only modulo a half turn. The branch is chosen once the
+                    // chain (up to 180 degrees near the low-pass cutoff) is removed, centred on
+                    // the point's exact theory: the plant's psi leaves (-90, 90) degrees with
+                    // the phase shifter's error (x = 5 deg at 20000 deg/s) or a strong
+                    // quadrature coupling (k12 Q / w0^2 = 2: +93.5 deg, read as -86.5). A
+                    // reading far from its theory still shows as an error of up to 90 deg.
+                    let shift = if r.theory_deg[k].is_finite() {
+                        r.theory_deg[k] * DEG
+                    } else {
+                        match mode {
+                            Mode::One => 0.0,
+                            Mode::Two => cfg.board.phase_shifter_error_deg * DEG,
+                        }
                     };
-                    let (psi, turned) = fold_half_turn(est.psi_rad - total - shift);
-                    let psi = psi + shift;
+                    let (psi, turned) = fold_half_turn(est.psi_rad - total, shift);
                     let a = if turned {
                         wrap_pi(est.alpha_rad + core::f64::consts::PI)
                     } else {
@@ -377,10 +382,9 @@ pub fn post_process_with(
                     raw[k] = (psi + total) / DEG;
                     alpha[k] = a / DEG;
                     // A real channel cannot tell the sign of the carrier (an inverting TIA
-                    // flips it): fold the paper-style reading into (-90, 90] degrees.
+                    // flips it): fold the paper-style reading onto psi's branch.
                     let p = paper_i_channel_psi_rad(c, s, mode) - total;
-                    paper[k] =
-                        (p - core::f64::consts::PI * (p / core::f64::consts::PI).round()) / DEG;
+                    paper[k] = fold_half_turn(p, shift).0 / DEG;
                 }
                 r.raw_psi_deg = Some(raw);
                 r.paper_i_deg = Some(paper);
@@ -436,6 +440,7 @@ pub fn post_process_with(
                     &mut r.raw_psi_deg,
                     &mut r.alpha_deg,
                     &mut r.table_lag_deg,
+                    &mut r.single_mixer_dc_v,
                 ]
                 .into_iter()
                 .flatten()
