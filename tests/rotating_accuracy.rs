@@ -5,7 +5,6 @@
 
 mod common;
 use common::*;
-use std::f64::consts::PI;
 
 const TOL_MDEG: f64 = 1.0;
 
@@ -187,69 +186,5 @@ fn a_hann_window_over_few_periods_reads_psi_exactly() {
         for k in 0..2 {
             assert!((p.phase_deg[k] - psi).abs() * 1e3 < 1e-3, "{p:?}");
         }
-    }
-}
-
-/// The plant psi of a rotating drive on a coupled device (THEORY.md sections 4 and 6 with the
-/// stiffness coupling k12 of `gyroemu_resonator`), solved here from the 2x2 phasor equations at
-/// each sideband, w0 + Omega and w0 - Omega: the drive cos(Omega t) cos(w0 t) on mode 1 and
-/// sin(Omega t) cos(w0 t) on mode 2 has sideband phasors (1/2, 1/2) and (-j/2, +j/2); the
-/// sidebands of each mode's velocity give psi = (arg(V-/M-) - arg(V+/M+)) / 2, known only
-/// modulo a half turn. Degrees.
-fn coupled_psi_deg(f0: [f64; 2], q: [f64; 2], k12: f64, rate_dps: f64) -> [f64; 2] {
-    use num_complex::Complex64 as C;
-    let w0 = 2.0 * PI * f0[0];
-    let om = rate_dps * DEG;
-    let velocity = |w: f64, f: [C; 2]| -> [C; 2] {
-        let d = |k: usize| {
-            let wk = 2.0 * PI * f0[k];
-            C::new(wk * wk - w * w, w * wk / q[k])
-        };
-        let (a, b, c, e) = (d(0), C::from(k12), C::from(k12), d(1));
-        let det = a * e - b * c;
-        let x = [(f[0] * e - b * f[1]) / det, (a * f[1] - c * f[0]) / det];
-        x.map(|x| C::new(0.0, w) * x)
-    };
-    let j = C::new(0.0, 1.0);
-    let plus = velocity(w0 + om, [C::from(0.5), -0.5 * j]);
-    let minus = velocity(w0 - om, [C::from(0.5), 0.5 * j]);
-    let m = [(C::from(1.0), C::from(1.0)), (-j, j)];
-    [0, 1].map(|k| 0.5 * ((minus[k] / m[k].1).arg() - (plus[k] / m[k].0).arg()) / DEG)
-}
-
-#[test]
-fn psi_past_90_degrees_on_a_strongly_coupled_device_is_read_on_its_theorys_branch() {
-    // k12 Q / w0^2 = 2 with the modes 7.5 Hz apart: mode 2's psi is about 91 to 96 degrees.
-    // It was read as -89 to -84 (folded into (-90, 90]) beside a theory column of +91 to +96,
-    // an error of -180 000 mdeg, exit 0.
-    let (f0, q, k12, split) = (15e3, 2000.0, 8_882_644.0, 7.5);
-    let rates = [25.0, 100.0, 175.0];
-    let mut cfg = config("rotating", f0, q, 1.0, 1.0, &rates, 8.0);
-    cfg.device.quadrature_coupling_rad2_s2 = k12;
-    cfg.device.mode2_f0_offset_hz = split;
-    cfg.validate().unwrap();
-    let r = run(&cfg);
-    for p in &r.points {
-        let want = coupled_psi_deg([f0, f0 + split], [q, q], k12, p.rate_dps);
-        for k in 0..2 {
-            // The same psi modulo a half turn (the DAC hold moves it by about 1.3 mdeg here),
-            // and on the same branch as the reported theory.
-            let d = p.phase_deg[k] - want[k];
-            let off = (d - 180.0 * (d / 180.0).round()) * 1e3;
-            assert!(
-                off.abs() < 2.0,
-                "rate {} mode {}: {off} mdeg",
-                p.rate_dps,
-                k + 1
-            );
-            let err = (p.phase_deg[k] - p.theory_deg[k]) * 1e3;
-            assert!(
-                err.abs() < 2.0,
-                "rate {} mode {}: {err} mdeg",
-                p.rate_dps,
-                k + 1
-            );
-        }
-        assert!(p.phase_deg[1] > 90.0, "{p:?}");
     }
 }

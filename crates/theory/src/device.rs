@@ -2,7 +2,7 @@
 //! it, ideal or not: the closed forms for an ideal device, else the continuous-time steady
 //! state of the imperfect plant read as THEORY.md section 6 reads it.
 
-use crate::closed_form::{coriolis_theta_rad, rate_table_gain, rotating_psi_rad};
+use crate::closed_form::{coriolis_theta_rad, rotating_psi_rad};
 use gyroemu_core::Complex64;
 use gyroemu_mixer::phase_fundamental;
 use gyroemu_resonator::{
@@ -213,30 +213,5 @@ impl DrivenDevice {
         let amp = x.map(|x| x.norm());
         let lag = x.map(|x| -(x * Complex64::new(0.0, 1.0)).arg());
         (amp, lag)
-    }
-
-    /// Small-signal phase amplitude per unit rate-table amplitude at `table_hz`, per mode
-    /// (rad per rad/s): the first-order model of THEORY.md section 3.
-    pub fn rate_table_gain(&self, table_hz: f64) -> [f64; 2] {
-        let p = &self.plant;
-        let [f1, f2] = self.drive;
-        let g = |a: f64, b: f64| {
-            rate_table_gain(self.f0(), p.mode1.q, p.angular_gain, a, b, table_hz).0
-        };
-        [g(f1, f2), g(f2, f1)]
-    }
-
-    /// Small-angle Coriolis slope per mode, rad per rad/s: 2 Q lambda / w0 times the drive ratio
-    /// of the other mode over this one.
-    pub fn coriolis_slope(&self) -> [f64; 2] {
-        let p = &self.plant;
-        let [f1, f2] = self.drive;
-        let g = 2.0 * p.mode1.q * p.angular_gain / (2.0 * core::f64::consts::PI * self.f0());
-        [g * f2 / f1, g * f1 / f2]
-    }
-
-    /// Small-angle rotating slope, rad per rad/s: 2 Q / w0 (both modes).
-    pub fn rotating_slope(&self) -> [f64; 2] {
-        [2.0 * self.plant.mode1.q / (2.0 * core::f64::consts::PI * self.f0()); 2]
     }
 }
