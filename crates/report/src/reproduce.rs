@@ -4,7 +4,7 @@
 use crate::dump_figures::write_dump_figures;
 use crate::dump_set::read_dump_set;
 use crate::error::{check_problems, create_dir, ReportError};
-use crate::sweep_report::{sweep_figure, theory_series, write_run};
+use crate::sweep_report::{line_span, sweep_figure, theory_abscissae, theory_series, write_run};
 use gyroemu_analysis::bandwidth::{
     bandwidth, BandwidthPoint, BANDWIDTH_AMPLITUDE_DPS, BANDWIDTH_FREQS_HZ,
 };
@@ -456,7 +456,8 @@ fn job_index(jobs: &[Job], name: &str) -> usize {
 /// against the excitation rate divided by lambda: the two coincide.
 fn fig6(cfg: &Config, cor: &SweepResult, rot: &SweepResult) -> Figure {
     let lambda = cfg.device.angular_gain;
-    let x_max = cor.points.iter().map(|p| p.rate_dps).fold(0.0, f64::max);
+    let rates: Vec<f64> = cor.points.iter().map(|p| p.rate_dps).collect();
+    let (lo, hi) = line_span(&rates);
     Figure::new(
         "Fig. 6: Coriolis and rotating excitation coincide (excitation axis / lambda)",
         "Rotation rate, or excitation rate / lambda (deg/s)",
@@ -474,5 +475,11 @@ fn fig6(cfg: &Config, cor: &SweepResult, rot: &SweepResult) -> Figure {
         xs: rot.points.iter().map(|p| p.rate_dps / lambda).collect(),
         ys: rot.points.iter().map(|p| p.phase_deg[0]).collect(),
     })
-    .with(theory_series(cfg, x_max, 0, 1.0, "exact theory (eq. 3)"))
+    .with(theory_series(
+        cfg,
+        &theory_abscissae(lo, hi, &rates),
+        0,
+        1.0,
+        "exact theory (eq. 3)",
+    ))
 }

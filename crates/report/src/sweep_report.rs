@@ -148,26 +148,110 @@ pub fn axis_labels(r: &SweepResult) -> (&'static str, &'static str) {
     }
 }
 
-/// Dense theory curve over `[0, x_max]` for one mode, the x axis scaled by `x_scale`.
-pub fn theory_series(cfg: &Config, x_max: f64, mode: usize, x_scale: f64, name: &str) -> Series {
-    let xs: Vec<f64> = (0..=100).map(|i| x_max * i as f64 / 100.0).collect();
+/// The span the theory and fit lines cover: from the origin (where the paper's lines start)
+/// out to the farthest rate on each side, so negative rates get their lines too.
+pub fn line_span(rates: &[f64]) -> (f64, f64) {
+    rates
+        .iter()
+        .filter(|x| x.is_finite())
+        .fold((0.0, 0.0), |(lo, hi), &x| (x.min(lo), x.max(hi)))
+}
+
+/// Abscissae of a theory curve: evenly over `[lo, hi]`, halvings of the first step on each
+/// side towards 0 (a phase saturating at large rates turns most steeply there), and the
+/// measured `rates` themselves, so the line goes through the theory at every point.
+pub fn theory_abscissae(lo: f64, hi: f64, rates: &[f64]) -> Vec<f64> {
+    // A rate table's theory is a harmonic balance per abscissa: 100 steps keep the curve smooth
+    // at a pixel's width without making its figure the run's slowest (400 plus 40 halvings
+    // cost `reproduce` 0.3 CPU-s).
+    const STEPS: usize = 100;
+    let mut xs: Vec<f64> = (0..=STEPS)
+        .map(|i| lo + (hi - lo) * i as f64 / STEPS as f64)
+        .chain((1..=6).flat_map(|j| [lo, hi].map(|e| e / STEPS as f64 * 0.5f64.powi(j))))
+        .chain(rates.iter().copied().filter(|x| x.is_finite()))
+        .collect();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup();
+    xs
+}
+
+/// The theory of both modes at each of `xs`. A rotating excitation has no psi at Omega = 0
+/// (its two sidebands coincide; the config refuses the rate): NaN there, so the line breaks
+/// instead of dropping to the ideal device's 0, which an imperfect mode 2 is nowhere near.
+pub fn theory_curves(cfg: &Config, xs: &[f64]) -> [Vec<f64>; 2] {
+    let rotating = cfg.shape().is_rotating();
+    let t: Vec<[f64; 2]> = xs
+        .iter()
+        .map(|&x| {
+            if rotating && x == 0.0 {
+                [f64::NAN; 2]
+            } else {
+                theory_deg(cfg, x)
+            }
+        })
+        .collect();
+    [0, 1].map(|k| t.iter().map(|v| v[k]).collect())
+}
+
+/// Dense theory curve of one mode over the abscissae `xs` (see [`theory_abscissae`]), the x
+/// axis scaled by `x_scale`.
+pub fn theory_series(cfg: &Config, xs: &[f64], mode: usize, x_scale: f64, name: &str) -> Series {
+    let [t1, t2] = theory_curves(cfg, xs);
     Series {
         name: name.to_string(),
         style: SeriesStyle::Line,
-        ys: xs.iter().map(|&x| theory_deg(cfg, x)[mode]).collect(),
+        ys: if mode == 0 { t1 } else { t2 },
         xs: xs.iter().map(|x| x * x_scale).collect(),
     }
 }
 
-/// Measured points, theory and best linear fit of one sweep, both modes.
+/// Whether two theory curves differ anywhere: beyond rounding (the two modes' theories of an
+/// ideal device, computed apart, differ in the last digits) or in where they are finite.
+pub fn curves_differ(a: &[f64], b: &[f64]) -> bool {
+    let scale = a
+        .iter()
+        .chain(b)
+        .filter(|v| v.is_finite())
+        .fold(0.0, |m: f64, v| m.max(v.abs()));
+    a.iter().zip(b).any(|(x, y)| {
+        if x.is_finite() && y.is_finite() {
+            (x - y).abs() > 1e-9 * scale
+        } else {
+            x.is_finite() != y.is_finite()
+        }
+    })
+}
+
+/// Legend of one mode's measured points: a refused phase (NaN) draws no marker, so the legend
+/// says how many went rather than leave an empty or thinned series unexplained.
+fn points_name(r: &SweepResult, k: usize) -> String {
+    let n = r.points.len();
+    let refused = r
+        .points
+        .iter()
+        .filter(|p| !p.phase_deg[k].is_finite())
+        .count();
+    match refused {
+        0 => format!("mode {} emulated", k + 1),
+        _ if refused == n => format!("mode {}: no finite phase (refused)", k + 1),
+        _ => format!(
+            "mode {} emulated ({refused} of {n} points refused: no finite phase)",
+            k + 1
+        ),
+    }
+}
+
+/// Measured points, theory and best linear fit of one sweep, both modes. Mode 2's theory gets
+/// its own line whenever it differs from mode 1's on the plotted span (a mode offset,
+/// `q_mode2`, k12, a phase-shifter error or F1 != F2), else one line is labelled for both.
 pub fn sweep_figure(cfg: &Config, r: &SweepResult, title: &str) -> Figure {
     let (xl, yl) = axis_labels(r);
     let xs: Vec<f64> = r.points.iter().map(|p| p.rate_dps).collect();
-    let x_max = xs.iter().cloned().fold(0.0, f64::max);
+    let (lo, hi) = line_span(&xs);
     let mut fig = Figure::new(title, xl, yl);
     for k in 0..2 {
         fig = fig.with(Series {
-            name: format!("mode {} emulated", k + 1),
+            name: points_name(r, k),
             style: if k == 0 {
                 SeriesStyle::Points
             } else {
@@ -177,25 +261,55 @@ pub fn sweep_figure(cfg: &Config, r: &SweepResult, title: &str) -> Figure {
             ys: r.points.iter().map(|p| p.phase_deg[k]).collect(),
         });
     }
-    let theory_name = if matches!(r.shape, Shape::RateTable { .. }) {
-        "small-signal theory (first-order low-pass), mode 1"
+    // A rate table's theory is the exact harmonic balance (`theory_deg`), not the first-order
+    // small-signal model, which only its summary's theory slope uses.
+    let theory = if matches!(r.shape, Shape::RateTable { .. }) {
+        "exact theory (harmonic balance)"
     } else {
-        "exact theory, mode 1"
+        "exact theory"
     };
-    fig = fig.with(theory_series(cfg, x_max, 0, 1.0, theory_name));
-    if (cfg.drive.f1 - cfg.f2()).abs() > 0.0 {
-        fig = fig.with(theory_series(cfg, x_max, 1, 1.0, "exact theory, mode 2"));
+    let txs = theory_abscissae(lo, hi, &xs);
+    let [t1, t2] = theory_curves(cfg, &txs);
+    let own_mode2 = curves_differ(&t1, &t2);
+    let line = |name: String, ys: Vec<f64>| Series {
+        name,
+        style: SeriesStyle::Line,
+        xs: txs.clone(),
+        ys,
+    };
+    if own_mode2 {
+        fig = fig
+            .with(line(format!("{theory}, mode 1"), t1))
+            .with(line(format!("{theory}, mode 2"), t2));
+    } else {
+        fig = fig.with(line(format!("{theory}, modes 1 and 2"), t1));
     }
     let f = r.fit[0];
-    fig.with(Series {
-        name: format!(
-            "best linear fit, mode 1: {:.6} deg per deg/s (R^2 = {:.6})",
-            f.slope, f.r2
-        ),
-        style: SeriesStyle::DashedLine,
-        xs: vec![0.0, x_max],
-        ys: vec![f.intercept, f.intercept + f.slope * x_max],
-    })
+    if f.slope.is_finite() && f.intercept.is_finite() {
+        fig = fig.with(Series {
+            name: format!(
+                "best linear fit, mode 1: {:.6} deg per deg/s (R^2 = {:.6})",
+                f.slope, f.r2
+            ),
+            style: SeriesStyle::DashedLine,
+            xs: vec![lo, hi],
+            ys: vec![f.intercept + f.slope * lo, f.intercept + f.slope * hi],
+        });
+    } else if r.points.iter().all(|p| p.phase_deg[0].is_finite()) {
+        // No refusal explains the missing fit: say what does, with no line drawn.
+        let distinct = xs.iter().any(|&x| x != xs[0]);
+        fig = fig.with(Series {
+            name: if distinct {
+                "best linear fit, mode 1: not a finite number".into()
+            } else {
+                "best linear fit, mode 1: none (needs two distinct rates)".into()
+            },
+            style: SeriesStyle::DashedLine,
+            xs: Vec::new(),
+            ys: Vec::new(),
+        });
+    }
+    fig
 }
 
 /// The files [`write_run`] writes into its folder.
@@ -216,10 +330,18 @@ pub fn write_run(
     Ok(vec![csv, json, png])
 }
 
-/// The plot title of a run.
+/// The plot title of a run: each mode's resonance and Q when they differ (mode 1's alone
+/// would misdescribe mode 2's points).
 pub fn run_title(cfg: &Config) -> String {
-    format!(
-        "{:?} run, f0 = {} Hz, Q = {}",
-        cfg.experiment.kind, cfg.device.f0_hz, cfg.device.q
-    )
+    let d = &cfg.device;
+    let f0 = if cfg.f0_mode2_hz() != d.f0_hz {
+        format!("f01 = {} Hz, f02 = {} Hz", d.f0_hz, cfg.f0_mode2_hz())
+    } else {
+        format!("f0 = {} Hz", d.f0_hz)
+    };
+    let q = match d.q_mode2 {
+        Some(q2) if q2 != d.q => format!("Q1 = {}, Q2 = {q2}", d.q),
+        _ => format!("Q = {}", d.q),
+    };
+    format!("{:?} run, {f0}, {q}", cfg.experiment.kind)
 }
