@@ -200,3 +200,40 @@ fn a_decimation_that_folds_the_mixer_product_onto_dc_is_stated_and_bounded() {
     // The fold is real: the worst point moves by a sizeable share of the bound.
     assert!(errs.iter().any(|&e| e >= 0.1 * bound_mdeg), "{errs:?}");
 }
+
+#[test]
+fn a_clipping_warning_names_the_points_that_clipped_and_only_those() {
+    // Coriolis with F1 = F2: each mode's velocity is F Q / w0 cos(theta) (THEORY.md section 3:
+    // the amplitude falls as cos theta), held by the DAC (the fundamental of a held sine at
+    // fs = 16 f0 is sinc(1/16) = sin(pi/16) / (pi/16) of it) and seen through the TIA's pole.
+    // Rails at 0.9 of the zero-rate output catch rates up to 175 deg/s (cos theta >= 0.99) but
+    // not 1000 and 2000 deg/s (0.80 and 0.56, and a start-up overshoot of at most
+    // e^(-pi / (lambda Omega tau)) = 1.4 % and 12 %). The warning had summed all points.
+    let (f0, q) = (15e3, 2000.0);
+    let mut c = config(
+        "coriolis",
+        f0,
+        q,
+        1.0,
+        1.0,
+        &[25.0, 175.0, 1000.0, 2000.0],
+        0.5,
+    );
+    let w0 = 2.0 * std::f64::consts::PI * f0;
+    let x = std::f64::consts::PI / 16.0;
+    let out = c.board.tia_gain_ohm * c.device.transduction_a_s_per_m * q / w0 * x.sin()
+        / x
+        / (1.0 + (f0 / c.board.tia_pole_hz.unwrap()).powi(2)).sqrt();
+    c.board.tia_rail_v = Some(0.9 * out);
+    let r = run(&c);
+    let rails: Vec<&String> = r.warnings.iter().filter(|w| w.contains("rails")).collect();
+    assert_eq!(rails.len(), 2, "{:?}", r.warnings);
+    for w in rails {
+        for railed in ["the zero-rate reference", " 25 deg/s", " 175 deg/s"] {
+            assert!(w.contains(railed), "{railed}: {w}");
+        }
+        for clean in ["1000 deg/s", "2000 deg/s"] {
+            assert!(!w.contains(clean), "{clean}: {w}");
+        }
+    }
+}
