@@ -7,7 +7,7 @@ use gyroemu_spectrum::{find_tones, power_of_two_scale, welch, Tone};
 
 /// Tones listed per channel.
 pub const TONES_LISTED: usize = 4;
-/// A tone must stand this far above the spectrum's median bin to be listed, dB.
+/// A tone must stand this far above the median of its neighbouring bins to be listed, dB.
 pub const TONE_MIN_SNR_DB: f64 = 20.0;
 
 /// The numbers of one channel.
@@ -87,7 +87,9 @@ pub fn inspect_text(set: &DumpSet) -> String {
         for s in channel_stats(d) {
             let tones = match (&s.spectrum_error, s.tones.is_empty()) {
                 (Some(e), _) => format!("no spectrum: {e}"),
-                (None, true) => format!("none {TONE_MIN_SNR_DB} dB above the median bin"),
+                (None, true) => {
+                    format!("none {TONE_MIN_SNR_DB} dB above the median of its neighbouring bins")
+                }
                 (None, false) => s
                     .tones
                     .iter()

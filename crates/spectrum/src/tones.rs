@@ -75,24 +75,34 @@ fn refine(psd: &Psd, k: usize) -> Tone {
     }
 }
 
+/// Bins on each side of a peak whose median is the noise floor it must clear.
+const FLOOR_HALF_WIDTH: usize = 32;
+
 /// The strongest `max` tones of `psd`, strongest first: local maxima of the power spectrum (DC
-/// counts when bin 0 exceeds bin 1) at least `min_snr_db` above the median bin. A single
-/// sinusoid's leakage, sampled at the bins, falls monotonically away from its peak, so its
-/// sidelobes are not reported as tones.
+/// counts when bin 0 exceeds bin 1) at least `min_snr_db` above the median of the bins within
+/// [`FLOOR_HALF_WIDTH`] of them. The floor is local because a coloured spectrum has no one
+/// floor: on a low-passed node most bins lie in the stop band, and pass-band noise stood 20 dB
+/// above the whole spectrum's median and was listed as tones. A single sinusoid's leakage,
+/// sampled at the bins, falls monotonically away from its peak, so its sidelobes are not
+/// reported as tones.
 pub fn find_tones(psd: &Psd, max: usize, min_snr_db: f64) -> Vec<Tone> {
     let p = &psd.power;
     if p.len() < 2 {
         return Vec::new();
     }
-    let mut sorted = p.clone();
-    sorted.sort_by(f64::total_cmp);
-    let floor = sorted[sorted.len() / 2] * 10f64.powf(min_snr_db / 10.0);
+    let snr = 10f64.powf(min_snr_db / 10.0);
+    let floor = |k: usize| {
+        let mut near =
+            p[k.saturating_sub(FLOOR_HALF_WIDTH)..(k + FLOOR_HALF_WIDTH + 1).min(p.len())].to_vec();
+        near.sort_by(f64::total_cmp);
+        near[near.len() / 2] * snr
+    };
     let last = p.len() - 1;
     let mut peaks: Vec<usize> = (0..p.len())
         .filter(|&k| {
             let left = k == 0 || p[k] > p[k - 1];
             let right = k == last || p[k] >= p[k + 1];
-            left && right && p[k] > floor && p[k] > 0.0
+            left && right && p[k] > 0.0 && p[k] > floor(k)
         })
         .collect();
     peaks.sort_by(|&a, &b| p[b].total_cmp(&p[a]));

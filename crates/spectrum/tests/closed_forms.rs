@@ -219,3 +219,47 @@ fn bad_requests_are_refused_with_reasons() {
     assert_eq!(default_segment_len(10), 10);
     assert_eq!(default_segment_len(4), 4);
 }
+
+#[test]
+fn low_passed_noise_gives_no_tones_but_a_tone_in_its_pass_band_is_found() {
+    // White noise through four 16-sample boxcars (|H| = |sinc|^4 of the 1/16 band): most bins
+    // lie in the stop band, so the pass band stood far above the whole spectrum's median and its
+    // noise was listed as tones. Against the median of its neighbours it is just noise.
+    let (n, fs) = (1 << 16, 240_000.0);
+    let mut x = gaussian(n + 64, 1.0, 3);
+    for _ in 0..4 {
+        x = x
+            .windows(16)
+            .map(|w| w.iter().sum::<f64>() / 16.0)
+            .collect();
+    }
+    x.truncate(n);
+    let psd = welch(&x, fs, Some(2048)).unwrap();
+    let median = {
+        let mut s = psd.power.clone();
+        s.sort_by(f64::total_cmp);
+        s[s.len() / 2]
+    };
+    assert!(
+        psd.power[10] > 1e4 * median,
+        "the pass band is 40 dB above the median"
+    );
+    assert!(
+        find_tones(&psd, 5, 20.0).is_empty(),
+        "{:?}",
+        find_tones(&psd, 5, 20.0)
+    );
+    // A sine in the pass band 30 dB above the noise there is a tone.
+    let bin = fs / 2048.0;
+    let level = psd.density()[20] * bin;
+    let f = 20.3 * bin;
+    let a = (2.0 * 1e3 * level).sqrt();
+    let y: Vec<f64> = x
+        .iter()
+        .zip(sines(n, fs, 0.0, &[(a, f, 0.1)]))
+        .map(|(u, v)| u + v)
+        .collect();
+    let found = find_tones(&welch(&y, fs, Some(2048)).unwrap(), 5, 20.0);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!((found[0].freq_hz - f).abs() < bin, "{found:?}");
+}
