@@ -17,6 +17,7 @@ mod validate;
 mod validate_montecarlo;
 mod validate_noise;
 mod validate_regime;
+mod validate_settling;
 mod validate_sweep;
 
 pub use config::{

@@ -123,9 +123,20 @@ impl Config {
         if p.non_negative("sweep.settle_s", settle) && device_ok {
             let tau = self.slowest_tau_s();
             if settle < 10.6 * tau {
+                // Each frequency's average over T keeps at most e^(-settle/tau) tau/T (1 -
+                // e^(-T/tau)) of its start-up transient (the mean of a decaying exponential),
+                // relative to the response: that much of the magnitude, its asin in phase.
+                let t = if average.is_finite() && average > 0.0 {
+                    average
+                } else {
+                    f64::INFINITY
+                };
+                let rel = ((-settle / tau).exp() * tau / t * -(-t / tau).exp_m1()).min(1.0);
                 warnings.push(format!(
-                    "sweep.settle_s = {settle} is shorter than 10.6 mechanical time constants ({} s): the start-up transient, e^(-settle_s/tau) of the response, biases the fit",
-                    10.6 * tau
+                    "sweep.settle_s = {settle} is shorter than 10.6 mechanical time constants ({} s): the start-up transient left in each average over sweep.average_s can move a Bode point by up to {:.1e} of its magnitude and {:.3e} mdeg in phase, and biases the fit",
+                    10.6 * tau,
+                    rel,
+                    rel.asin().to_degrees() * 1e3
                 ));
             }
         }

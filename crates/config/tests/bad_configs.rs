@@ -790,11 +790,7 @@ fn cases() -> Vec<Case> {
             "settle below the mechanical time constants warns",
             set(&c, "experiment", "settle_s", "0.01").0,
             Warning,
-            &[
-                "experiment.settle_s",
-                "0.01",
-                "10.6 mechanical time constants",
-            ],
+            &["experiment.settle_s", "0.01", "plant's start-up", "mdeg"],
         ),
         invalid(
             "rotating rate above the cutoff",

@@ -1,0 +1,465 @@
+//! What the averaging window cannot remove, checked before any sample: the start-up left at
+//! the window's start by a hand-set `experiment.settle_s` (the plant's and the stage-1
+//! low-pass's together), and rate-table harmonics that the output rate aliases onto each other.
+
+use crate::config::Config;
+use crate::error::ConfigError;
+use crate::rules::Rules;
+use crate::validate_regime::WARN_HOLD_ERROR_MDEG;
+use gyroemu_board::Shape;
+use gyroemu_core::Complex64;
+use gyroemu_lpf::Window;
+
+/// Two demodulated table harmonics whose difference aliases to within this many cycles per
+/// averaging window of DC cannot be told apart: the window-leak system the read-out solves is
+/// then too close to singular for f64. Measured (m2tfg device, order-2 low-pass at 60 Hz,
+/// fs_out = 8 x 25 Hz, 0.4 s and 4 s windows): an alias distance delta with delta T = 4e-6
+/// added below 1e-4 mdeg, 4e-7 added 0.005 mdeg, 4e-8 added 6 mdeg and 4e-9 degrees (0 is
+/// singular: NaN or degree-size garbage). 1e-5 keeps a factor 25 from the first harm.
+pub const MIN_TABLE_ALIAS_CYCLES: f64 = 1e-5;
+
+/// The poles `z_k` and residues `r_k` of the stage-1 Butterworth low-pass as the lpf crate
+/// builds it (the bilinear transform of the analog prototype with the cutoff prewarped, so
+/// `H(z) = G prod (1 + z^-1) / (1 - z_k z^-1)`), and `h[0] = G`: `h[n] = sum r_k z_k^n`
+/// for `n >= 1`. The differences are formed from the analog poles, with no cancellation for
+/// the narrow filters whose poles crowd z = 1.
+pub(crate) fn lowpass_modes(
+    order: usize,
+    cutoff_hz: f64,
+    fs_hz: f64,
+) -> (Vec<(Complex64, Complex64)>, f64) {
+    let wc = (core::f64::consts::PI * cutoff_hz / fs_hz).tan();
+    let one = Complex64::new(1.0, 0.0);
+    let s: Vec<Complex64> = (0..order)
+        .map(|k| {
+            let a = core::f64::consts::PI * (2 * k + order + 1) as f64 / (2 * order) as f64;
+            Complex64::from_polar(wc, a)
+        })
+        .collect();
+    let g = s.iter().fold(one, |g, &sk| g * (-sk / (one - sk))).re;
+    let modes = s
+        .iter()
+        .enumerate()
+        .map(|(k, &sk)| {
+            let z = (one + sk) / (one - sk);
+            // (1 + 1/z_k)^N / prod_{i != k} (1 - z_i / z_k), each factor from the s-plane.
+            let mut r = Complex64::new(g, 0.0) * (2.0 / (one + sk)).powi(order as i32);
+            for (i, &si) in s.iter().enumerate() {
+                if i != k {
+                    r /= 2.0 * (sk - si) / ((one - si) * (one + sk));
+                }
+            }
+            (z, r)
+        })
+        .collect();
+    (modes, g)
+}
+
+/// `e^x - 1` for complex `x`, accurate near 0 (the geometric ratios of slow poles sit there).
+fn expm1(x: Complex64) -> Complex64 {
+    let (s, c) = x.im.sin_cos();
+    let h = (0.5 * x.im).sin();
+    Complex64::new(x.re.exp_m1() * c - 2.0 * h * h, x.re.exp() * s)
+}
+
+/// `e^{n l}` for a complex log `l` and a possibly huge `n` (the phase wrapped first).
+fn pow_log(l: Complex64, n: f64) -> Complex64 {
+    let mag = (n * l.re).exp();
+    if mag == 0.0 {
+        return Complex64::new(0.0, 0.0);
+    }
+    let turns = (n * l.im / core::f64::consts::TAU).rem_euclid(1.0);
+    Complex64::from_polar(mag, turns * core::f64::consts::TAU)
+}
+
+/// `sum_j w_j q^j / sum_j w_j` over `window`'s weights with `q = e^l` (`|q| <= 1`), in closed
+/// form: the window's mean of a geometric sequence.
+fn window_mean(window: &Window, l: Complex64) -> Complex64 {
+    // sum_{j < n} e^{l j} = (e^{l n} - 1) / (e^l - 1); l = 0 gives n.
+    let geo = |l: Complex64, n: u64| {
+        let d = expm1(l);
+        if d.norm() == 0.0 {
+            Complex64::new(n as f64, 0.0)
+        } else {
+            expm1(l * n as f64) / d
+        }
+    };
+    match *window {
+        Window::Boxcar { n, frac } => (geo(l, n) + pow_log(l, n as f64) * frac) / (n as f64 + frac),
+        Window::Hann { n } => {
+            // sin^2(pi (j + 1/2)/n) = 1/2 - (e^{j 2 pi (j + 1/2)/n} + conj) / 4.
+            let step = core::f64::consts::TAU / n as f64;
+            let half = Complex64::from_polar(1.0, 0.5 * step);
+            let j = Complex64::new(0.0, step);
+            let sum = 0.5 * geo(l, n) - 0.25 * (half * geo(l + j, n) + half.conj() * geo(l - j, n));
+            sum / if n == 1 { 1.0 } else { 0.5 * n as f64 }
+        }
+    }
+}
+
+/// The start-up a point's read-out keeps, per unit of the stage-1 input: the input samples
+/// its window averages are `n_j = (n_settle + j) M + M - 1`.
+struct StartUp<'a> {
+    modes: &'a [(Complex64, Complex64)],
+    window: Window,
+    n0: f64,
+    m: f64,
+    /// ln of the plant's start-up decay per input sample, -1/(tau fs).
+    ln_a: f64,
+}
+
+impl StartUp<'_> {
+    /// The low-pass's own start-up on a tone `e^{j w n}` applied from sample 0, read at `w_read`
+    /// (rad per input sample): exactly `-sum_{k > n} h_k e^{j w (n - k)}`, demodulated by
+    /// `e^{-j w_read n}` and averaged over the window (each pole is a geometric sequence).
+    fn lowpass(&self, w: f64, w_read: f64) -> Complex64 {
+        let jw = Complex64::new(0.0, w);
+        let mut sum = Complex64::new(0.0, 0.0);
+        for &(z, r) in self.modes {
+            let lz = z.ln();
+            // e^{jwn} sum_{k > n} r z^k e^{-jwk} = r z^n (z e^{-jw}) / (1 - z e^{-jw}), so the
+            // demodulated start-up of this pole is -c z^n e^{-j w_read n}.
+            let c = r * (lz - jw).exp() / -expm1(lz - jw);
+            let l = lz - Complex64::new(0.0, w_read);
+            sum -= c * pow_log(l, self.n0) * window_mean(&self.window, l * self.m);
+        }
+        sum
+    }
+
+    /// A bound on the plant's start-up after the low-pass: the plant starts at rest, so its
+    /// input differs from the steady one by a transient of at most the steady amplitude times
+    /// `a^n` (`a = e^{-1/(tau fs)}`), whose output is at most `sum_k |h_k| a^{n-k}`. The first
+    /// `k0` taps are the built filter's own (`head = sum_{k <= k0} |h_k| a^{k0-k}`, see
+    /// [`impulse_head`]); beyond, `|h_k| <= sum |r_i| rho_i^k` sums in closed form to
+    /// `sum |r_i| rho_i^(k0+1) (a^n' - rho_i^n') / (a - rho_i)`, `n' = n - k0`; averaged over
+    /// the window.
+    fn plant(&self, k0: f64, head: f64) -> f64 {
+        let n0 = self.n0 - k0;
+        let mean = |ln_q: f64| {
+            (pow_log(Complex64::new(ln_q, 0.0), n0)
+                * window_mean(&self.window, Complex64::new(ln_q * self.m, 0.0)))
+            .re
+        };
+        let mut total = head * mean(self.ln_a);
+        for &(z, r) in self.modes {
+            let ln_rho = z.norm().ln();
+            let mut ln_a = self.ln_a;
+            // Equal decays: a slightly slower plant only raises the bound.
+            if (ln_a - ln_rho).abs() < 1e-6 * ln_rho.abs() {
+                ln_a = ln_rho * (1.0 - 1e-3);
+            }
+            let (a, rho) = (ln_a.exp(), ln_rho.exp());
+            let far = (ln_rho * (k0 + 1.0)).exp();
+            total += r.norm() * far * (mean(ln_a) - mean(ln_rho)) / (a - rho);
+        }
+        total.max(0.0)
+    }
+}
+
+/// Most taps of the built low-pass [`impulse_head`] runs (a few ms).
+const MAX_HEAD_TAPS: f64 = 4e6;
+
+/// The built stage-1 filter's impulse response, run for `k0 + 1` taps (`k0` at most `n0`, the
+/// first averaged sample, and about 200 time constants of the cutoff, where the slowest
+/// order-8 pole has decayed by e^-39): `(k0, sum_{k <= k0} |h_k| a^{k0-k})`. Its exact taps
+/// keep the plant's bound from the modal envelope's looseness (10x at order 4).
+fn impulse_head(
+    design: gyroemu_lpf::LowPassDesign,
+    fs: f64,
+    cutoff: f64,
+    n0: f64,
+    ln_a: f64,
+) -> (f64, f64) {
+    use gyroemu_core::Stage;
+    let Ok(mut lp) = gyroemu_lpf::LowPass::<f64>::new(design, fs) else {
+        return (0.0, 0.0);
+    };
+    let k0 = n0
+        .min((200.0 * fs / (core::f64::consts::TAU * cutoff)).ceil())
+        .min(MAX_HEAD_TAPS);
+    let a = ln_a.exp();
+    let mut head = 0.0;
+    for k in 0..=(k0 as u64) {
+        head = head * a + lp.tick(if k == 0 { 1.0 } else { 0.0 }).abs();
+    }
+    (k0, head)
+}
+
+impl Config {
+    /// The start-up a hand-set `experiment.settle_s` leaves in the averaging windows, bounded
+    /// per point from the plant's decay and the low-pass's exact start-up; a warning with the
+    /// bound, or a refusal when the start-up can be as large as the signal read.
+    pub(crate) fn validate_settling(&self, p: &mut Rules, warnings: &mut Vec<String>) {
+        let Some(settle) = self.experiment.settle_s else {
+            return;
+        };
+        if !p.clean(&[
+            "experiment.settle_s",
+            "experiment.average_s",
+            "experiment.table_freq_hz",
+            "experiment.rate_table",
+        ]) {
+            return;
+        }
+        let Some((worst, at, table_lag, exact)) = self.settling_bound() else {
+            return;
+        };
+        let tau = self.slowest_tau_s();
+        let fc = self.lpf_cutoff_hz();
+        let what = format!(
+            "experiment.settle_s = {settle} leaves the plant's start-up (tau = {tau} s) and the stage-1 low-pass's ({}th order at {fc} Hz) in the averaging window",
+            self.board.lpf_order
+        );
+        let fix = format!(
+            "raise settle_s (the default, {:.4} s here, is 16 tau + 40/(2 pi lpf_cutoff_hz)) or remove the key",
+            16.0 * tau + 40.0 / (core::f64::consts::TAU * fc)
+        );
+        // The low-pass's own start-up on the sidebands read is exact (no bound): once it is as
+        // large as what the filter passes of them, the phase read is undetermined and no bound
+        // on it exists, so the run is refused. The rest is a bound, stated in a warning.
+        if exact >= 1.0 || exact.is_nan() {
+            p.push(ConfigError::key(
+                "experiment.settle_s",
+                settle,
+                format!("{what}: at {at} deg/s the low-pass's start-up left in the window is {exact:.2e} of the sideband it passes, so the measured phase is undetermined; {fix}"),
+            ));
+            return;
+        }
+        let mdeg = worst.min(1.0).asin().to_degrees() * 1e3;
+        let mdeg = match self.shape() {
+            // Each Coriolis phase is the difference of two read-outs, each with a start-up.
+            Shape::Coriolis => 2.0 * mdeg,
+            _ => mdeg,
+        };
+        if mdeg > WARN_HOLD_ERROR_MDEG {
+            let lag = table_lag
+                .map(|l: f64| format!(" (the table lag by up to {:.3e} deg)", l.to_degrees()))
+                .unwrap_or_default();
+            let size = if worst < 1.0 {
+                format!("by up to {mdeg:.3e} mdeg{lag}")
+            } else {
+                // asin saturates: beyond a relative 1 the bound says nothing smaller than this.
+                format!("by up to {mdeg:.3e} mdeg or more (the start-up bound reaches the signal's size: do not trust the reading){lag}")
+            };
+            warnings.push(format!(
+                "{what}: it can move the measured phase {size} (worst at {at} deg/s); {fix}"
+            ));
+        }
+    }
+
+    /// The largest relative start-up of a read phasor over the points, the rate it is at, for
+    /// a rate table the lag bound (rad) it implies, and the largest exact low-pass start-up on
+    /// a rotating run's sidebands, relative; `None` if the chain cannot be built.
+    fn settling_bound(&self) -> Option<(f64, f64, Option<f64>, f64)> {
+        let chain = gyroemu_board::ChainResponse::new(&self.board_params()).ok()?;
+        let fs = self.fs_hz();
+        let (modes, _) = lowpass_modes(self.board.lpf_order, self.lpf_cutoff_hz(), fs);
+        let m = self.decimation() as f64;
+        let n0 = self.n_settle_out() as f64 * m + m - 1.0;
+        let w_of = |f: f64| core::f64::consts::TAU * f / fs;
+        // The mixer's 2 f_c product starts up with the rest (its start-up is tiny: the
+        // low-pass stops it).
+        let image = -w_of(2.0 * self.carrier_hz());
+        let (mut worst, mut at, mut lag, mut exact) = (0.0f64, f64::NAN, None, 0.0f64);
+        for rate in self.emulated_rates_dps() {
+            let su = StartUp {
+                modes: &modes,
+                window: self.plan_point(rate).window,
+                n0,
+                m,
+                ln_a: -1.0 / (self.slowest_tau_s() * fs),
+            };
+            let (k0, head) =
+                impulse_head(self.lowpass_design(), fs, self.lpf_cutoff_hz(), n0, su.ln_a);
+            let plant = su.plant(k0, head);
+            let (e, l) = match self.shape() {
+                Shape::Coriolis => {
+                    // The low-pass's start-up on DC scales every point's phasor alike: the
+                    // phase against the zero-rate reference keeps none of it.
+                    let kept = (Complex64::new(1.0, 0.0) + su.lowpass(0.0, 0.0)).norm();
+                    ((plant + su.lowpass(image, 0.0).norm()) / kept, None)
+                }
+                Shape::Rotating => {
+                    // z = A/2 (e^{j Omega t} + e^{-j Omega t}) (THEORY section 6); each
+                    // sideband read against |L(fm)| A/2, psi is half their phase difference.
+                    let wm = w_of(rate.abs() / 360.0);
+                    let mut e = 0.0;
+                    for w_read in [wm, -wm] {
+                        let left: f64 = [wm, -wm, image + wm, image - wm]
+                            .iter()
+                            .map(|&w| 0.5 * su.lowpass(w, w_read).norm())
+                            .sum();
+                        let steady =
+                            0.5 * chain.lowpass(w_read * fs / core::f64::consts::TAU).norm();
+                        exact = exact.max(left / steady);
+                        e += 0.5 * ((left + plant) / steady).min(1.0);
+                    }
+                    (e, None)
+                }
+                Shape::RateTable { freq_hz } => {
+                    let n = self.table_harmonics() as i64;
+                    let env = self.driven_device().rate_table_envelopes(
+                        rate.abs() * core::f64::consts::PI / 180.0,
+                        freq_hz,
+                        n as usize,
+                    );
+                    let mut e: f64 = 0.0;
+                    let mut amp: f64 = f64::INFINITY;
+                    for z in &env {
+                        // The phase of z(t) moves by at most |dz| / min |z(t)| (min over a
+                        // period, sampled finely: z(t) is a trigonometric polynomial of
+                        // degree N).
+                        let total: f64 = z.iter().map(|v| v.norm()).sum();
+                        let steps = 64 * (n as usize + 1);
+                        let floor = (0..steps)
+                            .map(|t| {
+                                let th = core::f64::consts::TAU * t as f64 / steps as f64;
+                                z.iter()
+                                    .enumerate()
+                                    .map(|(i, v)| {
+                                        v * Complex64::from_polar(1.0, (i as i64 - n) as f64 * th)
+                                    })
+                                    .sum::<Complex64>()
+                                    .norm()
+                            })
+                            .fold(f64::INFINITY, f64::min);
+                        let mut dz = 0.0;
+                        for read in -n..=n {
+                            let w_read = w_of(read as f64 * freq_hz);
+                            let mut left = total * plant;
+                            for (i, v) in z.iter().enumerate() {
+                                let w = w_of((i as i64 - n) as f64 * freq_hz);
+                                left += v.norm()
+                                    * (su.lowpass(w, w_read).norm()
+                                        + su.lowpass(image - w, w_read).norm());
+                            }
+                            dz += left / chain.lowpass(read as f64 * freq_hz).norm();
+                        }
+                        e = e.max(if floor > 0.0 {
+                            dz / floor
+                        } else {
+                            f64::INFINITY
+                        });
+                    }
+                    let theory = self
+                        .driven_device()
+                        .rate_table_response(rate.abs() * core::f64::consts::PI / 180.0, freq_hz)
+                        .0;
+                    for a in theory {
+                        amp = amp.min(a.abs());
+                    }
+                    (
+                        e,
+                        Some((e.min(1.0).asin() / amp).min(core::f64::consts::PI)),
+                    )
+                }
+            };
+            if e > worst || e.is_nan() {
+                (worst, at) = (e, rate);
+                if l.is_some() {
+                    lag = l;
+                }
+            }
+        }
+        Some((worst, at, lag, exact))
+    }
+
+    /// Rate-table runs: two demodulated harmonics `n` and `n + d` (`d <= 2N`) whose frequency
+    /// difference `d f_t` the output rate aliases to (near) DC read as one: the window-leak
+    /// system the read-out solves is singular (NaN, or finite garbage with exit 0).
+    pub(crate) fn validate_table_alias(&self, p: &mut Rules) {
+        let Shape::RateTable { freq_hz: ft } = self.shape() else {
+            return;
+        };
+        if !p.clean(&["experiment.table_freq_hz", "experiment.average_s"]) {
+            return;
+        }
+        let n = self.table_harmonics();
+        let fs_out = self.fs_out_hz();
+        for rate in self.experiment.rates_dps.iter().take(1) {
+            // Every table point averages whole table periods of the same span.
+            let window = self.plan_point(*rate).window;
+            let t = window.span() / fs_out;
+            for d in 1..=2 * n {
+                let f = d as f64 * ft;
+                let k = (f / fs_out).round();
+                let delta = (f - k * fs_out).abs();
+                if k >= 1.0 && delta * t < MIN_TABLE_ALIAS_CYCLES {
+                    p.push(ConfigError::key(
+                        "board.decimation",
+                        self.decimation(),
+                        format!(
+                            "the output rate fs_hz/decimation = {fs_out} Hz is {} x {d} x experiment.table_freq_hz ({ft} Hz){}: at the output instants table harmonics n and n + {d} are the same frequency, and the read-out demodulates harmonics -{n} ..= {n}, so it cannot tell them apart (their alias distance {delta:.3e} Hz is below {MIN_TABLE_ALIAS_CYCLES:e} cycles of the {t} s window); choose a decimation whose output rate is not within that of a multiple of table_freq_hz / k for k <= {}, or remove the key for the derived one, or change table_freq_hz",
+                            if k == 1.0 { "1".to_string() } else { format!("1/{k}") },
+                            if delta == 0.0 { "" } else { " (nearly)" },
+                            2 * n
+                        ),
+                    ));
+                    return;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gyroemu_core::Stage;
+    use gyroemu_lpf::{LowPass, LowPassDesign};
+
+    /// The modal impulse response is the built filter's (run on an impulse), every order, a
+    /// narrow and a wide cutoff: the bound rests on the real filter, not an analog model.
+    #[test]
+    fn the_modes_give_the_built_filters_impulse_response() {
+        let fs = 240_000.0;
+        for order in 1..=8 {
+            for fc in [3.0, 2000.0] {
+                let (modes, h0) = lowpass_modes(order, fc, fs);
+                let mut lp = LowPass::<f64>::new(
+                    LowPassDesign::Butterworth {
+                        order,
+                        cutoff_hz: fc,
+                    },
+                    fs,
+                )
+                .unwrap();
+                let n_max = (20.0 * fs / (core::f64::consts::TAU * fc)) as u64;
+                let mut peak: f64 = 0.0;
+                let mut worst: f64 = 0.0;
+                for n in 0..n_max {
+                    let h = lp.tick(if n == 0 { 1.0 } else { 0.0 });
+                    let modal = if n == 0 {
+                        h0
+                    } else {
+                        modes.iter().map(|&(z, r)| (r * z.powf(n as f64)).re).sum()
+                    };
+                    peak = peak.max(h.abs());
+                    worst = worst.max((h - modal).abs());
+                }
+                assert!(
+                    worst < 1e-7 * peak,
+                    "order {order}, {fc} Hz: {worst:e} of {peak:e}"
+                );
+            }
+        }
+    }
+
+    /// The closed-form window mean is the direct weighted sum.
+    #[test]
+    fn the_window_mean_is_the_weighted_sum() {
+        let l = Complex64::new(-1e-3, 0.37);
+        for w in [
+            Window::Boxcar { n: 500, frac: 0.3 },
+            Window::Hann { n: 500 },
+        ] {
+            let (mut s, mut ws) = (Complex64::new(0.0, 0.0), 0.0);
+            for j in 0..w.samples() {
+                s += w.weight(j) * (l * j as f64).exp();
+                ws += w.weight(j);
+            }
+            let d = (window_mean(&w, l) - s / ws).norm();
+            assert!(d < 1e-12, "{w:?}: {d:e}");
+        }
+    }
+}
