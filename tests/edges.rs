@@ -72,10 +72,22 @@ fn an_undithered_adc_states_how_far_its_rounding_can_move_the_phase_and_stays_wi
     // Without noise the ADC's error is a sawtooth of a carrier of 16 samples per period: it
     // repeats every period, so no averaging removes it (at 2.6 LSBs the phase froze on a
     // staircase with no warning). The bound is asin(LSB / A): twice the half-LSB bias over
-    // the amplitude, computed here from the board's values.
+    // the smallest amplitude of the run, computed here from the board's values: at 100 deg/s
+    // the velocity falls by cos theta (THEORY.md section 3), and the chain is the hold's sinc
+    // and the TIA recursion's |H| = (1 - a)/|1 - a e^{-j w Ts}| (a = e^{-2 pi 60 kHz Ts}).
+    let ts = 1.0 / 240e3;
+    let w = 2.0 * PI * 15e3;
+    let a = (-2.0 * PI * 60e3 * ts).exp();
+    let tia = (1.0 - a)
+        / num_complex::Complex64::new(1.0 - a * (w * ts).cos(), a * (w * ts).sin()).norm();
+    let hold = (w * ts / 2.0).sin() / (w * ts / 2.0);
+    let theta = common::theta_deg(15e3, 2000.0, 1.0, 1.0, 1.0, 100.0)[0].to_radians();
+    let smallest = 1e-6 * 1e6 * 2000.0 / w * theta.cos() * tia * hold;
+    let resonance = 1e-6 * 1e6 * 2000.0 / w / (1.0 + 0.25f64.powi(2)).sqrt();
     for lsbs in [2.6, 40.0, 120.0] {
         let c = with_adc(lsbs);
-        let bound_mdeg = (1.0 / lsbs).min(1.0).asin().to_degrees() * 1e3;
+        let lsb = resonance / lsbs;
+        let bound_mdeg = (lsb / smallest).min(1.0).asin().to_degrees() * 1e3;
         let w = c.validate().expect("a warning, not a refusal");
         let said: Vec<&String> = w.iter().filter(|w| w.contains("rounding error")).collect();
         assert_eq!(said.len(), 2, "{lsbs} LSBs: {w:?}");

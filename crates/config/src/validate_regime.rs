@@ -6,7 +6,11 @@
 use crate::config::Config;
 use crate::error::ConfigError;
 use crate::rules::Rules;
-use gyroemu_board::Shape;
+use gyroemu_board::{ChainResponse, Shape};
+use gyroemu_core::Complex64;
+use gyroemu_resonator::continuous_steady_state;
+
+const DEG: f64 = core::f64::consts::PI / 180.0;
 
 /// Every node's amplitude must lie in this band (in its own unit): products of two stay finite
 /// and normal, and no signal is rounded away in subnormals.
@@ -20,8 +24,9 @@ pub const MAX_HOLD_ERROR_MDEG: f64 = 1000.0;
 pub const WARN_HOLD_ERROR_MDEG: f64 = 0.01;
 
 /// The steady-state amplitude at resonance of each node of mode `k` at zero rate: drive,
-/// displacement, velocity, motional current, TIA output (an upper bound for every experiment:
-/// rotation and the rotating envelope only lower it).
+/// displacement, velocity, motional current, TIA output. Only an order of magnitude (a
+/// detuned carrier or rotation moves it by a factor of order Q at most), which is all the
+/// node-range band needs; the converter rules weigh [`Config::tia_output_span`] instead.
 fn node_amplitudes(c: &Config, k: usize) -> [f64; 5] {
     let p = c.resonator_params();
     let mode = [p.mode1, p.mode2][k];
@@ -56,6 +61,7 @@ impl Config {
             return;
         }
         self.validate_converters(p, warnings);
+        self.validate_dac_rounding(warnings);
         self.validate_mixer_product(warnings);
         self.validate_table_harmonics(warnings);
         self.validate_table_step(warnings);
@@ -152,9 +158,81 @@ impl Config {
         Ok(())
     }
 
+    /// Per mode, the TIA output's amplitude over the run's points: the steady state of the
+    /// configured device (detuning, mismatch, coupling, rotation) at the carrier, through the
+    /// DAC hold's fundamental and the TIA as built. Coriolis: the exact amplitude at each rate
+    /// (zero included). Rotating: the peak of the envelope, |V+| + |V-| over the sidebands at
+    /// f_c +- f_m (its zeros are the modulation's, not a dead signal). Rate table: the extremes
+    /// of the envelope over the table period (harmonic balance, 24 harmonics, on a fine grid).
+    /// `None` when the chain cannot be built (other rules report it).
+    fn tia_output_span(&self) -> Option<[AmpSpan; 2]> {
+        let chain = ChainResponse::new(&self.board_params()).ok()?;
+        let plant = self.resonator_params();
+        let dev = self.driven_device();
+        let fc = self.carrier_hz();
+        // Velocity to the ADC's input: transduction, the hold's fundamental, the TIA.
+        let g = |f: f64| chain.dac_hold(f) * chain.tia(f) * self.device.transduction_a_s_per_m;
+        let [f1, f2] = dev.drive;
+        let shift = (90.0 + dev.phase_shifter_error_deg) * DEG;
+        let force = [Complex64::new(f1, 0.0), Complex64::from_polar(f2, -shift)];
+        let mut span = [AmpSpan::default(); 2];
+        for rate in self.emulated_rates_dps() {
+            let omega = rate * DEG;
+            let amps: [(f64, f64); 2] = match self.shape() {
+                Shape::Coriolis => {
+                    let x = continuous_steady_state(&plant, omega, fc, force);
+                    [0, 1].map(|k| {
+                        let a = (x[2 + k] * g(fc)).norm();
+                        (a, a)
+                    })
+                }
+                Shape::Rotating => {
+                    // The sidebands of THEORY.md section 4 (the shifter's error turns mode
+                    // 2's), as DrivenDevice::rotating_psi_rad takes them.
+                    let fm = omega / core::f64::consts::TAU;
+                    let eps = dev.phase_shifter_error_deg * DEG;
+                    let j = Complex64::new(0.0, 1.0);
+                    let side = |sign: f64| {
+                        let turn = Complex64::from_polar(1.0, -sign * eps);
+                        let f = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
+                        let x = continuous_steady_state(&plant, 0.0, fc + sign * fm, f);
+                        [x[2] * g(fc + sign * fm), x[3] * g(fc + sign * fm)]
+                    };
+                    let (vp, vm) = (side(1.0), side(-1.0));
+                    [0, 1].map(|k| {
+                        // At f_m = 0 both sidebands are one tone: their sum, not their sizes.
+                        let a = if fm == 0.0 {
+                            (vp[k] + vm[k]).norm()
+                        } else {
+                            vp[k].norm() + vm[k].norm()
+                        };
+                        (a, a)
+                    })
+                }
+                Shape::RateTable { freq_hz } => {
+                    const N: usize = 24;
+                    let env = dev.rate_table_envelopes(omega, freq_hz, N);
+                    [0, 1].map(|k| {
+                        let h: Vec<Complex64> = env[k]
+                            .iter()
+                            .enumerate()
+                            .map(|(i, &x)| x * g(fc + (i as f64 - N as f64) * freq_hz))
+                            .collect();
+                        envelope_extremes(&h)
+                    })
+                }
+            };
+            for (s, (lo, hi)) in span.iter_mut().zip(amps) {
+                s.include(lo, hi, rate);
+            }
+        }
+        Some(span)
+    }
+
     fn validate_converters(&self, p: &mut Rules, warnings: &mut Vec<String>) {
         let b = &self.board;
         let lsb = |bits: u32, full_scale: f64| full_scale / (1u64 << (bits - 1)) as f64;
+        let span = self.tia_output_span();
         for k in 0..2 {
             let a = node_amplitudes(self, k);
             let drive_key = ["drive.f1", "drive.f2"][k];
@@ -175,49 +253,65 @@ impl Config {
                     ));
                 }
             }
-            let tia_out = a[4];
+            let Some(s) = span.map(|s| s[k]) else {
+                continue;
+            };
+            if !(s.min.is_finite() && s.max.is_finite()) {
+                continue; // an unbuildable plant: reported by the other rules
+            }
+            // The dead-signal rules and the phase bound weigh the smallest amplitude, the
+            // clipping rules the largest: each errs towards the warning.
+            let (small, big) = (
+                format!("about {:e} V at {} deg/s", s.min, s.min_at),
+                format!("about {:e} V at {} deg/s", s.max, s.max_at),
+            );
             if let Some(bits) = b.adc_bits {
                 let step = lsb(bits, b.adc_full_scale_v);
-                // The amplitude is an estimate at resonance: refuse only a clearly dead ADC.
+                // The amplitude is the steady state's (the hold's images and the settling
+                // transient can add a little): refuse only a clearly dead ADC.
                 p.check(
-                    !(tia_out < 0.125 * step && self.noise.is_none()),
+                    !(s.min < 0.125 * step && self.noise.is_none()),
                     "board.adc_bits",
                     bits,
                     format!(
-                        "the TIA output of mode {} (about {tia_out:e} V) is far below half an LSB of the ADC ({:e} V): every sample would read 0; raise board.tia_gain_ohm or board.adc_bits, or lower board.adc_full_scale_v",
+                        "the TIA output of mode {} ({small}) is far below half an LSB of the ADC ({:e} V): every sample would read 0; raise board.tia_gain_ohm or board.adc_bits, or lower board.adc_full_scale_v",
                         k + 1,
                         0.5 * step
                     ),
                 );
-                if tia_out < 0.5 * step {
+                if s.min < 0.5 * step {
                     warnings.push(format!(
-                        "the TIA output of mode {} (about {tia_out:e} V) is below half an LSB of the ADC ({:e} V): the signal survives only as dither of the noise",
+                        "the TIA output of mode {} ({small}) is below half an LSB of the ADC ({:e} V): {}",
                         k + 1,
-                        0.5 * step
+                        0.5 * step,
+                        if self.noise.is_some() {
+                            "the signal survives only as dither of the noise"
+                        } else {
+                            "with no noise to dither it every sample there reads 0, and the run gives that mode no phase; raise board.tia_gain_ohm or board.adc_bits, or lower board.adc_full_scale_v"
+                        }
                     ));
-                }
-                if tia_out >= 0.5 * step {
-                    let bound_mdeg = self.adc_phase_bound_mdeg(step, tia_out);
+                } else {
+                    let bound_mdeg = self.adc_phase_bound_mdeg(step, s.min);
                     if bound_mdeg > WARN_HOLD_ERROR_MDEG {
                         warnings.push(format!(
-                            "the ADC's LSB ({step:e} V) against the TIA output of mode {} (about {tia_out:e} V){}: its rounding error follows the carrier instead of averaging out and can move the measured phase by up to about {bound_mdeg:.3e} mdeg; raise board.adc_bits or lower board.adc_full_scale_v",
+                            "the ADC's LSB ({step:e} V) against the TIA output of mode {} ({small}){}: its rounding error follows the carrier instead of averaging out and can move the measured phase by up to about {bound_mdeg:.3e} mdeg; raise board.adc_bits or lower board.adc_full_scale_v",
                             k + 1,
                             if self.noise.is_some() { " and the TIA noise there" } else { ", no noise to dither it" }
                         ));
                     }
                 }
-                if tia_out > b.adc_full_scale_v - 0.5 * step {
+                if s.max > b.adc_full_scale_v - 0.5 * step {
                     warnings.push(format!(
-                        "the TIA output of mode {} (about {tia_out:e} V) exceeds the ADC's range (board.adc_full_scale_v = {}): it will clip; raise board.adc_full_scale_v or lower board.tia_gain_ohm",
+                        "the TIA output of mode {} ({big}) exceeds the ADC's range (board.adc_full_scale_v = {}): it will clip; raise board.adc_full_scale_v or lower board.tia_gain_ohm",
                         k + 1,
                         b.adc_full_scale_v
                     ));
                 }
             }
             if let Some(rail) = b.tia_rail_v {
-                if tia_out > rail {
+                if s.max > rail {
                     warnings.push(format!(
-                        "the TIA output of mode {} (about {tia_out:e} V) exceeds board.tia_rail_v = {rail}: it will saturate; raise the rails or lower board.tia_gain_ohm",
+                        "the TIA output of mode {} ({big}) exceeds board.tia_rail_v = {rail}: it will saturate; raise the rails or lower board.tia_gain_ohm",
                         k + 1
                     ));
                 }
@@ -225,11 +319,132 @@ impl Config {
         }
     }
 
+    /// The DAC rounds the cos and the sin drive sequences differently whenever the drives
+    /// differ or the carrier's period is not a multiple of 4 samples (only then is the sin
+    /// sequence a shifted copy of the cos one): the fundamentals the plant responds to change
+    /// in ratio and relative phase, which moves the Coriolis phase like a drive mismatch (250
+    /// mdeg at 4 bits, 1.85 mdeg at 12 bits, fs = 250 kHz, with no warning before). Stated as
+    /// the largest change of the theory's phase at the run's rates when the drives are
+    /// replaced by their quantised fundamentals. Rotating runs are left out: the drives there
+    /// share the in-phase carrier and the quantiser is odd and memoryless, so each drive's
+    /// fundamental is its envelope through one describing function, in phase with it, and
+    /// psi does not depend on the drives' ratio (measured: below 1e-4 mdeg at 4 bits).
+    fn validate_dac_rounding(&self, warnings: &mut Vec<String>) {
+        let Some(bits) = self.board.dac_bits else {
+            return;
+        };
+        if self.shape() == Shape::Rotating {
+            return;
+        }
+        let Some(([p1, p2], [q1, q2])) = self.dac_fundamentals(bits) else {
+            return;
+        };
+        let dev = self.driven_device();
+        // Common gains and phases cancel in every phase the board reads (each against zero
+        // rate, or against the table's own swing): only the ratio and the relative phase count.
+        let turn = ((q2 / q1) / (p2 / p1)).arg();
+        let quantised = gyroemu_theory::DrivenDevice {
+            drive: [
+                dev.drive[0] * q1.norm() / p1.norm(),
+                dev.drive[1] * q2.norm() / p2.norm(),
+            ],
+            phase_shifter_error_deg: dev.phase_shifter_error_deg - turn / DEG,
+            ..dev
+        };
+        let mut worst: f64 = 0.0;
+        for &r in &self.experiment.rates_dps {
+            let omega = r * DEG;
+            let pairs: Vec<([f64; 2], [f64; 2])> = match self.shape() {
+                Shape::RateTable { freq_hz } => {
+                    let (a, l) = dev.rate_table_response(omega, freq_hz);
+                    let (qa, ql) = quantised.rate_table_response(omega, freq_hz);
+                    vec![(a, qa), (l, ql)]
+                }
+                _ => vec![(
+                    dev.coriolis_phase_rad(omega),
+                    quantised.coriolis_phase_rad(omega),
+                )],
+            };
+            for (exact, q) in pairs {
+                for k in 0..2 {
+                    // Within a half turn, as the hold's (the sidebands' branch).
+                    let d = q[k] - exact[k];
+                    let d = d - core::f64::consts::PI * (d / core::f64::consts::PI).round();
+                    let e = (d / DEG * 1e3).abs();
+                    if e.is_finite() {
+                        worst = worst.max(e);
+                    }
+                }
+            }
+        }
+        if worst > WARN_HOLD_ERROR_MDEG {
+            let ratio = |a: Complex64, b: Complex64| (b / a).norm();
+            warnings.push(format!(
+                "board.dac_bits = {bits}: the DAC rounds the two drives differently (their fundamentals' ratio F2/F1 becomes {:.6e} instead of {:.6e}, their phase difference moves by {:.3e} deg), which moves the measured phase from the theory by up to {worst:.3e} mdeg at these rates, as a drive mismatch would; raise board.dac_bits (equal drives at a whole multiple of 4 samples per carrier period round alike)",
+                ratio(q1, q2),
+                ratio(p1, p2),
+                -turn / DEG
+            ));
+        }
+    }
+
+    /// The fundamentals at the carrier of the two Coriolis drive sequences as the board makes
+    /// them (its NCO, phase shifter and gains), unquantised and through the DAC's quantiser
+    /// (mid-tread, step 2 FS / 2^bits, ties away from zero, clipped to [-FS, FS - step]: the
+    /// arithmetic of `gyroemu_am::Quantizer::quantize`). Over one exact period of the sampled
+    /// carrier when it repeats within 2^20 samples (its phase then drifts by under 1e-12 turn
+    /// per period: the NCO's step word is within half a unit of the exact ratio); else over
+    /// 2^20 samples with a Hann window, whose leakage from the other lines of the rounding
+    /// error falls as the cube of their distance. `None` if a fundamental vanishes (the
+    /// dead-drive rules speak) or the NCO cannot be built.
+    fn dac_fundamentals(&self, bits: u32) -> Option<([Complex64; 2], [Complex64; 2])> {
+        const MAX_SPAN: u64 = 1 << 20;
+        let nco = gyroemu_nco::Nco::new(self.carrier_hz(), self.fs_hz(), 0.0).ok()?;
+        let step_word = nco.step_word();
+        let near_whole = |n: u64| (step_word.wrapping_mul(n) as i64).unsigned_abs() < 1 << 24;
+        let period = (1..=MAX_SPAN).find(|&n| near_whole(n));
+        let (n, hann) = period.map_or((MAX_SPAN, true), |n| (n, false));
+        let e = self.board.phase_shifter_error_deg;
+        let shifter = if e == 0.0 {
+            gyroemu_nco::PhaseShifter::quadrature()
+        } else {
+            gyroemu_nco::PhaseShifter::new((90.0 + e).to_radians()).ok()?
+        };
+        let fs = self.board.dac_full_scale;
+        let half_codes = (1u64 << (bits - 1)) as f64;
+        let lsb = fs / half_codes;
+        let quantise = |x: f64| (x / lsb).round().clamp(-half_codes, half_codes - 1.0) * lsb;
+        let gains = [self.drive.f1, self.f2()];
+        let mut carrier = gyroemu_nco::RotatingNco::<f64>::new(&[nco]);
+        let zero = Complex64::new(0.0, 0.0);
+        let (mut exact, mut rounded) = ([zero; 2], [zero; 2]);
+        for i in 0..n {
+            let (c, sn) = gyroemu_core::Stage::tick(&mut carrier, ());
+            let c = Complex64::new(c, sn);
+            let u = [gains[0] * c.re, gains[1] * shifter.apply(c).re];
+            let w = if hann {
+                let x = core::f64::consts::PI * (i as f64 + 0.5) / n as f64;
+                x.sin().powi(2)
+            } else {
+                1.0
+            };
+            for k in 0..2 {
+                exact[k] += c.conj() * (w * u[k]);
+                rounded[k] += c.conj() * (w * quantise(u[k]));
+            }
+        }
+        let ok = |v: &[Complex64; 2]| v.iter().all(|x| x.norm() > 0.0 && x.norm().is_finite());
+        (ok(&exact) && ok(&rounded)).then_some((exact, rounded))
+    }
+
     /// The stage-1 mixer's 2 f_c product, what the low-pass leaves of it, aliased by the
     /// decimation: a hand-set decimation whose output rate divides 2 f_c folds it onto DC
-    /// (6 % of the scale factor at order 1, M = 8). It moves the phasor by at most
-    /// |L(2 f_c)| x the averaging window's exact gain at the alias's distance from each
-    /// frequency the read-out demodulates (DC; Omega when rotating; the table's harmonics).
+    /// (6 % of the scale factor at order 1, M = 8). Coriolis: the read-out averages the
+    /// phasor (DC), which the product moves by at most |L(2 f_c)| x the window's exact gain at
+    /// the alias. Rate table: the read-out takes harmonics -N ..= N of the table, and the
+    /// product carries the envelope's own harmonics, so distances up to 2N table frequencies
+    /// from the alias count. Rotating: see [`Config::rotating_mixer_product_bound_rad`] (it
+    /// demodulates at +-f_m only, and what lands on DC there mostly cancels in psi).
     fn validate_mixer_product(&self, warnings: &mut Vec<String>) {
         let Ok(chain) = gyroemu_board::ChainResponse::new(&self.board_params()) else {
             return;
@@ -242,10 +457,16 @@ impl Config {
             let window = self.plan_point(rate).window;
             let refs: Vec<f64> = match self.shape() {
                 Shape::Coriolis => vec![0.0],
-                Shape::Rotating => vec![0.0, rate.abs() / 360.0],
-                Shape::RateTable { freq_hz } => (0..=15).map(|h| h as f64 * freq_hz).collect(),
+                Shape::Rotating => vec![],
+                Shape::RateTable { freq_hz } => (0..=2 * self.table_harmonics())
+                    .map(|h| h as f64 * freq_hz)
+                    .collect(),
             };
-            let (e, f) = mixer_product_bound_rad(&chain, fc, fs_out, &window, &refs);
+            let (e, f) = if self.shape() == Shape::Rotating {
+                self.rotating_mixer_product_bound_rad(&chain, &window, rate)
+            } else {
+                mixer_product_bound_rad(&chain, fc, fs_out, &window, &refs)
+            };
             if e > worst {
                 (worst, at) = (e, f);
             }
@@ -260,6 +481,61 @@ impl Config {
                 alias.abs()
             ));
         }
+    }
+
+    /// The rotating read-out's error from the stage-1 mixer's 2 f_c product at the point of
+    /// `rate_dps`, rad, and the f_m it demodulates. With the envelope `Z+ e^{j Omega t} + Z-
+    /// e^{-j Omega t}` the product is `conj(Z+) L'(2 f_c + f_m) e^{-j (2 w_c + Omega) t} +
+    /// conj(Z-) L'(2 f_c - f_m) e^{-j (2 w_c - Omega) t}` (`L' = conj L`). Stage 2 reads `Z+`
+    /// as the average of `z e^{-j Omega t}`, `Z-` of `z e^{j Omega t}`: each takes one term at
+    /// the alias of 2 f_c (window gain `W_a`, the same for both) and one at 2 f_c -+ 2 f_m.
+    /// The first terms move psi = (arg Z- - arg Z+)/2 by `Im(W_a e^{-j(arg Z+ + arg Z-)} (rho
+    /// L'+ / L(-f_m) - L'- / (rho L(f_m))))/2`, `rho = |Z+|/|Z-|` at the low-pass input: they
+    /// cancel for symmetric sidebands, which is why the DC bound was 5000 times too loose.
+    /// Bounded over the unknown common phase, plus the second terms' sizes.
+    fn rotating_mixer_product_bound_rad(
+        &self,
+        chain: &ChainResponse,
+        window: &gyroemu_lpf::Window,
+        rate_dps: f64,
+    ) -> (f64, f64) {
+        let (fc, fs_out) = (self.carrier_hz(), self.fs_out_hz());
+        let fm = rate_dps * DEG / core::f64::consts::TAU;
+        let w = |f: f64| window.response(f / fs_out).norm();
+        if fm == 0.0 {
+            // No modulation: the envelope is a constant phasor, as in a Coriolis run.
+            return mixer_product_bound_rad(chain, fc, fs_out, window, &[0.0]);
+        }
+        let plant = self.resonator_params();
+        let dev = self.driven_device();
+        let [f1, f2] = dev.drive;
+        let eps = dev.phase_shifter_error_deg * DEG;
+        let j = Complex64::new(0.0, 1.0);
+        // The sidebands at the low-pass input (the chain before it scales them by its response).
+        let side = |sign: f64| {
+            let turn = Complex64::from_polar(1.0, -sign * eps);
+            let f = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
+            let x = continuous_steady_state(&plant, 0.0, fc + sign * fm, f);
+            let g = chain.dac_hold(fc + sign * fm) * chain.tia(fc + sign * fm);
+            [x[2] * g, x[3] * g]
+        };
+        let (zp, zm) = (side(1.0), side(-1.0));
+        let lp = chain.lowpass(2.0 * fc + fm).conj();
+        let lm = chain.lowpass(2.0 * fc - fm).conj();
+        let l_pos = chain.lowpass(fm);
+        let l_neg = l_pos.conj();
+        let (w_a, w_p, w_m) = (w(2.0 * fc), w(2.0 * fc + 2.0 * fm), w(2.0 * fc - 2.0 * fm));
+        let worst = (0..2)
+            .map(|k| {
+                let rho = zp[k].norm() / zm[k].norm();
+                let dc = w_a * (rho * lp / l_neg - lm / (rho * l_pos)).norm();
+                let rest = (lp.norm() * w_p + lm.norm() * w_m) / l_pos.norm();
+                (0.5 * (dc + rest)).min(1.0).asin()
+            })
+            // A vanished sideband has no psi: the read-out reports it.
+            .filter(|e| e.is_finite())
+            .fold(0.0, f64::max);
+        (worst, fm.abs())
     }
 
     /// The stepped sine's own mixer products: each frequency is the carrier of its reading
@@ -391,4 +667,66 @@ fn mixer_product_bound_rad(
         }
     }
     (worst, at)
+}
+
+/// The smallest and the largest amplitude of a signal over the run's points, with the rate
+/// (deg/s) of each.
+#[derive(Clone, Copy, Debug)]
+struct AmpSpan {
+    min: f64,
+    min_at: f64,
+    max: f64,
+    max_at: f64,
+}
+
+impl Default for AmpSpan {
+    fn default() -> Self {
+        Self {
+            min: f64::INFINITY,
+            min_at: f64::NAN,
+            max: f64::NEG_INFINITY,
+            max_at: f64::NAN,
+        }
+    }
+}
+
+impl AmpSpan {
+    /// Widens the span by a point's amplitudes; a NaN (an unbuildable plant) poisons it.
+    fn include(&mut self, lo: f64, hi: f64, rate_dps: f64) {
+        if lo.is_nan() || hi.is_nan() {
+            self.min = f64::NAN;
+            self.max = f64::NAN;
+        }
+        if lo < self.min {
+            (self.min, self.min_at) = (lo, rate_dps);
+        }
+        if hi > self.max {
+            (self.max, self.max_at) = (hi, rate_dps);
+        }
+    }
+}
+
+/// The smallest and the largest `|sum_n h[n] e^{j (n - N) phi}|` over a period (`h` holds
+/// harmonics `-N ..= N`), on 16 (2N + 1) points per period: over a grid step near an
+/// extreme the envelope (its square a trigonometric polynomial of degree 2N) moves by about
+/// N^2 sum|h| (step/2)^2 / 2 (Bernstein), under 0.5 % of sum|h|.
+fn envelope_extremes(h: &[Complex64]) -> (f64, f64) {
+    let n = (h.len() / 2) as f64;
+    let points = 16 * h.len().max(1);
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for i in 0..points {
+        let phi = core::f64::consts::TAU * i as f64 / points as f64;
+        let v: Complex64 = h
+            .iter()
+            .enumerate()
+            .map(|(m, &x)| x * Complex64::from_polar(1.0, (m as f64 - n) * phi))
+            .sum();
+        let a = v.norm();
+        if a.is_nan() {
+            return (f64::NAN, f64::NAN);
+        }
+        lo = lo.min(a);
+        hi = hi.max(a);
+    }
+    (lo, hi)
 }

@@ -111,6 +111,23 @@ fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
     c.board.adc_bits = adc.map(|b| b.max(bits_for(2.0 * a1.max(a2) / a1.min(a2))));
     c.board.adc_full_scale_v = 2.0 * a1.max(a2);
     c.board.phase_shifter_error_deg = shift;
+    // Converter bits for what the run really sees below the resonance levels (validation weighs
+    // the steady state at the carrier and every rate): mode 2 is |mismatch| off the carrier, a
+    // rotating run's sidebands f_m off, and a Coriolis rate turns the phase by theta
+    // (amplitude cos theta). Each lowers a level by at most 1 + 2 Q offset / f0 or 1 + tan.
+    let raise = |c: &mut Config| {
+        let qmax = q.max(q2v);
+        let fm_max = match c.experiment.kind {
+            ExperimentKind::Rotating => c.max_rate_rad_s() / std::f64::consts::TAU,
+            ExperimentKind::Coriolis => 0.0,
+        };
+        let tan = 2.0 * qmax * lambda * c.max_rate_rad_s() / w0 * (f1 / f2).max(f2 / f1);
+        let drop = 1.0 + 2.0 * qmax * ((mismatch * f0).abs() + fm_max) / f0 + tan;
+        c.board.adc_bits = c
+            .board
+            .adc_bits
+            .map(|b| (b + drop.log2().ceil() as u32).min(32));
+    };
 
     let (kind, rates, avg_mult, hann, settle, noise, selfcal) = e;
     let cutoff = c.lpf_cutoff_hz();
@@ -164,6 +181,7 @@ fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
         f0_tc_ppm_per_k: -30.0,
         q_tc_ppm_per_k: -3000.0,
     });
+    raise(&mut c);
     c
 }
 
