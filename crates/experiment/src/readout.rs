@@ -246,9 +246,10 @@ pub fn theory_deg(cfg: &Config, rate_dps: f64) -> [f64; 2] {
 /// rates h, 2h and 4h: the forward differences D(h) and D(2h) combine as 2 D(h) - D(2h), which
 /// cancels the curvature's first term (a curve that starts off zero, as a strongly coupled
 /// device's psi, counts only its slope). h puts the phase near 1e-4 rad: smaller rates lose
-/// digits in the theory's w0^2 - w^2, larger ones bend (both near 1e-8 relative). The closed
-/// forms (2 Q lambda / w0 times a drive ratio) hold for the ideal device only: a mode-2 Q of
-/// half mode 1's halves mode 1's Coriolis slope, and a 2 Hz mode split lowers it by 22 %.
+/// digits in the theory's w0^2 - w^2, larger ones bend (atan's cube leaves 14/3 (1e-4)^2 =
+/// 5e-8 relative; Q = 36 000 loses about as much to rounding). The closed forms (2 Q lambda /
+/// w0 times a drive ratio) hold for the ideal device only: a mode-2 Q of half mode 1's halves
+/// mode 1's Coriolis slope, and a 2 Hz mode split lowers it by 22 %.
 fn small_rate_slope(cfg: &Config) -> [f64; 2] {
     let d = &cfg.device;
     let q = d.q.max(d.q_mode2.unwrap_or(d.q));
