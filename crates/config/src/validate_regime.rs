@@ -12,6 +12,15 @@ use gyroemu_resonator::continuous_steady_state;
 
 const DEG: f64 = core::f64::consts::PI / 180.0;
 
+/// |a - b| in mdeg within a half turn: a phase and the same plus 180 degrees read alike (the
+/// sidebands' branch), so only the difference within a half turn is a converter's or the
+/// hold's. NaN stays NaN.
+fn half_turn_mdeg(a: f64, b: f64) -> f64 {
+    let d = a - b;
+    let d = d - core::f64::consts::PI * (d / core::f64::consts::PI).round();
+    (d / DEG * 1e3).abs()
+}
+
 /// Every node's amplitude must lie in this band (in its own unit): products of two stay finite
 /// and normal, and no signal is rounded away in subnormals.
 pub const NODE_RANGE: (f64, f64) = (1e-100, 1e100);
@@ -367,10 +376,7 @@ impl Config {
             };
             for (exact, q) in pairs {
                 for k in 0..2 {
-                    // Within a half turn, as the hold's (the sidebands' branch).
-                    let d = q[k] - exact[k];
-                    let d = d - core::f64::consts::PI * (d / core::f64::consts::PI).round();
-                    let e = (d / DEG * 1e3).abs();
+                    let e = half_turn_mdeg(q[k], exact[k]);
                     if e.is_finite() {
                         worst = worst.max(e);
                     }
@@ -599,10 +605,9 @@ impl Config {
     /// matters, refused when the hold's images dominate.
     fn validate_hold(&self, p: &mut Rules, warnings: &mut Vec<String>) {
         let dev = self.driven_device();
-        let deg = core::f64::consts::PI / 180.0;
         let mut worst: f64 = 0.0;
         for &r in &self.experiment.rates_dps {
-            let omega = r * deg;
+            let omega = r * DEG;
             let (held, exact) = match self.shape() {
                 Shape::Rotating => (
                     dev.held_rotating_psi_rad(omega),
@@ -615,11 +620,7 @@ impl Config {
                 ),
             };
             for k in 0..2 {
-                // A phase and the same plus 180 degrees read alike (the sidebands' branch):
-                // only the difference within a half turn is the hold's.
-                let d = held[k] - exact[k];
-                let d = d - core::f64::consts::PI * (d / core::f64::consts::PI).round();
-                let e = (d / deg * 1e3).abs();
+                let e = half_turn_mdeg(held[k], exact[k]);
                 // A NaN (an unbuildable plant) is reported by the other rules.
                 if e.is_finite() {
                     worst = worst.max(e);
