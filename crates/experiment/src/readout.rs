@@ -253,7 +253,13 @@ pub fn theory_deg(cfg: &Config, rate_dps: f64) -> [f64; 2] {
 fn small_rate_slope(cfg: &Config) -> [f64; 2] {
     let d = &cfg.device;
     let q = d.q.max(d.q_mode2.unwrap_or(d.q));
-    let ideal = 2.0 * q * d.angular_gain / (core::f64::consts::TAU * d.f0_hz);
+    // The ideal device's largest slope, rad per rad/s: a rotating psi has no lambda, a
+    // Coriolis phase the larger drive ratio.
+    let gain = match cfg.shape() {
+        Shape::Rotating => 1.0,
+        _ => d.angular_gain * (cfg.drive.f1 / cfg.f2()).max(cfg.f2() / cfg.drive.f1),
+    };
+    let ideal = 2.0 * q * gain / (core::f64::consts::TAU * d.f0_hz);
     let h = 1e-4 / ideal / DEG;
     let t = [1.0, 2.0, 4.0].map(|m| theory_deg(cfg, m * h));
     [0, 1].map(|k| {
