@@ -155,6 +155,25 @@ fn averaging_time_reading_at_the_sweep_time_equals_the_sweep() {
 }
 
 #[test]
+fn averaging_time_readings_of_a_hann_config_are_boxcar_reads_and_right() {
+    // The readings are early reads of one run, which only a boxcar window has. A Hann config
+    // had them take Hann leaks never applied: +27.75 at 1 s and -2.55 at 10 s on this
+    // noiseless ideal device, where the self-calibration is exact (THEORY.md section 4:
+    // lambda times the rotating slope is the Coriolis slope).
+    let mut c = fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2);
+    c.experiment.window = gyroemu::config::WindowKind::Hann;
+    c.validate().unwrap();
+    let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
+    let m = core.modes[0];
+    assert!(m.relative_error.abs() < 1e-6, "{:?}", m.relative_error);
+    let t = tau_analysis(&c, 14.4, &m.coriolis, &core.combined.coriolis, None, &quiet).unwrap();
+    for p in &t {
+        assert!(p.relative_error.abs() < 1e-6, "{p:?}");
+        assert!(p.combined_relative_error.abs() < 1e-6, "{p:?}");
+    }
+}
+
+#[test]
 fn an_averaging_time_reading_carries_the_rate_tables_error_and_its_own_theory() {
     // Noisy, with unequal drives and Q: at the sweep's own averaging time the reading is the
     // self-calibration itself, so it must carry the same interval (it left out the rate-table
