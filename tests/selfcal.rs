@@ -248,6 +248,52 @@ fn averaging_time_progress_ends_at_its_total_whatever_the_lane_groups() {
 }
 
 #[test]
+fn an_open_loop_drift_error_carries_an_interval_as_wide_as_its_smaller_slope_makes_it() {
+    // Noise-dominated (TIA current noise), 20 K warmer: the open-loop carrier is then x
+    // half-bandwidths off the drifted resonance, so the Coriolis slope falls by 1 + x^2 and the
+    // signal by sqrt(1 + x^2) against a TIA noise that does not fall: the self-calibration's
+    // relative error, and its 95 % interval, grow by about (1 + x^2)^1.5, the slope ratio to
+    // the power 1.5. The drift cases had reported no interval at all. Each interval rests on
+    // its fits' residuals (6 degrees of freedom), so the widening is averaged (in logs) over
+    // seeds.
+    let rates = [60.0, 75.0, 90.0, 105.0, 120.0, 135.0, 150.0, 175.0];
+    let (mut log_widening, mut log_ratio) = (0.0, 0.0);
+    let seeds = 0..6u64;
+    let n = seeds.clone().count() as f64;
+    for seed in seeds {
+        let mut c = fast_cfg(&rates, 3.6);
+        c.noise = Some(NoiseConfig {
+            seed,
+            temperature_k: 300.0,
+            effective_mass_kg: None,
+            tia_current_noise_a_per_rthz: 5e-12,
+            tia_voltage_noise_v_per_rthz: 0.0,
+            ..Default::default()
+        });
+        c.selfcal = Some(SelfcalConfig {
+            f0_tc_ppm_per_k: -30.0,
+            q_tc_ppm_per_k: -3000.0,
+            ..Default::default()
+        });
+        let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
+        let m = core.modes[0];
+        let nominal = m.coriolis.slope_deg_per_dps;
+        let d = drift_analysis(&c, &[20.0], nominal, None, &quiet).unwrap();
+        let open = &d[0].open_loop;
+        log_ratio += (nominal / open.measured_deg_per_dps).ln() / n;
+        log_widening += (open.selfcal_relative_error_ci95 / m.relative_error_ci95).ln() / n;
+        assert!(open.combined_selfcal_relative_error_ci95.is_finite());
+    }
+    let (ratio, widening) = (log_ratio.exp(), log_widening.exp());
+    assert!(ratio > 5.0, "the carrier is off resonance: {ratio}");
+    let expected = ratio.powf(1.5);
+    assert!(
+        widening > expected / 1.5 && widening < 1.5 * expected,
+        "intervals widened {widening}x for a slope {ratio}x smaller ({expected}x expected)"
+    );
+}
+
+#[test]
 fn noisy_selfcal_errors_scatter_as_their_reported_confidence() {
     // Ideal device, TIA noise raised so noise dominates: 8 seeds. The errors must centre on
     // zero and scatter like the standard error each run reports (from its fit residuals).

@@ -416,14 +416,16 @@ fn tau_figure(t: &[TauPoint], average_s: f64) -> Figure {
 
 fn drift_table(d: &[DriftPoint]) -> CsvTable {
     let case = |c: Option<&DriftCase>| {
-        c.map_or([f64::NAN; 6], |c| {
+        c.map_or([f64::NAN; 8], |c| {
             [
                 c.carrier_hz,
                 c.measured_deg_per_dps,
                 c.selfcal_deg_per_dps,
                 c.selfcal_relative_error,
+                c.selfcal_relative_error_ci95,
                 c.stale_relative_error,
                 c.combined_selfcal_relative_error,
+                c.combined_selfcal_relative_error_ci95,
             ]
         })
     };
@@ -446,14 +448,18 @@ fn drift_table(d: &[DriftPoint]) -> CsvTable {
             "open_loop_measured_deg_per_dps",
             "open_loop_selfcal_deg_per_dps",
             "open_loop_selfcal_relative_error",
+            "open_loop_selfcal_relative_error_ci95",
             "open_loop_stale_relative_error",
             "open_loop_combined_selfcal_relative_error",
+            "open_loop_combined_selfcal_relative_error_ci95",
             "pll_carrier_hz",
             "pll_measured_deg_per_dps",
             "pll_selfcal_deg_per_dps",
             "pll_selfcal_relative_error",
+            "pll_selfcal_relative_error_ci95",
             "pll_stale_relative_error",
             "pll_combined_selfcal_relative_error",
+            "pll_combined_selfcal_relative_error_ci95",
             "pll_lock_time_s",
         ],
         rows,
