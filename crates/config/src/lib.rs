@@ -14,6 +14,7 @@ mod resolve;
 mod rules;
 mod schema;
 mod validate;
+mod validate_dac;
 mod validate_montecarlo;
 mod validate_noise;
 mod validate_regime;

@@ -10,12 +10,12 @@ use gyroemu_board::{ChainResponse, Shape};
 use gyroemu_core::Complex64;
 use gyroemu_resonator::continuous_steady_state;
 
-const DEG: f64 = core::f64::consts::PI / 180.0;
+pub(crate) const DEG: f64 = core::f64::consts::PI / 180.0;
 
 /// |a - b| in mdeg within a half turn: a phase and the same plus 180 degrees read alike (the
 /// sidebands' branch), so only the difference within a half turn is a converter's or the
 /// hold's. NaN stays NaN.
-fn half_turn_mdeg(a: f64, b: f64) -> f64 {
+pub(crate) fn half_turn_mdeg(a: f64, b: f64) -> f64 {
     let d = a - b;
     let d = d - core::f64::consts::PI * (d / core::f64::consts::PI).round();
     (d / DEG * 1e3).abs()
@@ -326,121 +326,6 @@ impl Config {
                 }
             }
         }
-    }
-
-    /// The DAC rounds the cos and the sin drive sequences differently whenever the drives
-    /// differ or the carrier's period is not a multiple of 4 samples (only then is the sin
-    /// sequence a shifted copy of the cos one): the fundamentals the plant responds to change
-    /// in ratio and relative phase, which moves the Coriolis phase like a drive mismatch (250
-    /// mdeg at 4 bits, 1.85 mdeg at 12 bits, fs = 250 kHz, with no warning before). Stated as
-    /// the largest change of the theory's phase at the run's rates when the drives are
-    /// replaced by their quantised fundamentals. Rotating runs are left out: the drives there
-    /// share the in-phase carrier and the quantiser is odd and memoryless, so each drive's
-    /// fundamental is its envelope through one describing function, in phase with it, and
-    /// psi does not depend on the drives' ratio (measured: below 1e-4 mdeg at 4 bits).
-    fn validate_dac_rounding(&self, warnings: &mut Vec<String>) {
-        let Some(bits) = self.board.dac_bits else {
-            return;
-        };
-        if self.shape() == Shape::Rotating {
-            return;
-        }
-        let Some(([p1, p2], [q1, q2])) = self.dac_fundamentals(bits) else {
-            return;
-        };
-        let dev = self.driven_device();
-        // Common gains and phases cancel in every phase the board reads (each against zero
-        // rate, or against the table's own swing): only the ratio and the relative phase count.
-        let turn = ((q2 / q1) / (p2 / p1)).arg();
-        let quantised = gyroemu_theory::DrivenDevice {
-            drive: [
-                dev.drive[0] * q1.norm() / p1.norm(),
-                dev.drive[1] * q2.norm() / p2.norm(),
-            ],
-            phase_shifter_error_deg: dev.phase_shifter_error_deg - turn / DEG,
-            ..dev
-        };
-        let mut worst: f64 = 0.0;
-        for &r in &self.experiment.rates_dps {
-            let omega = r * DEG;
-            let pairs: Vec<([f64; 2], [f64; 2])> = match self.shape() {
-                Shape::RateTable { freq_hz } => {
-                    let (a, l) = dev.rate_table_response(omega, freq_hz);
-                    let (qa, ql) = quantised.rate_table_response(omega, freq_hz);
-                    vec![(a, qa), (l, ql)]
-                }
-                _ => vec![(
-                    dev.coriolis_phase_rad(omega),
-                    quantised.coriolis_phase_rad(omega),
-                )],
-            };
-            for (exact, q) in pairs {
-                for k in 0..2 {
-                    let e = half_turn_mdeg(q[k], exact[k]);
-                    if e.is_finite() {
-                        worst = worst.max(e);
-                    }
-                }
-            }
-        }
-        if worst > WARN_HOLD_ERROR_MDEG {
-            let ratio = |a: Complex64, b: Complex64| (b / a).norm();
-            warnings.push(format!(
-                "board.dac_bits = {bits}: the DAC rounds the two drives differently (their fundamentals' ratio F2/F1 becomes {:.6e} instead of {:.6e}, their phase difference moves by {:.3e} deg), which moves the measured phase from the theory by up to {worst:.3e} mdeg at these rates, as a drive mismatch would; raise board.dac_bits (equal drives at a whole multiple of 4 samples per carrier period round alike)",
-                ratio(q1, q2),
-                ratio(p1, p2),
-                -turn / DEG
-            ));
-        }
-    }
-
-    /// The fundamentals at the carrier of the two Coriolis drive sequences as the board makes
-    /// them (its NCO, phase shifter and gains), unquantised and through the DAC's quantiser
-    /// (mid-tread, step 2 FS / 2^bits, ties away from zero, clipped to [-FS, FS - step]: the
-    /// arithmetic of `gyroemu_am::Quantizer::quantize`). Over one exact period of the sampled
-    /// carrier when it repeats within 2^20 samples (its phase then drifts by under 1e-12 turn
-    /// per period: the NCO's step word is within half a unit of the exact ratio); else over
-    /// 2^20 samples with a Hann window, whose leakage from the other lines of the rounding
-    /// error falls as the cube of their distance. `None` if a fundamental vanishes (the
-    /// dead-drive rules speak) or the NCO cannot be built.
-    fn dac_fundamentals(&self, bits: u32) -> Option<([Complex64; 2], [Complex64; 2])> {
-        const MAX_SPAN: u64 = 1 << 20;
-        let nco = gyroemu_nco::Nco::new(self.carrier_hz(), self.fs_hz(), 0.0).ok()?;
-        let step_word = nco.step_word();
-        let near_whole = |n: u64| (step_word.wrapping_mul(n) as i64).unsigned_abs() < 1 << 24;
-        let period = (1..=MAX_SPAN).find(|&n| near_whole(n));
-        let (n, hann) = period.map_or((MAX_SPAN, true), |n| (n, false));
-        let e = self.board.phase_shifter_error_deg;
-        let shifter = if e == 0.0 {
-            gyroemu_nco::PhaseShifter::quadrature()
-        } else {
-            gyroemu_nco::PhaseShifter::new((90.0 + e).to_radians()).ok()?
-        };
-        let fs = self.board.dac_full_scale;
-        let half_codes = (1u64 << (bits - 1)) as f64;
-        let lsb = fs / half_codes;
-        let quantise = |x: f64| (x / lsb).round().clamp(-half_codes, half_codes - 1.0) * lsb;
-        let gains = [self.drive.f1, self.f2()];
-        let mut carrier = gyroemu_nco::RotatingNco::<f64>::new(&[nco]);
-        let zero = Complex64::new(0.0, 0.0);
-        let (mut exact, mut rounded) = ([zero; 2], [zero; 2]);
-        for i in 0..n {
-            let (c, sn) = gyroemu_core::Stage::tick(&mut carrier, ());
-            let c = Complex64::new(c, sn);
-            let u = [gains[0] * c.re, gains[1] * shifter.apply(c).re];
-            let w = if hann {
-                let x = core::f64::consts::PI * (i as f64 + 0.5) / n as f64;
-                x.sin().powi(2)
-            } else {
-                1.0
-            };
-            for k in 0..2 {
-                exact[k] += c.conj() * (w * u[k]);
-                rounded[k] += c.conj() * (w * quantise(u[k]));
-            }
-        }
-        let ok = |v: &[Complex64; 2]| v.iter().all(|x| x.norm() > 0.0 && x.norm().is_finite());
-        (ok(&exact) && ok(&rounded)).then_some((exact, rounded))
     }
 
     /// The stage-1 mixer's 2 f_c product, what the low-pass leaves of it, aliased by the
