@@ -154,15 +154,81 @@ impl StartUp<'_> {
         }
         total.max(0.0)
     }
+
+    /// The plant's start-up bound `b_j` (the per-sample form of [`StartUp::plant`]) at each of
+    /// the window's samples, weighted by the window and folded onto `bins` equal bins of the
+    /// table period (by the table's phase at the sample): entry `i` is the window's mean of
+    /// `b` over the samples whose phase lies in `[i, i + 1) / bins` of a turn.
+    fn plant_fold(
+        &self,
+        k0: f64,
+        head: f64,
+        cycles_per_sample: f64,
+        bins: usize,
+    ) -> Option<Vec<f64>> {
+        // Beyond this many samples (a few ms each million) the caller weighs the window's
+        // mean against the kernel's largest value instead.
+        if self.window.samples() > 1 << 22 {
+            return None;
+        }
+        let m = self.m;
+        // b at the window's sample j, n' = n0 + j M - k0 (see `plant`): the head's a^{n'} and,
+        // per pole, c (a^{n'} - rho^{n'}) / (a - rho); each a geometric sequence in j.
+        let n1 = self.n0 - k0;
+        let mut head_term = head * (self.ln_a * n1).exp();
+        let head_step = (self.ln_a * m).exp();
+        let mut terms: Vec<[f64; 4]> = self
+            .modes
+            .iter()
+            .map(|&(z, r)| {
+                let ln_rho = z.norm().ln();
+                let mut ln_a = self.ln_a;
+                if (ln_a - ln_rho).abs() < 1e-6 * ln_rho.abs() {
+                    ln_a = ln_rho * (1.0 - 1e-3);
+                }
+                let c = r.norm() * (ln_rho * (k0 + 1.0)).exp() / (ln_a.exp() - ln_rho.exp());
+                [
+                    c * (ln_a * n1).exp(),
+                    c * (ln_rho * n1).exp(),
+                    (ln_a * m).exp(),
+                    (ln_rho * m).exp(),
+                ]
+            })
+            .collect();
+        let mut folded = vec![0.0; bins];
+        let mut wsum = 0.0;
+        let phase0 = (cycles_per_sample * self.n0).rem_euclid(1.0);
+        let dphase = (cycles_per_sample * m).rem_euclid(1.0);
+        for j in 0..self.window.samples() {
+            let w = self.window.weight(j);
+            wsum += w;
+            let b = (head_term + terms.iter().map(|t| t[0] - t[1]).sum::<f64>()).max(0.0);
+            let phase = (phase0 + dphase * j as f64).rem_euclid(1.0);
+            folded[((phase * bins as f64) as usize).min(bins - 1)] += w * b;
+            head_term *= head_step;
+            for t in terms.iter_mut() {
+                t[0] *= t[2];
+                t[1] *= t[3];
+            }
+        }
+        if wsum > 0.0 {
+            for f in folded.iter_mut() {
+                *f /= wsum;
+            }
+        }
+        Some(folded)
+    }
 }
 
-/// Most taps of the built low-pass [`impulse_head`] runs (a few ms).
-const MAX_HEAD_TAPS: f64 = 4e6;
+/// Most taps of the built low-pass [`impulse_head`] runs (about 10 ms at 48 MHz).
+const MAX_HEAD_TAPS: f64 = 1.5e6;
 
 /// The built stage-1 filter's impulse response, run for `k0 + 1` taps (`k0` at most `n0`, the
-/// first averaged sample, and about 200 time constants of the cutoff, where the slowest
-/// order-8 pole has decayed by e^-39): `(k0, sum_{k <= k0} |h_k| a^{k0-k})`. Its exact taps
-/// keep the plant's bound from the modal envelope's looseness (10x at order 4).
+/// first averaged sample, and 40 time constants of the cutoff): `(k0, sum_{k <= k0} |h_k|
+/// a^{k0-k})`. Its exact taps keep the plant's bound from the modal envelope's looseness (10x
+/// at order 4, where the poles still cancel); by 40 time constants only the slowest pair is
+/// left (order 8's next one has decayed by e^-22), and the envelope `sum |r_i| rho_i^k` of a
+/// single pair is its own peak. (200 time constants had cost 35 ms per rate at 48 MHz.)
 fn impulse_head(
     design: gyroemu_lpf::LowPassDesign,
     fs: f64,
@@ -175,7 +241,7 @@ fn impulse_head(
         return (0.0, 0.0);
     };
     let k0 = n0
-        .min((200.0 * fs / (core::f64::consts::TAU * cutoff)).ceil())
+        .min((40.0 * fs / (core::f64::consts::TAU * cutoff)).ceil())
         .min(MAX_HEAD_TAPS);
     let a = ln_a.exp();
     let mut head = 0.0;
@@ -201,13 +267,13 @@ impl Config {
         ]) {
             return;
         }
-        let Some((worst, at, table_lag, exact)) = self.settling_bound() else {
+        let Some((worst, at, table_lag, (exact, exact_at))) = self.settling_bound() else {
             return;
         };
         let tau = self.slowest_tau_s();
         let fc = self.lpf_cutoff_hz();
         let what = format!(
-            "experiment.settle_s = {settle} leaves the plant's start-up (tau = {tau} s) and the stage-1 low-pass's ({}th order at {fc} Hz) in the averaging window",
+            "experiment.settle_s = {settle} leaves the plant's start-up (tau = {tau} s) and the stage-1 low-pass's (order {} at {fc} Hz) in the averaging window",
             self.board.lpf_order
         );
         let fix = format!(
@@ -221,7 +287,7 @@ impl Config {
             p.push(ConfigError::key(
                 "experiment.settle_s",
                 settle,
-                format!("{what}: at {at} deg/s the low-pass's start-up left in the window is {exact:.2e} of the sideband it passes, so the measured phase is undetermined; {fix}"),
+                format!("{what}: at {exact_at} deg/s the low-pass's start-up left in the window is {exact:.2e} of the sideband it passes, so the measured phase is undetermined; {fix}"),
             ));
             return;
         }
@@ -247,10 +313,12 @@ impl Config {
         }
     }
 
-    /// The largest relative start-up of a read phasor over the points, the rate it is at, for
-    /// a rate table the lag bound (rad) it implies, and the largest exact low-pass start-up on
-    /// a rotating run's sidebands, relative; `None` if the chain cannot be built.
-    fn settling_bound(&self) -> Option<(f64, f64, Option<f64>, f64)> {
+    /// The largest relative start-up of a read phasor over the points (for a rate table, of
+    /// the phase amplitude read, rad), the rate it is at, for a rate table the lag bound (rad)
+    /// it implies, and the largest exact low-pass start-up on a rotating run's sidebands,
+    /// relative, with its rate; `None` if the chain cannot be built.
+    #[allow(clippy::type_complexity)]
+    fn settling_bound(&self) -> Option<(f64, f64, Option<f64>, (f64, f64))> {
         let chain = gyroemu_board::ChainResponse::new(&self.board_params()).ok()?;
         let fs = self.fs_hz();
         let (modes, _) = lowpass_modes(self.board.lpf_order, self.lpf_cutoff_hz(), fs);
@@ -260,17 +328,21 @@ impl Config {
         // The mixer's 2 f_c product starts up with the rest (its start-up is tiny: the
         // low-pass stops it).
         let image = -w_of(2.0 * self.carrier_hz());
-        let (mut worst, mut at, mut lag, mut exact) = (0.0f64, f64::NAN, None, 0.0f64);
+        let (mut worst, mut at, mut lag) = (0.0f64, f64::NAN, None);
+        let (mut exact, mut exact_at) = (0.0f64, f64::NAN);
+        let ln_a = -1.0 / (self.slowest_tau_s() * fs);
+        // The same for every point: computed once (it runs up to MAX_HEAD_TAPS taps).
+        let (k0, head) = impulse_head(self.lowpass_design(), fs, self.lpf_cutoff_hz(), n0, ln_a);
+        // Every table point has the same window: the plant's Dirichlet-weighted bound once.
+        let mut table_fold: Option<Option<Vec<f64>>> = None;
         for rate in self.emulated_rates_dps() {
             let su = StartUp {
                 modes: &modes,
                 window: self.plan_point(rate).window,
                 n0,
                 m,
-                ln_a: -1.0 / (self.slowest_tau_s() * fs),
+                ln_a,
             };
-            let (k0, head) =
-                impulse_head(self.lowpass_design(), fs, self.lpf_cutoff_hz(), n0, su.ln_a);
             let plant = su.plant(k0, head);
             let (e, l) = match self.shape() {
                 Shape::Coriolis => {
@@ -291,67 +363,160 @@ impl Config {
                             .sum();
                         let steady =
                             0.5 * chain.lowpass(w_read * fs / core::f64::consts::TAU).norm();
-                        exact = exact.max(left / steady);
+                        if left / steady > exact || (left / steady).is_nan() {
+                            (exact, exact_at) = (left / steady, rate);
+                        }
                         e += 0.5 * ((left + plant) / steady).min(1.0);
                     }
                     (e, None)
                 }
                 Shape::RateTable { freq_hz } => {
                     let n = self.table_harmonics() as i64;
+                    let nu = n as usize;
+                    let tau = core::f64::consts::TAU;
                     let env = self.driven_device().rate_table_envelopes(
                         rate.abs() * core::f64::consts::PI / 180.0,
                         freq_hz,
-                        n as usize,
+                        nu,
                     );
-                    let mut e: f64 = 0.0;
-                    let mut amp: f64 = f64::INFINITY;
+                    let inv_l: Vec<Complex64> = (-n..=n)
+                        .map(|r| 1.0 / chain.lowpass(r as f64 * freq_hz))
+                        .collect();
+                    let bins = 64 * (2 * nu + 1);
+                    let fold = table_fold
+                        .get_or_insert_with(|| su.plant_fold(k0, head, freq_hz / fs, bins))
+                        .as_deref();
+                    let mut amp_err: f64 = 0.0;
+                    let mut pointwise: f64 = 0.0;
                     for z in &env {
-                        // The phase of z(t) moves by at most |dz| / min |z(t)| (min over a
-                        // period, sampled finely: z(t) is a trigonometric polynomial of
-                        // degree N).
+                        // z(theta) on a fine grid: its floor, and g = 1/z's harmonics
+                        // -(N+1) ..= N+1 (smooth while z stays off 0: its higher ones fall
+                        // geometrically; 64 (N+1) points leave their fold-over negligible).
                         let total: f64 = z.iter().map(|v| v.norm()).sum();
-                        let steps = 64 * (n as usize + 1);
-                        let floor = (0..steps)
+                        let steps = 64 * (nu + 1);
+                        let zs: Vec<Complex64> = (0..steps)
                             .map(|t| {
-                                let th = core::f64::consts::TAU * t as f64 / steps as f64;
+                                let th = tau * t as f64 / steps as f64;
                                 z.iter()
                                     .enumerate()
                                     .map(|(i, v)| {
                                         v * Complex64::from_polar(1.0, (i as i64 - n) as f64 * th)
                                     })
                                     .sum::<Complex64>()
-                                    .norm()
                             })
-                            .fold(f64::INFINITY, f64::min);
-                        let mut dz = 0.0;
-                        for read in -n..=n {
-                            let w_read = w_of(read as f64 * freq_hz);
-                            let mut left = total * plant;
-                            for (i, v) in z.iter().enumerate() {
-                                let w = w_of((i as i64 - n) as f64 * freq_hz);
-                                left += v.norm()
-                                    * (su.lowpass(w, w_read).norm()
-                                        + su.lowpass(image - w, w_read).norm());
-                            }
-                            dz += left / chain.lowpass(read as f64 * freq_hz).norm();
+                            .collect();
+                        let floor = zs.iter().map(|v| v.norm()).fold(f64::INFINITY, f64::min);
+                        if floor.is_nan() || floor <= 0.0 {
+                            (amp_err, pointwise) = (f64::INFINITY, f64::INFINITY);
+                            break;
                         }
-                        e = e.max(if floor > 0.0 {
-                            dz / floor
+                        let g = |m: i64| -> Complex64 {
+                            zs.iter()
+                                .enumerate()
+                                .map(|(t, v)| {
+                                    let th = tau * t as f64 / steps as f64;
+                                    Complex64::from_polar(1.0, -(m as f64) * th) / v
+                                })
+                                .sum::<Complex64>()
+                                / steps as f64
+                        };
+                        let gs: Vec<Complex64> = (-(n + 1)..=n + 1).map(g).collect();
+                        let g_at = |m: i64| gs[(m + n + 1) as usize];
+                        // The low-pass's own start-up, exact per tone and per harmonic read:
+                        // |d_n| <= left_n / |L_n| in the rebuilt envelope.
+                        let d: Vec<f64> = (-n..=n)
+                            .map(|read| {
+                                let w_read = w_of(read as f64 * freq_hz);
+                                let left: f64 = z
+                                    .iter()
+                                    .enumerate()
+                                    .map(|(i, v)| {
+                                        let w = w_of((i as i64 - n) as f64 * freq_hz);
+                                        v.norm()
+                                            * (su.lowpass(w, w_read).norm()
+                                                + su.lowpass(image - w, w_read).norm())
+                                    })
+                                    .sum();
+                                left * inv_l[(read + n) as usize].norm()
+                            })
+                            .collect();
+                        // Pointwise |dz| / |z| (the old bound): the second-order remainder,
+                        // and the whole bound once the first order no longer holds.
+                        let e = (total * plant * inv_l.iter().map(|l| l.norm()).sum::<f64>()
+                            + d.iter().sum::<f64>())
+                            / floor;
+                        pointwise = pointwise.max(e);
+                        let a = if e < 0.5 {
+                            // The fundamental of delta phi = Im(dz g) (+ at most |u|^2, u =
+                            // dz/z, as |arg(1 + u) - Im u| <= |u|^2 for |u| <= 1/2) has
+                            // amplitude <= |(dz g)_1| + |(dz g)_-1|. Low-pass part:
+                            // sum_n |d_n| |g_{+-1-n}|. Plant part: dz_n = <dy e^{-j n w t}> / L_n
+                            // with |dy| <= total b(t), so (dz g)_{+-1} = <dy K_{+-}(w t)>,
+                            // K_{+-}(x) = sum_n g_{+-1-n} e^{-j n x} / L_n: charged once
+                            // against the folded b, not per harmonic.
+                            let lp: f64 = (-n..=n)
+                                .map(|r| {
+                                    d[(r + n) as usize] * (g_at(1 - r).norm() + g_at(-1 - r).norm())
+                                })
+                                .sum();
+                            let slope: f64 = (-n..=n)
+                                .map(|r| {
+                                    let l = inv_l[(r + n) as usize].norm();
+                                    r.abs() as f64 * l * (g_at(1 - r).norm() + g_at(-1 - r).norm())
+                                })
+                                .sum();
+                            let half_bin = 0.5 * tau / bins as f64;
+                            // A window too long to fold: its whole mean in every bin's place.
+                            let uniform;
+                            let folded = fold.is_some();
+                            let fold: &[f64] = match fold {
+                                Some(f) => f,
+                                None => {
+                                    uniform = vec![plant; bins];
+                                    &uniform
+                                }
+                            };
+                            let kernel = fold.iter().enumerate().filter(|&(_, &f)| f > 0.0).map(
+                                |(b, &f)| {
+                                    let x = tau * (b as f64 + 0.5) / bins as f64;
+                                    let k = |s: i64| {
+                                        (-n..=n)
+                                            .map(|r| {
+                                                g_at(s - r)
+                                                    * inv_l[(r + n) as usize]
+                                                    * Complex64::from_polar(1.0, -(r as f64) * x)
+                                            })
+                                            .sum::<Complex64>()
+                                            .norm()
+                                    };
+                                    f * (k(1) + k(-1) + slope * half_bin)
+                                },
+                            );
+                            let plant_part: f64 = if folded {
+                                kernel.sum()
+                            } else {
+                                kernel.fold(0.0, f64::max)
+                            };
+                            total * plant_part + lp + 4.0 / core::f64::consts::PI * e * e
                         } else {
-                            f64::INFINITY
-                        });
+                            // The fundamental of a function bounded by x is at most 4x/pi.
+                            4.0 / core::f64::consts::PI * e.min(1.0).asin()
+                        };
+                        amp_err = amp_err.max(a);
                     }
-                    let theory = self
+                    let amp = self
                         .driven_device()
                         .rate_table_response(rate.abs() * core::f64::consts::PI / 180.0, freq_hz)
-                        .0;
-                    for a in theory {
-                        amp = amp.min(a.abs());
-                    }
-                    (
-                        e,
-                        Some((e.min(1.0).asin() / amp).min(core::f64::consts::PI)),
-                    )
+                        .0
+                        .into_iter()
+                        .fold(f64::INFINITY, |m, a| m.min(a.abs()));
+                    // Stated as asin of what is returned (1 and beyond: "or more").
+                    let stated = if pointwise >= 1.0 || amp_err >= 0.5 * core::f64::consts::PI {
+                        pointwise.max(1.0)
+                    } else {
+                        amp_err.sin()
+                    };
+                    (stated, Some((amp_err / amp).min(core::f64::consts::PI)))
                 }
             };
             if e > worst || e.is_nan() {
@@ -361,7 +526,7 @@ impl Config {
                 }
             }
         }
-        Some((worst, at, lag, exact))
+        Some((worst, at, lag, (exact, exact_at)))
     }
 
     /// Rate-table runs: two demodulated harmonics `n` and `n + d` (`d <= 2N`) whose frequency
@@ -376,6 +541,17 @@ impl Config {
         }
         let n = self.table_harmonics();
         let fs_out = self.fs_out_hz();
+        // Removing the key helps only when the derived decimation is another one.
+        let derived = {
+            let mut c = self.clone();
+            c.board.decimation = None;
+            c.decimation()
+        };
+        let derived_note = if derived == self.decimation() {
+            String::new()
+        } else {
+            format!(", or remove the key for the derived one ({derived})")
+        };
         for rate in self.experiment.rates_dps.iter().take(1) {
             // Every table point averages whole table periods of the same span.
             let window = self.plan_point(*rate).window;
@@ -389,10 +565,11 @@ impl Config {
                         "board.decimation",
                         self.decimation(),
                         format!(
-                            "the output rate fs_hz/decimation = {fs_out} Hz is {} x {d} x experiment.table_freq_hz ({ft} Hz){}: at the output instants table harmonics n and n + {d} are the same frequency, and the read-out demodulates harmonics -{n} ..= {n}, so it cannot tell them apart (their alias distance {delta:.3e} Hz is below {MIN_TABLE_ALIAS_CYCLES:e} cycles of the {t} s window); choose a decimation whose output rate is not within that of a multiple of table_freq_hz / k for k <= {}, or remove the key for the derived one, or change table_freq_hz",
+                            "the output rate fs_hz/decimation = {fs_out} Hz is {} x {d} x experiment.table_freq_hz ({ft} Hz){}: at the output instants table harmonics n and n + {d} are the same frequency, and the read-out demodulates harmonics -{n} ..= {n}, so it cannot tell them apart (their alias distance {delta:.3e} Hz is below {MIN_TABLE_ALIAS_CYCLES:e} cycles of the {t} s window); choose a decimation whose output rate is not within that of a multiple of table_freq_hz / k for k <= {}{}, or change table_freq_hz",
                             if k == 1.0 { "1".to_string() } else { format!("1/{k}") },
                             if delta == 0.0 { "" } else { " (nearly)" },
-                            2 * n
+                            2 * n,
+                            derived_note
                         ),
                     ));
                     return;
