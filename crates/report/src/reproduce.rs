@@ -477,7 +477,7 @@ fn fig6(cfg: &Config, cor: &SweepResult, rot: &SweepResult) -> Figure {
     })
     .with(theory_series(
         cfg,
-        &theory_abscissae(lo, hi, &rates),
+        &theory_abscissae(lo, hi, &rates, 100),
         0,
         1.0,
         "exact theory (eq. 3)",

@@ -157,17 +157,13 @@ pub fn line_span(rates: &[f64]) -> (f64, f64) {
         .fold((0.0, 0.0), |(lo, hi), &x| (x.min(lo), x.max(hi)))
 }
 
-/// Abscissae of a theory curve: evenly over `[lo, hi]`, halvings of the first step on each
-/// side towards 0 (a phase saturating at large rates turns most steeply there), and the
-/// measured `rates` themselves, so the line goes through the theory at every point.
-pub fn theory_abscissae(lo: f64, hi: f64, rates: &[f64]) -> Vec<f64> {
-    // A rate table's theory is a harmonic balance per abscissa: 100 steps keep the curve smooth
-    // at a pixel's width without making its figure the run's slowest (400 plus 40 halvings
-    // cost `reproduce` 0.3 CPU-s).
-    const STEPS: usize = 100;
-    let mut xs: Vec<f64> = (0..=STEPS)
-        .map(|i| lo + (hi - lo) * i as f64 / STEPS as f64)
-        .chain((1..=6).flat_map(|j| [lo, hi].map(|e| e / STEPS as f64 * 0.5f64.powi(j))))
+/// Abscissae of a theory curve: `steps` even steps over `[lo, hi]`, halvings of the first step
+/// on each side towards 0 (a phase saturating at large rates turns most steeply there), and
+/// the measured `rates` themselves, so the line goes through the theory at every point.
+pub fn theory_abscissae(lo: f64, hi: f64, rates: &[f64], steps: usize) -> Vec<f64> {
+    let mut xs: Vec<f64> = (0..=steps)
+        .map(|i| lo + (hi - lo) * i as f64 / steps as f64)
+        .chain((1..=6).flat_map(|j| [lo, hi].map(|e| e / steps as f64 * 0.5f64.powi(j))))
         .chain(rates.iter().copied().filter(|x| x.is_finite()))
         .collect();
     xs.sort_by(f64::total_cmp);
@@ -268,7 +264,15 @@ pub fn sweep_figure(cfg: &Config, r: &SweepResult, title: &str) -> Figure {
     } else {
         "exact theory"
     };
-    let txs = theory_abscissae(lo, hi, &xs);
+    // A rate table's theory is a harmonic balance per abscissa (its overlay had become a fifth
+    // of the preset's run); its phase amplitude bends gently with the swing, so 40 steps draw
+    // it as smoothly as 100 draw the others.
+    let steps = if matches!(r.shape, Shape::RateTable { .. }) {
+        40
+    } else {
+        100
+    };
+    let txs = theory_abscissae(lo, hi, &xs, steps);
     let [t1, t2] = theory_curves(cfg, &txs);
     let own_mode2 = curves_differ(&t1, &t2);
     let line = |name: String, ys: Vec<f64>| Series {
