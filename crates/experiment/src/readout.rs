@@ -416,7 +416,7 @@ pub fn post_process_with(
                     // the phase shifter's error (x = 5 deg at 20000 deg/s) or a strong
                     // quadrature coupling (k12 Q / w0^2 = 2: +93.5 deg, read as -86.5). A
                     // reading far from its theory still shows as an error of up to 90 deg.
-                    let shift = if r.theory_deg[k].is_finite() {
+                    let centre = if r.theory_deg[k].is_finite() {
                         r.theory_deg[k] * DEG
                     } else {
                         match mode {
@@ -424,7 +424,7 @@ pub fn post_process_with(
                             Mode::Two => cfg.board.phase_shifter_error_deg * DEG,
                         }
                     };
-                    let (psi, turned) = fold_half_turn(est.psi_rad - total, shift);
+                    let (psi, turned) = fold_half_turn(est.psi_rad - total, centre);
                     let a = if turned {
                         wrap_pi(est.alpha_rad + core::f64::consts::PI)
                     } else {
@@ -436,7 +436,7 @@ pub fn post_process_with(
                     // A real channel cannot tell the sign of the carrier (an inverting TIA
                     // flips it): fold the paper-style reading onto psi's branch.
                     let p = paper_i_channel_psi_rad(c, s, mode) - total;
-                    paper[k] = fold_half_turn(p, shift).0 / DEG;
+                    paper[k] = fold_half_turn(p, centre).0 / DEG;
                 }
                 r.raw_psi_deg = Some(raw);
                 r.paper_i_deg = Some(paper);
