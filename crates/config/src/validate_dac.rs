@@ -77,13 +77,15 @@ impl Config {
         } else {
             vec![(r_lo, t_lo)]
         };
+        // The device driven by the rounded drives: their ratio r and relative turn (rad).
+        let quantised_at = |r: f64, turn: f64| gyroemu_theory::DrivenDevice {
+            drive: [dev.drive[0], dev.drive[1] * r],
+            phase_shifter_error_deg: dev.phase_shifter_error_deg - turn / DEG,
+            ..dev
+        };
         let mut worst: f64 = 0.0;
         for &(r, turn) in &corners {
-            let quantised = gyroemu_theory::DrivenDevice {
-                drive: [dev.drive[0], dev.drive[1] * r],
-                phase_shifter_error_deg: dev.phase_shifter_error_deg - turn / DEG,
-                ..dev
-            };
+            let quantised = quantised_at(r, turn);
             for &rate in &self.experiment.rates_dps {
                 let omega = rate * DEG;
                 let pairs: Vec<([f64; 2], [f64; 2])> = match self.shape() {
@@ -116,11 +118,7 @@ impl Config {
             // at the corners missed 1074 mdeg at 4 bits, 15000.01 Hz.)
             let mut ratio_part: f64 = 0.0;
             for &(r, turn) in &corners {
-                let quantised = gyroemu_theory::DrivenDevice {
-                    drive: [dev.drive[0], dev.drive[1] * r],
-                    phase_shifter_error_deg: dev.phase_shifter_error_deg - turn / DEG,
-                    ..dev
-                };
+                let quantised = quantised_at(r, turn);
                 for &rate in &self.experiment.rates_dps {
                     let (a, b) = (
                         dev.coriolis_phase_rad(rate * DEG),
