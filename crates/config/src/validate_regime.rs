@@ -199,13 +199,9 @@ impl Config {
                     // The sidebands of THEORY.md section 4 (the shifter's error turns mode
                     // 2's), as DrivenDevice::rotating_psi_rad takes them.
                     let fm = omega / core::f64::consts::TAU;
-                    let eps = dev.phase_shifter_error_deg * DEG;
-                    let j = Complex64::new(0.0, 1.0);
                     let side = |sign: f64| {
-                        let turn = Complex64::from_polar(1.0, -sign * eps);
-                        let f = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
-                        let x = continuous_steady_state(&plant, 0.0, fc + sign * fm, f);
-                        [x[2] * g(fc + sign * fm), x[3] * g(fc + sign * fm)]
+                        let v = rotating_sideband(&dev, fc, fm, sign);
+                        v.map(|v| v * g(fc + sign * fm))
                     };
                     let (vp, vm) = (side(1.0), side(-1.0));
                     [0, 1].map(|k| {
@@ -397,18 +393,11 @@ impl Config {
             // No modulation: the envelope is a constant phasor, as in a Coriolis run.
             return mixer_product_bound_rad(chain, fc, fs_out, window, &[0.0]);
         }
-        let plant = self.resonator_params();
         let dev = self.driven_device();
-        let [f1, f2] = dev.drive;
-        let eps = dev.phase_shifter_error_deg * DEG;
-        let j = Complex64::new(0.0, 1.0);
         // The sidebands at the low-pass input (the chain before it scales them by its response).
         let side = |sign: f64| {
-            let turn = Complex64::from_polar(1.0, -sign * eps);
-            let f = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
-            let x = continuous_steady_state(&plant, 0.0, fc + sign * fm, f);
             let g = chain.dac_hold(fc + sign * fm) * chain.tia(fc + sign * fm);
-            [x[2] * g, x[3] * g]
+            rotating_sideband(&dev, fc, fm, sign).map(|v| v * g)
         };
         let (zp, zm) = (side(1.0), side(-1.0));
         let lp = chain.lowpass(2.0 * fc + fm).conj();
@@ -553,6 +542,24 @@ fn mixer_product_bound_rad(
         }
     }
     (worst, at)
+}
+
+/// Both modes' velocity phasors at the sideband `fc + sign fm` of the rotating drive (THEORY.md
+/// section 4; mode 2's drive turned by the phase shifter's error, as
+/// `DrivenDevice::rotating_psi_rad` takes it), before the chain.
+fn rotating_sideband(
+    dev: &gyroemu_theory::DrivenDevice,
+    fc: f64,
+    fm: f64,
+    sign: f64,
+) -> [Complex64; 2] {
+    let [f1, f2] = dev.drive;
+    let eps = dev.phase_shifter_error_deg * DEG;
+    let turn = Complex64::from_polar(1.0, -sign * eps);
+    let j = Complex64::new(0.0, 1.0);
+    let f = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
+    let x = continuous_steady_state(&dev.plant, 0.0, fc + sign * fm, f);
+    [x[2], x[3]]
 }
 
 /// The smallest and the largest amplitude of a signal over the run's points, with the rate
