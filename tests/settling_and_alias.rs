@@ -7,13 +7,19 @@ mod common;
 use common::*;
 use gyroemu::config::parse_config;
 
-/// The bound, mdeg, the settling warning states (None: no settling warning).
-fn stated_bound_mdeg(warnings: &[String]) -> Option<f64> {
+/// The number the settling warning states between `before` and `unit` (None: no settling
+/// warning).
+fn stated(warnings: &[String], before: &str, unit: &str) -> Option<f64> {
     let w = warnings
         .iter()
         .find(|w| w.starts_with("experiment.settle_s"))?;
-    let rest = &w[w.find("by up to ")? + 9..];
-    rest[..rest.find(" mdeg")?].parse().ok()
+    let rest = &w[w.find(before)? + before.len()..];
+    rest[..rest.find(unit)?].parse().ok()
+}
+
+/// The bound, mdeg, the settling warning states (None: no settling warning).
+fn stated_bound_mdeg(warnings: &[String]) -> Option<f64> {
+    stated(warnings, "by up to ", " mdeg")
 }
 
 /// Rotating run, Q = 200 at 15 kHz (tau = 4.2 ms), `settle_s` by hand; the largest error of
@@ -223,11 +229,7 @@ fn table_errors(cfg: &gyroemu::config::Config) -> (f64, f64) {
 
 /// The table lag bound, deg, the settling warning states.
 fn stated_lag_deg(warnings: &[String]) -> Option<f64> {
-    let w = warnings
-        .iter()
-        .find(|w| w.starts_with("experiment.settle_s"))?;
-    let rest = &w[w.find("table lag by up to ")? + 19..];
-    rest[..rest.find(" deg")?].parse().ok()
+    stated(warnings, "table lag by up to ", " deg")
 }
 
 /// The rate-table bound had charged the whole plant start-up to every demodulated harmonic:

@@ -5,9 +5,10 @@
 //! Equal drives at 16 samples per period round alike, and the rotating excitation does not
 //! depend on the drives' ratio: no warning there, and none needed (measured).
 
-use gyroemu_board::{unleak_sidebands, ChainResponse, GroupBoard, LaneResult, RunOptions};
+mod common;
+
+use common::{raw_psi, run};
 use gyroemu_config::{parse_config, Config};
-use gyroemu_core::Complex64;
 use std::f64::consts::PI;
 
 fn config(kind: &str, fs: f64, f: (f64, f64), dac: &str, rates: &str, average: f64) -> Config {
@@ -20,19 +21,6 @@ fn config(kind: &str, fs: f64, f: (f64, f64), dac: &str, rates: &str, average: f
         f.0, f.1
     ))
     .unwrap()
-}
-
-/// Every emulated point of `c` on the board, in the order of `emulated_rates_dps`.
-fn run(c: &Config) -> (Vec<f64>, Vec<LaneResult>) {
-    let rates = c.emulated_rates_dps();
-    let points: Vec<_> = rates.iter().map(|&r| c.plan_point(r)).collect();
-    let rad: Vec<f64> = points.iter().map(|p| p.rate_rad_s).collect();
-    let streams: Vec<u64> = (0..rates.len() as u64).collect();
-    let mut board = GroupBoard::new(&c.board_params(), &rad, &streams).unwrap();
-    let out = board
-        .run(c.n_settle_out(), &points, RunOptions::default(), &|_| {})
-        .unwrap();
-    (rates, out.lanes)
 }
 
 /// The largest |measured - theory| Coriolis phase, mdeg, over the points and modes.
@@ -95,32 +83,6 @@ fn equal_drives_at_16_samples_per_period_round_alike_and_are_not_warned() {
         let e = coriolis_error_mdeg(&c);
         assert!(e < 0.01, "{bits} bits: {e} mdeg");
     }
-}
-
-/// psi per mode from the stage-2 averages (THEORY.md section 6), the window's leak removed;
-/// the chain's terms are left in (they cancel between two runs of the same chain).
-fn raw_psi(c: &Config) -> Vec<[f64; 2]> {
-    let (rates, lanes) = run(c);
-    let chain = ChainResponse::new(&c.board_params()).unwrap();
-    let j = Complex64::new(0.0, 1.0);
-    let m = [
-        (Complex64::new(1.0, 0.0), Complex64::new(1.0, 0.0)),
-        (-j, j),
-    ];
-    rates
-        .iter()
-        .zip(&lanes)
-        .map(|(&r, l)| {
-            let leak = chain
-                .stage2_leak(&c.plan_point(r), c.n_settle_out())
-                .unwrap();
-            [0, 1].map(|k| {
-                let (cc, s) = unleak_sidebands(l.c[k], l.s[k], leak);
-                let (zp, zm) = ((cc - j * s) / 2.0, (cc + j * s) / 2.0);
-                0.5 * ((zm / m[k].1).arg() - (zp / m[k].0).arg())
-            })
-        })
-        .collect()
 }
 
 #[test]

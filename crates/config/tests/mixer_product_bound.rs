@@ -4,9 +4,10 @@
 //! emulated error (psi with the fold against psi of the same board with a decimation that
 //! puts the alias far away) without being the Coriolis bound (57 mdeg for a 0.011 mdeg error).
 
-use gyroemu_board::{unleak_sidebands, ChainResponse, GroupBoard, RunOptions};
+mod common;
+
+use common::raw_psi;
 use gyroemu_config::{parse_config, Config};
-use gyroemu_core::Complex64;
 use std::f64::consts::PI;
 
 fn config(device: &str, decimation: usize) -> Config {
@@ -18,38 +19,6 @@ fn config(device: &str, decimation: usize) -> Config {
          [experiment]\nkind = \"rotating\"\nrates_dps = [60.0, 175.0]\naverage_s = 6.0\n"
     ))
     .unwrap()
-}
-
-/// psi per point and mode from the board's stage-2 averages (THEORY.md section 6), the
-/// window's leak removed; the chain's own terms are left in (equal for both decimations: the
-/// low-pass runs at the input rate).
-fn raw_psi(c: &Config) -> Vec<[f64; 2]> {
-    let rates = c.emulated_rates_dps();
-    let points: Vec<_> = rates.iter().map(|&r| c.plan_point(r)).collect();
-    let rad: Vec<f64> = points.iter().map(|p| p.rate_rad_s).collect();
-    let mut board = GroupBoard::new(&c.board_params(), &rad, &[0, 1]).unwrap();
-    let lanes = board
-        .run(c.n_settle_out(), &points, RunOptions::default(), &|_| {})
-        .unwrap()
-        .lanes;
-    let chain = ChainResponse::new(&c.board_params()).unwrap();
-    let j = Complex64::new(0.0, 1.0);
-    let m = [
-        (Complex64::new(1.0, 0.0), Complex64::new(1.0, 0.0)),
-        (-j, j),
-    ];
-    points
-        .iter()
-        .zip(&lanes)
-        .map(|(p, l)| {
-            let leak = chain.stage2_leak(p, c.n_settle_out()).unwrap();
-            [0, 1].map(|k| {
-                let (cc, s) = unleak_sidebands(l.c[k], l.s[k], leak);
-                let (zp, zm) = ((cc - j * s) / 2.0, (cc + j * s) / 2.0);
-                0.5 * ((zm / m[k].1).arg() - (zp / m[k].0).arg())
-            })
-        })
-        .collect()
 }
 
 #[test]
