@@ -14,6 +14,18 @@ use gyroemu::config::{Config, NoiseConfig, SelfcalConfig};
 
 fn quiet(_: u64, _: u64) {}
 
+/// White TIA current noise of `a_per_rthz` alone (300 K, no Brownian mass), seeded.
+fn tia_noise(seed: u64, a_per_rthz: f64) -> Option<NoiseConfig> {
+    Some(NoiseConfig {
+        seed,
+        temperature_k: 300.0,
+        effective_mass_kg: None,
+        tia_current_noise_a_per_rthz: a_per_rthz,
+        tia_voltage_noise_v_per_rthz: 0.0,
+        ..Default::default()
+    })
+}
+
 fn fast_cfg(rates: &[f64], average_s: f64) -> Config {
     let mut c = preset("m2tfg-rotating").unwrap();
     c.experiment.rates_dps = rates.to_vec();
@@ -181,14 +193,7 @@ fn an_averaging_time_reading_carries_the_rate_tables_error_and_its_own_theory() 
     let mut c = fast_cfg(&[100.0, 125.0, 150.0, 175.0], 3.6);
     c.drive.f2 = Some(1.01);
     c.device.q_mode2 = Some(1950.0);
-    c.noise = Some(NoiseConfig {
-        seed: 3,
-        temperature_k: 300.0,
-        effective_mass_kg: None,
-        tia_current_noise_a_per_rthz: 3e-11,
-        tia_voltage_noise_v_per_rthz: 0.0,
-        ..Default::default()
-    });
+    c.noise = tia_noise(3, 3e-11);
     let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
     let (m, comb) = (core.modes[0], core.combined);
     let taus = tau_analysis(&c, 7.2, &m.coriolis, &comb.coriolis, None, &quiet).unwrap();
@@ -262,14 +267,7 @@ fn an_open_loop_drift_error_carries_an_interval_as_wide_as_its_smaller_slope_mak
     let n = seeds.clone().count() as f64;
     for seed in seeds {
         let mut c = fast_cfg(&rates, 3.6);
-        c.noise = Some(NoiseConfig {
-            seed,
-            temperature_k: 300.0,
-            effective_mass_kg: None,
-            tia_current_noise_a_per_rthz: 5e-12,
-            tia_voltage_noise_v_per_rthz: 0.0,
-            ..Default::default()
-        });
+        c.noise = tia_noise(seed, 5e-12);
         c.selfcal = Some(SelfcalConfig {
             f0_tc_ppm_per_k: -30.0,
             q_tc_ppm_per_k: -3000.0,
@@ -303,14 +301,7 @@ fn noisy_selfcal_errors_scatter_as_their_reported_confidence() {
     let mut comb_reported = Vec::new();
     for seed in 0..8 {
         let mut c = fast_cfg(&[100.0, 125.0, 150.0, 175.0], 3.6);
-        c.noise = Some(NoiseConfig {
-            seed,
-            temperature_k: 300.0,
-            effective_mass_kg: None,
-            tia_current_noise_a_per_rthz: 3e-11,
-            tia_voltage_noise_v_per_rthz: 0.0,
-            ..Default::default()
-        });
+        c.noise = tia_noise(seed, 3e-11);
         let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
         let comb = core.combined;
         comb_errs.push(comb.relative_error);
@@ -339,14 +330,7 @@ fn noisy_selfcal_errors_scatter_as_their_reported_confidence() {
     }
     // Same seed, same bits.
     let mut c = fast_cfg(&[100.0, 125.0, 150.0, 175.0], 3.6);
-    c.noise = Some(NoiseConfig {
-        seed: 0,
-        temperature_k: 300.0,
-        effective_mass_kg: None,
-        tia_current_noise_a_per_rthz: 3e-11,
-        tia_voltage_noise_v_per_rthz: 0.0,
-        ..Default::default()
-    });
+    c.noise = tia_noise(0, 3e-11);
     let again = run_selfcal_core(&c, &quiet, &quiet, None).unwrap().modes[0].relative_error;
     assert_eq!(again.to_bits(), errs[0].to_bits());
 }
