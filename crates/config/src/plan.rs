@@ -9,7 +9,8 @@ use gyroemu_resonator::{ModeParams, ResonatorParams};
 use gyroemu_theory::{mechanical_tau_s, DrivenDevice};
 use gyroemu_tia::TiaParams;
 
-const DEG: f64 = core::f64::consts::PI / 180.0;
+/// Radians per degree.
+pub(crate) const DEG: f64 = core::f64::consts::PI / 180.0;
 
 /// A rate-table run demodulates every table harmonic of the envelope above this fraction of
 /// its largest one (what it leaves out moves the phase by about as many radians).

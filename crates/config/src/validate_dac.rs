@@ -4,7 +4,8 @@
 //! samples, and the rounding with it (a worst case over the drift).
 
 use crate::config::Config;
-use crate::validate_regime::{half_turn_mdeg, DEG, WARN_HOLD_ERROR_MDEG};
+use crate::plan::DEG;
+use crate::validate_regime::{half_turn_mdeg, WARN_HOLD_ERROR_MDEG};
 use gyroemu_board::{ChainResponse, Shape};
 use gyroemu_core::Complex64;
 

@@ -5,12 +5,11 @@
 
 use crate::config::Config;
 use crate::error::ConfigError;
+use crate::plan::DEG;
 use crate::rules::Rules;
 use gyroemu_board::{ChainResponse, Shape};
 use gyroemu_core::Complex64;
 use gyroemu_resonator::continuous_steady_state;
-
-pub(crate) const DEG: f64 = core::f64::consts::PI / 180.0;
 
 /// |a - b| in mdeg within a half turn: a phase and the same plus 180 degrees read alike (the
 /// sidebands' branch), so only the difference within a half turn is a converter's or the
