@@ -411,3 +411,33 @@ fn selfcal_lists_its_sweeps_problems_with_the_configs_own() {
         "{e}"
     );
 }
+
+#[test]
+fn selfcal_names_the_run_each_added_warning_holds_for() {
+    // The selfcal preset's 16-bit DAC rounds its unequal drives differently; the rule states
+    // a different size for each run selfcal makes (the rate-table sweep, each drifted
+    // device). Each such warning must name its runs, and say each text once.
+    let c = preset("m2tfg-selfcal").unwrap();
+    let own = c.validate().unwrap();
+    let extra = validate_selfcal(&c).unwrap();
+    let dac: Vec<&String> = extra.iter().filter(|w| w.contains("dac_bits")).collect();
+    assert!(dac.len() >= 2, "{extra:#?}");
+    let runs = |w: &str| w.rsplit_once(" (in the ").map(|(_, r)| r.to_string());
+    for w in &extra {
+        let r = runs(w).unwrap_or_else(|| panic!("no run named: {w}"));
+        assert!(r.ends_with(" of selfcal)"), "{w}");
+        assert!(!own.contains(w), "said twice: {w}");
+    }
+    assert!(
+        extra.iter().any(|w| w.contains("rate-table sweep")),
+        "{extra:#?}"
+    );
+    // One line per distinct text: no two lines differ only in the runs they name.
+    let texts: Vec<&str> = extra
+        .iter()
+        .map(|w| w.rsplit_once(" (in the ").unwrap().0)
+        .collect();
+    for (i, t) in texts.iter().enumerate() {
+        assert!(!texts[i + 1..].contains(t), "{t} said twice");
+    }
+}

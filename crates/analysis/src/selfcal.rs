@@ -202,14 +202,21 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
             return Err(ConfigError::from_problems(list).expect("a problem was found"));
         }
     };
-    let mut warnings = Vec::new();
+    // Each added warning with the runs it holds for: the same rule states different sizes
+    // on different runs, and an unnamed list of them reads as one warning said four times.
+    let mut warnings: Vec<(String, Vec<String>)> = Vec::new();
     let mut problems = Vec::new();
     let (rot, cor) = sweep_configs(cfg);
     let mut add = |what: &str, r: Result<Vec<String>, ConfigError>| match r {
         Ok(w) => {
             for x in w {
-                if !base.contains(&x) && !warnings.contains(&x) {
-                    warnings.push(x);
+                if base.contains(&x) {
+                    continue;
+                }
+                match warnings.iter_mut().find(|(t, _)| *t == x) {
+                    Some((_, runs)) if !runs.iter().any(|r| r == what) => runs.push(what.into()),
+                    Some(_) => {}
+                    None => warnings.push((x, vec![what.into()])),
                 }
             }
         }
@@ -256,7 +263,10 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
     }
     match ConfigError::from_problems(problems) {
         Some(e) => Err(e),
-        None => Ok(warnings),
+        None => Ok(warnings
+            .into_iter()
+            .map(|(w, runs)| format!("{w} (in the {} of selfcal)", runs.join(", the ")))
+            .collect()),
     }
 }
 
