@@ -220,7 +220,7 @@ impl StartUp<'_> {
     }
 }
 
-/// Most taps of the built low-pass [`impulse_head`] runs (about 10 ms at 48 MHz).
+/// Most taps of the built low-pass [`impulse_head`] runs: a bound on validation's own work.
 const MAX_HEAD_TAPS: f64 = 1.5e6;
 
 /// The built stage-1 filter's impulse response, run for `k0 + 1` taps (`k0` at most `n0`, the
@@ -228,7 +228,7 @@ const MAX_HEAD_TAPS: f64 = 1.5e6;
 /// a^{k0-k})`. Its exact taps keep the plant's bound from the modal envelope's looseness (10x
 /// at order 4, where the poles still cancel); by 40 time constants only the slowest pair is
 /// left (order 8's next one has decayed by e^-22), and the envelope `sum |r_i| rho_i^k` of a
-/// single pair is its own peak. (200 time constants had cost 35 ms per rate at 48 MHz.)
+/// single pair is its own peak. (200 time constants ran five times the taps for no tighter bound.)
 fn impulse_head(
     design: gyroemu_lpf::LowPassDesign,
     fs: f64,

@@ -7,9 +7,9 @@ use crate::sweep::canonical_work;
 use gyroemu_board::Point;
 use gyroemu_config::Config;
 
-/// Runs above this many operating-point samples are refused unless forced: about 5 to 15
-/// minutes of a 2-core machine (1e11 point-samples at 100 to 300 M point-samples/s), far more
-/// than any figure of the paper needs (the full `reproduce` is 1.3e9).
+/// Runs above this many operating-point samples are refused unless forced: minutes of a
+/// 2-core machine at the chain's rate (docs/performance.md), and far more than any figure of
+/// the paper needs (the full `reproduce` is 1.3e9).
 pub const MAX_POINT_SAMPLES: u64 = 100_000_000_000;
 
 /// The size of a sweep.
