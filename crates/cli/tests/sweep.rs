@@ -186,6 +186,15 @@ fn bad_sweep_keys_are_refused_before_anything_is_written() {
             "points = 21\nspacing = \"octave\"",
             &["sweep.spacing", "\"octave\""][..],
         ),
+        // Work above the cap names the sweep's own keys, not the experiment's.
+        (
+            "points = 21\naverage_s = 1e7",
+            &[
+                "above the cap",
+                "lower sweep.points, sweep.settle_s or sweep.average_s",
+                "--force",
+            ][..],
+        ),
     ] {
         let cfg = config(dir.path(), &DEVICE.replace("points = 21", edit));
         let out = dir.path().join("never");

@@ -67,11 +67,19 @@ impl Work {
 
     /// Refuses work above [`MAX_POINT_SAMPLES`] unless `force`, with what to do.
     pub fn check_cap(&self, force: bool) -> Result<(), String> {
+        self.check_cap_with(
+            force,
+            "shorten experiment.average_s or experiment.settle_s (the default settling is 16 mechanical time constants Q/(pi f0))",
+        )
+    }
+
+    /// [`Work::check_cap`] with the keys that size this work named in `remedy`.
+    pub fn check_cap_with(&self, force: bool, remedy: &str) -> Result<(), String> {
         if force || self.point_samples <= MAX_POINT_SAMPLES {
             return Ok(());
         }
         Err(format!(
-            "{}: above the cap of {:.0e} point-samples without --force (a mistyped Q or averaging time would otherwise start a run of days); shorten experiment.average_s or experiment.settle_s (the default settling is 16 mechanical time constants Q/(pi f0)), or add --force to run it anyway",
+            "{}: above the cap of {:.0e} point-samples without --force (a mistyped Q or averaging time would otherwise start a run of days); {remedy}, or add --force to run it anyway",
             self.describe(None),
             MAX_POINT_SAMPLES as f64
         ))
@@ -123,5 +131,9 @@ mod tests {
         assert_eq!((w.points, w.point_samples), (usize::MAX, u64::MAX));
         assert!(w.check_cap(false).is_err());
         assert!(w.check_cap(true).is_ok());
+        // Each command names the keys that size its own work.
+        let e = w.check_cap_with(false, "lower sweep.points").unwrap_err();
+        assert!(e.contains("; lower sweep.points, or add --force"), "{e}");
+        assert!(!e.contains("experiment.average_s"), "{e}");
     }
 }

@@ -5,7 +5,6 @@ use crate::progress::Terminal;
 use crate::signals;
 use anyhow::Result;
 use gyroemu_analysis::{run_frequency_response, stepped_sine_work};
-use gyroemu_experiment::MAX_POINT_SAMPLES;
 use gyroemu_report::{check_problems, write_freq_sweep};
 use gyroemu_runs::{lock_out, prepare_out, LockScope};
 use std::path::Path;
@@ -21,14 +20,11 @@ pub fn sweep_command(config: &Path, out: &Path, force: bool) -> Result<()> {
         note!("warning: {}: {w}", config.display());
     }
     let work = stepped_sine_work(&cfg);
-    if !force && work.point_samples > MAX_POINT_SAMPLES {
-        return Err(BadInput(format!(
-            "{}: above the cap of {:.0e} point-samples without --force; lower sweep.points, sweep.settle_s or sweep.average_s (the default settling is 16 mechanical time constants Q/(pi f0) per frequency), or add --force to run it anyway",
-            work.describe(None),
-            MAX_POINT_SAMPLES as f64
-        ))
-        .into());
-    }
+    work.check_cap_with(
+        force,
+        "lower sweep.points, sweep.settle_s or sweep.average_s (the default settling is 16 mechanical time constants Q/(pi f0) per frequency)",
+    )
+    .map_err(BadInput)?;
     note!(
         "{} (each mode driven alone at {} frequencies)",
         work.describe(None),
