@@ -30,5 +30,5 @@ pub use lot_run::{check_lot, check_lot_size, run_lot, LotOutcome, MAX_DEVICES};
 pub use manifest::RunKind;
 pub use merge::merge;
 pub use resume::{previous_devices, previous_points};
-pub use run::{check_run, prepare_out, run, RunOutcome, RunRequest};
+pub use run::{check_run, lock_subfolders, prepare_out, run, RunOutcome, RunRequest};
 pub use shard::{check_split, resolve_shard, Shard, ShardFrom};

@@ -6,10 +6,11 @@
 use crate::dumps::reconcile_dump;
 use crate::error::RunError;
 use crate::ledger::Ledger;
-use crate::manifest::{manifest_path, RunKind};
+use crate::lock::{lock_out, LockScope, OutLock};
+use crate::manifest::RunKind;
 use crate::points::{canonical_toml, config_hash, scan_points, write_point, POINTS_DIR};
 use crate::resume::previous_points;
-use crate::shard::{check_split, Shard};
+use crate::shard::{check_split, manifest_path, Shard};
 use gyroemu_board::LaneResult;
 use gyroemu_config::Config;
 use gyroemu_experiment::work::measured_throughput;
@@ -84,6 +85,35 @@ pub fn prepare_out(out: &Path) -> Result<(), RunError> {
                 out.display()
             ))
         })
+}
+
+/// The folders `names` below `out`, for a command that writes several runs (reproduce: one per
+/// preset): all checked before any is made (a file in the way is named, and nothing is
+/// created), then each prepared and locked, so that a `run` writing into one of them holds its
+/// lock and none of them is written over.
+pub fn lock_subfolders(
+    out: &Path,
+    names: &[&str],
+    command: &str,
+    reporter: &dyn Reporter,
+) -> Result<Vec<OutLock>, RunError> {
+    for n in names {
+        let dir = out.join(n);
+        if dir.exists() && !dir.is_dir() {
+            return Err(RunError::BadInput(format!(
+                "`{}` is a file, not a folder: this command writes its {n} files there; move it away",
+                dir.display()
+            )));
+        }
+    }
+    names
+        .iter()
+        .map(|n| {
+            let dir = out.join(n);
+            prepare_out(&dir)?;
+            lock_out(&dir, command, LockScope::Folder, reporter)
+        })
+        .collect()
 }
 
 /// The refusals of [`run`] that need nothing computed: a shard count far above the points, a
