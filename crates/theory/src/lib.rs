@@ -5,8 +5,10 @@
 
 pub mod closed_form;
 mod device;
+mod plant_modes;
 pub mod quantiser;
 
 pub use closed_form::*;
 pub use device::DrivenDevice;
+pub use plant_modes::{coupled_modes, held_response};
 pub use quantiser::{quantiser_bias_bound, quantiser_phase_bound_rad};
