@@ -4,12 +4,15 @@
 use crate::dump_figures::write_dump_figures;
 use crate::dump_set::read_dump_set;
 use crate::error::{check_problems, create_dir, ReportError};
-use crate::sweep_report::{line_span, sweep_figure, theory_abscissae, theory_series, write_run};
+use crate::sweep_report::{
+    fit_series, line_span, sweep_figure, theory_abscissae, theory_series, write_run,
+};
 use gyroemu_analysis::bandwidth::{
     bandwidth, BandwidthPoint, BANDWIDTH_AMPLITUDE_DPS, BANDWIDTH_FREQS_HZ,
 };
 use gyroemu_config::presets::preset;
 use gyroemu_config::{Config, DumpConfig};
+use gyroemu_experiment::fit::LineFit;
 use gyroemu_experiment::{
     finish_sweep_with, run_sweep_with, DumpPlan, Reporter, Stage2Leaks, SweepOptions, SweepResult,
     SweepRun, DUMP_STEM,
@@ -453,12 +456,28 @@ fn job_index(jobs: &[Job], name: &str) -> usize {
 }
 
 /// Fig. 6: the Coriolis phase against the rotation rate, and the rotating-excitation phase
-/// against the excitation rate divided by lambda: the two coincide.
-fn fig6(cfg: &Config, cor: &SweepResult, rot: &SweepResult) -> Figure {
+/// against the excitation rate divided by lambda: the two coincide. Each series has its best
+/// linear fit, drawn as in the sweep figures ([`fit_series`]): the rotating sweep's fit against
+/// Omega, redrawn against Omega / lambda (slope times lambda; intercept and R^2 unchanged), so
+/// its slope is the self-calibrated Coriolis slope beside the rate table's.
+pub fn fig6(cfg: &Config, cor: &SweepResult, rot: &SweepResult) -> Figure {
     let lambda = cfg.device.angular_gain;
-    let rates: Vec<f64> = cor.points.iter().map(|p| p.rate_dps).collect();
-    let (lo, hi) = line_span(&rates);
-    Figure::new(
+    let mode1 = |r: &SweepResult| -> Vec<f64> { r.points.iter().map(|p| p.phase_deg[0]).collect() };
+    let cor_x: Vec<f64> = cor.points.iter().map(|p| p.rate_dps).collect();
+    let rot_x: Vec<f64> = rot.points.iter().map(|p| p.rate_dps / lambda).collect();
+    let all_x: Vec<f64> = cor_x.iter().chain(&rot_x).copied().collect();
+    let span = line_span(&all_x);
+    let (cor_y, rot_y) = (mode1(cor), mode1(rot));
+    let rot_fit = LineFit {
+        slope: rot.fit[0].slope * lambda,
+        slope_std_err: rot.fit[0].slope_std_err * lambda,
+        ..rot.fit[0]
+    };
+    let fits = [
+        fit_series("Coriolis mode 1", &cor.fit[0], &cor_x, &cor_y, span),
+        fit_series("rotating mode 1", &rot_fit, &rot_x, &rot_y, span),
+    ];
+    let mut fig = Figure::new(
         "Fig. 6: Coriolis and rotating excitation coincide (excitation axis / lambda)",
         "Rotation rate, or excitation rate / lambda (deg/s)",
         "Phase (deg)",
@@ -466,20 +485,24 @@ fn fig6(cfg: &Config, cor: &SweepResult, rot: &SweepResult) -> Figure {
     .with(Series {
         name: "Coriolis, mode 1".into(),
         style: SeriesStyle::Points,
-        xs: cor.points.iter().map(|p| p.rate_dps).collect(),
-        ys: cor.points.iter().map(|p| p.phase_deg[0]).collect(),
+        xs: cor_x,
+        ys: cor_y,
     })
     .with(Series {
         name: format!("rotating excitation, mode 1 (Omega / {lambda})"),
         style: SeriesStyle::OpenPoints,
-        xs: rot.points.iter().map(|p| p.rate_dps / lambda).collect(),
-        ys: rot.points.iter().map(|p| p.phase_deg[0]).collect(),
+        xs: rot_x,
+        ys: rot_y,
     })
     .with(theory_series(
         cfg,
-        &theory_abscissae(lo, hi, &rates, 100),
+        &theory_abscissae(span.0, span.1, &all_x, 100),
         0,
         1.0,
         "exact theory (eq. 3)",
-    ))
+    ));
+    for s in fits.into_iter().flatten() {
+        fig = fig.with(s);
+    }
+    fig
 }

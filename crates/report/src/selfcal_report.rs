@@ -124,7 +124,7 @@ fn write_selfcal_files(
     render_png(&selfcal_figure(core), &path("selfcal.png"))?;
     if let Some(a) = allan {
         write_csv(&path("allan.csv"), &allan_table(a))?;
-        render_png(&allan_figure(a), &path("allan.png"))?;
+        render_allan_png(a, &path("allan.png"))?;
     }
     if let Some(t) = taus {
         write_csv(&path("error_vs_tau.csv"), &tau_table(t))?;
@@ -292,7 +292,8 @@ fn log_series(name: &str, style: SeriesStyle, pts: &[AllanPoint], scale: f64) ->
     )
 }
 
-fn allan_figure(a: &AllanResult) -> Figure {
+/// The overall title of `allan.png`: the noise readings, or why one was not taken.
+pub fn allan_title(a: &AllanResult) -> String {
     // A reading that could not be taken says so instead of printing NaN.
     let read = |v: f64, unit: &str| {
         if v.is_finite() {
@@ -301,35 +302,68 @@ fn allan_figure(a: &AllanResult) -> Figure {
             "not read (see warnings)".to_string()
         }
     };
-    let title = match a.readings {
+    match a.readings {
         Some(r) => format!(
             "Allan deviation at zero rate: ARW {}, bias instability {}",
             read(r.arw_deg_per_rt_h, "deg/sqrt(h)"),
             read(r.bias_instability_deg_per_h, "deg/h")
         ),
         None => "Allan deviation at zero rate".to_string(),
-    };
-    let mut fig = Figure::new(title, "tau (s)", "Allan deviation (deg/h)")
-        .log_x()
-        .log_y()
-        .with(log_series(
-            "rate-equivalent output (phase / scale factor)",
-            SeriesStyle::Points,
-            &a.rate_dps,
-            3600.0,
-        ));
+    }
+}
+
+/// Renders `allan.png` at `path`: [`allan_panels`] side by side under [`allan_title`].
+pub fn render_allan_png(a: &AllanResult, path: &Path) -> Result<(), ReportError> {
+    render_panels_png(&allan_title(a), &allan_panels(a), 2, 1600, 650, path)?;
+    Ok(())
+}
+
+/// The two panels of `allan.png`: the Allan deviation of the mode-1 phase output in degrees
+/// (what the board reads), and of the rate-equivalent output in deg/h (the same curve over the
+/// scale factor, the unit of the readings), with the angle random walk's -1/2 line when it was
+/// read.
+pub fn allan_panels(a: &AllanResult) -> [Figure; 2] {
+    let phase = Figure::new(
+        "Phase output, mode 1",
+        "tau (s)",
+        "Allan deviation of the phase (deg)",
+    )
+    .log_x()
+    .log_y()
+    .with(log_series(
+        "phase output (deg)",
+        SeriesStyle::Points,
+        &a.phase_deg,
+        1.0,
+    ));
+    let mut rate = Figure::new(
+        format!(
+            "Rate-equivalent output: phase / {:.6} deg per deg/s",
+            a.scale_deg_per_dps
+        ),
+        "tau (s)",
+        "Allan deviation (deg/h)",
+    )
+    .log_x()
+    .log_y()
+    .with(log_series(
+        "rate-equivalent output (phase / scale factor)",
+        SeriesStyle::Points,
+        &a.rate_dps,
+        3600.0,
+    ));
     if let Some(r) = a.readings.filter(|r| r.arw_deg_per_rt_h.is_finite()) {
         // The -1/2 line of the ARW reading: sigma = N / sqrt(tau), N = ARW / 60 deg/s*sqrt(s).
         let n = r.arw_deg_per_rt_h / 60.0;
         let ends: Vec<f64> = [a.rate_dps[0].tau_s, a.rate_dps[a.rate_dps.len() - 1].tau_s].into();
-        fig = fig.with(Series::new(
+        rate = rate.with(Series::new(
             "angle random walk: N / sqrt(tau)",
             SeriesStyle::DashedLine,
             ends.clone(),
             ends.iter().map(|t| n / t.sqrt() * 3600.0).collect(),
         ));
     }
-    fig
+    [phase, rate]
 }
 
 fn tau_table(t: &[TauPoint]) -> CsvTable {

@@ -4,6 +4,7 @@
 use crate::error::{create_dir, ReportError};
 use gyroemu_board::{Health, Shape};
 use gyroemu_config::Config;
+use gyroemu_experiment::fit::LineFit;
 use gyroemu_experiment::{theory_deg, SweepResult};
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
 use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
@@ -237,6 +238,55 @@ fn points_name(r: &SweepResult, k: usize) -> String {
     }
 }
 
+/// One mode's measured phases, in the order of the points.
+fn phases(r: &SweepResult, k: usize) -> Vec<f64> {
+    r.points.iter().map(|p| p.phase_deg[k]).collect()
+}
+
+/// The legend entry and dashed line of a best linear fit, as every sweep figure draws it: the
+/// line `fit` over `span` (see [`line_span`]), labelled "best linear fit, `who`: slope deg per
+/// deg/s (R^2)". `fit` is of `ys` against `xs`, in the figure's own axes. A fit that is not a
+/// finite number while every point is finite gets a legend entry saying why and no line; one
+/// whose points were refused gets nothing (the points' legend already says so).
+pub fn fit_series(
+    who: &str,
+    fit: &LineFit,
+    xs: &[f64],
+    ys: &[f64],
+    span: (f64, f64),
+) -> Option<Series> {
+    let (lo, hi) = span;
+    if fit.slope.is_finite() && fit.intercept.is_finite() {
+        return Some(Series {
+            name: format!(
+                "best linear fit, {who}: {:.6} deg per deg/s (R^2 = {:.6})",
+                fit.slope, fit.r2
+            ),
+            style: SeriesStyle::DashedLine,
+            xs: vec![lo, hi],
+            ys: vec![
+                fit.intercept + fit.slope * lo,
+                fit.intercept + fit.slope * hi,
+            ],
+        });
+    }
+    if !ys.iter().all(|y| y.is_finite()) {
+        return None;
+    }
+    // No refusal explains the missing fit: say what does, with no line drawn.
+    let distinct = xs.first().is_some_and(|&a| xs.iter().any(|&x| x != a));
+    Some(Series {
+        name: if distinct {
+            format!("best linear fit, {who}: not a finite number")
+        } else {
+            format!("best linear fit, {who}: none (needs two distinct rates)")
+        },
+        style: SeriesStyle::DashedLine,
+        xs: Vec::new(),
+        ys: Vec::new(),
+    })
+}
+
 /// Measured points, theory and best linear fit of one sweep, both modes. Mode 2's theory gets
 /// its own line whenever it differs from mode 1's on the plotted span (a mode offset,
 /// `q_mode2`, k12, a phase-shifter error or F1 != F2), else one line is labelled for both.
@@ -254,7 +304,7 @@ pub fn sweep_figure(cfg: &Config, r: &SweepResult, title: &str) -> Figure {
                 SeriesStyle::OpenPoints
             },
             xs: xs.clone(),
-            ys: r.points.iter().map(|p| p.phase_deg[k]).collect(),
+            ys: phases(r, k),
         });
     }
     // A rate table's theory is the exact harmonic balance (`theory_deg`), not the first-order
@@ -288,30 +338,8 @@ pub fn sweep_figure(cfg: &Config, r: &SweepResult, title: &str) -> Figure {
     } else {
         fig = fig.with(line(format!("{theory}, modes 1 and 2"), t1));
     }
-    let f = r.fit[0];
-    if f.slope.is_finite() && f.intercept.is_finite() {
-        fig = fig.with(Series {
-            name: format!(
-                "best linear fit, mode 1: {:.6} deg per deg/s (R^2 = {:.6})",
-                f.slope, f.r2
-            ),
-            style: SeriesStyle::DashedLine,
-            xs: vec![lo, hi],
-            ys: vec![f.intercept + f.slope * lo, f.intercept + f.slope * hi],
-        });
-    } else if r.points.iter().all(|p| p.phase_deg[0].is_finite()) {
-        // No refusal explains the missing fit: say what does, with no line drawn.
-        let distinct = xs.iter().any(|&x| x != xs[0]);
-        fig = fig.with(Series {
-            name: if distinct {
-                "best linear fit, mode 1: not a finite number".into()
-            } else {
-                "best linear fit, mode 1: none (needs two distinct rates)".into()
-            },
-            style: SeriesStyle::DashedLine,
-            xs: Vec::new(),
-            ys: Vec::new(),
-        });
+    if let Some(s) = fit_series("mode 1", &r.fit[0], &xs, &phases(r, 0), (lo, hi)) {
+        fig = fig.with(s);
     }
     fig
 }

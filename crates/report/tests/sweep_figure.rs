@@ -1,12 +1,14 @@
 //! The series of `gyroemu run`'s plot.png, checked against closed forms and independently
 //! computed values (not pixels): a theory line per mode wherever the modes' theories differ,
-//! lines over the whole span of the rates, labels that say what is drawn and what was refused.
+//! lines over the whole span of the rates, labels that say what is drawn and what was refused;
+//! and `reproduce`'s Fig. 6 (the Coriolis and the rescaled rotating points, each with its fit).
 
 use gyroemu_config::presets::preset;
 use gyroemu_config::Config;
 use gyroemu_experiment::fit::fit_line;
 use gyroemu_experiment::{theory_deg, SweepResult};
 use gyroemu_plot::{Figure, Series, SeriesStyle};
+use gyroemu_report::reproduce::fig6;
 use gyroemu_report::run_title;
 use gyroemu_report::sweep_report::sweep_figure;
 use std::f64::consts::PI;
@@ -235,5 +237,92 @@ fn refused_points_are_named_in_the_legend_and_no_nan_is_printed() {
         "mode 1 emulated (1 of 3 points refused: no finite phase)"
     );
     assert_eq!(fig.series[1].name, "mode 2 emulated");
+    assert!(fig.series.iter().all(|s| !s.name.contains("NaN")));
+}
+
+/// The BAW pair of Fig. 6 (Coriolis rates 300..2100 deg/s, rotating rates lambda times those),
+/// each sweep's phases its exact theory, and Fig. 6 drawn from them.
+fn baw_fig6(rot_phase: impl Fn(&Config, f64) -> [f64; 2]) -> (SweepResult, SweepResult, Figure) {
+    let (cc, rc) = (
+        preset("baw-coriolis").unwrap(),
+        preset("baw-rotating").unwrap(),
+    );
+    let cor = result(&cc, |x| theory_deg(&cc, x));
+    let rot = result(&rc, |x| rot_phase(&rc, x));
+    let fig = fig6(&cc, &cor, &rot);
+    (cor, rot, fig)
+}
+
+fn dashed(fig: &Figure) -> Vec<&Series> {
+    fig.series
+        .iter()
+        .filter(|s| s.style == SeriesStyle::DashedLine)
+        .collect()
+}
+
+#[test]
+fn fig6_draws_the_best_linear_fit_of_each_series_in_its_own_axes() {
+    let (cor, rot, fig) = baw_fig6(theory_deg);
+    let d = dashed(&fig);
+    assert_eq!(d.len(), 2, "{:?}", fig.series);
+    // The fits go after the points and the theory, in the sweep figures' wording.
+    assert_eq!(fig.series.len(), 5);
+    let lambda = 0.6;
+    let cor_x: Vec<f64> = cor.points.iter().map(|p| p.rate_dps).collect();
+    let rot_x: Vec<f64> = rot.points.iter().map(|p| p.rate_dps / lambda).collect();
+    let phases =
+        |r: &SweepResult| -> Vec<f64> { r.points.iter().map(|p| p.phase_deg[0]).collect() };
+    // Each line is the least-squares line of its series' points as plotted, computed here
+    // afresh (the rotating one against Omega / lambda, not against Omega).
+    for (s, who, xs, ys) in [
+        (d[0], "Coriolis mode 1", &cor_x, phases(&cor)),
+        (d[1], "rotating mode 1", &rot_x, phases(&rot)),
+    ] {
+        let f = fit_line(xs, &ys);
+        assert_eq!(
+            s.name,
+            format!(
+                "best linear fit, {who}: {:.6} deg per deg/s (R^2 = {:.6})",
+                f.slope, f.r2
+            )
+        );
+        // From the origin to the farthest rate, as the sweep figures' fits.
+        assert_eq!(s.xs.len(), 2);
+        assert!(
+            s.xs[0] == 0.0 && (s.xs[1] - 2100.0).abs() < 1e-9,
+            "{:?}",
+            s.xs
+        );
+        for (x, y) in s.xs.iter().zip(&s.ys) {
+            let want = f.intercept + f.slope * x;
+            assert!(
+                (y - want).abs() < 1e-12 * want.abs().max(1.0),
+                "{who} at {x}: {y} vs {want}"
+            );
+        }
+    }
+    // The two slopes coincide (Fig. 6's point): the rotating slope against Omega is 1/lambda
+    // times the Coriolis one, and 0.000636 deg per deg/s against Omega / lambda.
+    let slope = |s: &Series| (s.ys[1] - s.ys[0]) / (s.xs[1] - s.xs[0]);
+    assert!(
+        (slope(d[1]) / slope(d[0]) - 1.0).abs() < 1e-4,
+        "{} {}",
+        slope(d[0]),
+        slope(d[1])
+    );
+    assert!((slope(d[0]) - 0.000636).abs() < 5e-7, "{}", slope(d[0]));
+}
+
+#[test]
+fn fig6_leaves_out_the_fit_of_refused_points_and_prints_no_nan() {
+    // One rotating point refused: its fit is NaN, which the points' series explain; the
+    // Coriolis fit is still drawn.
+    let (_, _, fig) = baw_fig6(|c, x| {
+        let t = theory_deg(c, x);
+        [if x == 540.0 { f64::NAN } else { t[0] }, t[1]]
+    });
+    let d = dashed(&fig);
+    assert_eq!(d.len(), 1, "{:?}", fig.series);
+    assert!(d[0].name.starts_with("best linear fit, Coriolis mode 1: "));
     assert!(fig.series.iter().all(|s| !s.name.contains("NaN")));
 }
