@@ -14,6 +14,7 @@ pub mod selfcal;
 pub mod selfcal_analyses;
 pub mod selfcal_combined;
 mod selfcal_run;
+mod slope_fit;
 pub mod stepped_sine;
 
 pub use freq_response::{run_frequency_response, FrequencyResponse};

@@ -4,39 +4,13 @@
 //! `run_sweep`; the analyses (averaging time, Allan deviation, drift) are in `selfcal_analyses`.
 
 use crate::selfcal_combined::{combined_selfcal, CombinedSelfcal};
-use gyroemu_config::{Config, ConfigError, ExperimentKind, RateTable};
-use gyroemu_experiment::fit::{fit_line, t95, LineFit};
+pub use crate::slope_fit::{linearised_slope, SlopeFit};
+use gyroemu_config::{Config, ConfigError, ExperimentKind, PllConfig, RateTable};
+use gyroemu_experiment::fit::t95;
 use gyroemu_experiment::{
     finish_sweep, run_sweep_with, Progress, SweepError, SweepOptions, SweepResult,
 };
 use serde::Serialize;
-
-/// A scale factor read from a sweep: the small-angle slope of the phase against the rate,
-/// from a line fit of tan(phase) (which undoes the atan of THEORY.md eqs. 2-3 exactly for
-/// the Coriolis phase and to O((Omega/w0)^2) for the rotating one), with its standard error.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct SlopeFit {
-    /// Degrees of phase per deg/s (the same number as rad per rad/s, i.e. seconds).
-    pub slope_deg_per_dps: f64,
-    /// Standard error of that slope (fit residuals).
-    pub std_err_deg_per_dps: f64,
-    /// Degrees of freedom of the fit (points - 2).
-    pub dof: usize,
-    /// The paper's plain best linear fit of the phase itself (degrees against deg/s).
-    pub plain_fit: LineFit,
-}
-
-/// The linearised slope of `phase_deg` against `rates_dps`.
-pub fn linearised_slope(rates_dps: &[f64], phase_deg: &[f64]) -> SlopeFit {
-    let t: Vec<f64> = phase_deg.iter().map(|p| p.to_radians().tan()).collect();
-    let f = fit_line(rates_dps, &t);
-    SlopeFit {
-        slope_deg_per_dps: f.slope.to_degrees(),
-        std_err_deg_per_dps: f.slope_std_err.to_degrees(),
-        dof: rates_dps.len().saturating_sub(2),
-        plain_fit: fit_line(rates_dps, phase_deg),
-    }
-}
 
 /// Self-calibration of one mode.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -151,6 +125,22 @@ pub fn drifted(cfg: &Config, delta_t_k: f64) -> Config {
     c
 }
 
+/// The config whose `[pll]` designs the drift scenario's loop: the user's, or the default
+/// loop (derived natural frequency and lock time) on the nominal device.
+pub fn drift_pll_design(cfg: &Config) -> Config {
+    let mut d = cfg.clone();
+    if d.pll.is_none() {
+        d.pll = Some(PllConfig {
+            natural_hz: None,
+            damping: core::f64::consts::FRAC_1_SQRT_2,
+            lock_s: None,
+            mode: 1,
+        });
+        d.resolve();
+    }
+    d
+}
+
 /// Validates every config `selfcal` will run (both sweeps, and each drifted device) before
 /// any sample is computed; returns the warnings they add to those of `cfg.validate()`, or
 /// every problem in one error (the sweeps' under keys `cfg`'s own problems do not name; the
@@ -228,7 +218,7 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
         if !s.drift_delta_t_k.is_empty() && cfg.pll.is_none() {
             // The PLL-tracked half of the drift scenario locks with the default loop; where
             // none fits the board, that half is left out (null), and said so.
-            if let Err(e) = crate::selfcal_analyses::drift_pll_design(cfg).validate() {
+            if let Err(e) = drift_pll_design(cfg).validate() {
                 add("drift scenario", Ok(vec![format!(
                     "selfcal.drift_delta_t_k: the drift scenario's PLL-tracked half is left out (null): the default carrier PLL does not fit this board ({}); add a [pll] section that fits to get it",
                     e.problems().iter().map(|p| p.to_string()).collect::<Vec<_>>().join("; ")

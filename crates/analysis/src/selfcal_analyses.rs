@@ -3,10 +3,12 @@
 //! averaging time (one long rotating run read at checkpoints), and a temperature drift.
 
 use crate::allan::{noise_readings_settled, overlapping_adev, AllanPoint, NoiseReadings};
-use crate::selfcal::{drifted, linearised_slope, run_selfcal_core, sweep_configs, SlopeFit};
+pub use crate::selfcal::drift_pll_design;
+use crate::selfcal::{drifted, run_selfcal_core, sweep_configs};
 use crate::selfcal_combined::{combined_slope, CombinedSlope};
+use crate::slope_fit::{linearised_slope, SlopeFit};
 use gyroemu_board::{lane_groups, max_lanes, GroupBoard, LaneResult, Point, RunOptions};
-use gyroemu_config::{Config, PllConfig, WindowKind};
+use gyroemu_config::{Config, WindowKind};
 use gyroemu_experiment::post_process;
 use gyroemu_experiment::sweep::{add_group_progress, group_samples};
 use gyroemu_experiment::{lock_config_carrier, resolve_lock, Progress, SweepError};
@@ -358,22 +360,6 @@ pub struct DriftPoint {
     pub pll: Option<DriftCase>,
     /// When the PLL's lock indicator came on for good, s.
     pub pll_lock_time_s: Option<f64>,
-}
-
-/// The config whose `[pll]` designs the drift scenario's loop: the user's, or the default
-/// loop (derived natural frequency and lock time) on the nominal device.
-pub fn drift_pll_design(cfg: &Config) -> Config {
-    let mut d = cfg.clone();
-    if d.pll.is_none() {
-        d.pll = Some(PllConfig {
-            natural_hz: None,
-            damping: core::f64::consts::FRAC_1_SQRT_2,
-            lock_s: None,
-            mode: 1,
-        });
-        d.resolve();
-    }
-    d
 }
 
 /// [`drift_pll_design`] when its loop fits the board: the drift scenario then runs its

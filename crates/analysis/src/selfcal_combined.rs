@@ -9,7 +9,7 @@
 //! whatever r and Q2/Q1 are. docs/selfcal.md gives what is left (mode split, phase-shifter
 //! error, quadrature coupling, noise).
 
-use crate::selfcal::linearised_slope;
+use crate::slope_fit::linearised_slope;
 use gyroemu_config::Config;
 use gyroemu_experiment::fit::{fit_line, t95};
 use gyroemu_experiment::SweepResult;

@@ -8,9 +8,10 @@ use crate::flicker::FlickerSources;
 use crate::lanes::MAX_LANES;
 use crate::params::{build_adc, build_dac, build_lowpass, build_tia, BoardParams, Shape};
 use crate::point::{Point, RunOptions, RunOutput};
+use crate::seeding::lane_set_rng;
 use gyroemu_am::{AmModulator, Dac, DrivePattern, Quantizer};
 use gyroemu_core::gauss::NormalBlock;
-use gyroemu_core::noise::{held_white_sigma, stream_seed, NoiseRng};
+use gyroemu_core::noise::held_white_sigma;
 use gyroemu_core::{ParamError, Sample};
 use gyroemu_lpf::LowPassBank;
 use gyroemu_mixer::{Stage1Mixer, Stage2Mixer, TableMixer};
@@ -173,16 +174,6 @@ pub struct Board<S: Sample> {
     pub(crate) pristine: Option<Box<Board<S>>>,
     /// Raised: the run stops at its next progress report (see [`Board::set_cancel`]).
     pub(crate) cancel: Option<Arc<AtomicBool>>,
-}
-
-/// The generator of lanes `4q .. 4q + 4`, lane `i` on stream `streams[i]` (lanes past the end
-/// repeat the last): every lane-parallel noise source draws from four-lane sets like this one,
-/// so a lane draws the same numbers in every lane type.
-pub(crate) fn lane_set_rng(seed: u64, streams: &[u64], q: usize) -> NoiseRng {
-    let last = streams.len() - 1;
-    NoiseRng::new(core::array::from_fn(|i| {
-        stream_seed(seed, streams[(4 * q + i).min(last)])
-    }))
 }
 
 impl<S: Sample> Board<S> {

@@ -23,6 +23,7 @@ mod params;
 mod point;
 mod probe;
 pub mod reference;
+mod seeding;
 
 pub use board::Board;
 pub use chain::{unleak_sidebands, unleak_table_harmonics, ChainResponse, RotatingTerms};

@@ -6,7 +6,7 @@
 //! their piece's core finish in the portable code's scalar ziggurat, each lane's further
 //! draws stepped in the register, so the bits are the same on either path (tested).
 
-use crate::gauss::{lane_normal, ONE_BITS, SIGN_BIT, SIGN_SHIFT};
+use crate::gauss_scalar::{lane_normal, ONE_BITS, SIGN_BIT, SIGN_SHIFT};
 use crate::gauss_tables::{FAST, N};
 use core::arch::x86_64::*;
 use wide::{f64x4, u64x4};

@@ -2,7 +2,8 @@
 //! scalar ziggurat written from the paper (statistics are in tests/gauss.rs).
 
 use super::*;
-use crate::gauss_tables::{V, X};
+use crate::gauss_scalar::{closed0, ln, open0};
+use crate::gauss_tables::{F, R, V, WEDGE, X};
 use crate::noise::tests::{reference_streams, Reference};
 
 /// f(x) = exp(-x^2 / 2), libm (the tests' own reference, not the generator's polynomial).

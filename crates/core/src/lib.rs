@@ -10,6 +10,7 @@ pub mod flicker;
 pub mod gauss;
 #[cfg(target_arch = "x86_64")]
 mod gauss_avx512;
+mod gauss_scalar;
 mod gauss_tables;
 pub mod noise;
 pub mod sample;

@@ -37,7 +37,7 @@ pub fn abort_now() -> Vec<PathBuf> {
         .collect();
     drop(live);
     for (_, path, text) in guard(&LOCKS).iter() {
-        crate::lock::remove_if_ours(path, text);
+        remove_if_ours(path, text);
     }
     written
 }
@@ -57,6 +57,14 @@ pub(crate) fn forget_lock(id: u64) {
 /// Whether this process holds a lock with exactly this content.
 pub(crate) fn holds(text: &str) -> bool {
     guard(&LOCKS).iter().any(|(_, _, t)| t == text)
+}
+
+/// Removes the lock at `path` if it still holds `text` (not a lock another process took
+/// over after this one was found stale).
+pub(crate) fn remove_if_ours(path: &Path, text: &str) {
+    if std::fs::read_to_string(path).is_ok_and(|t| t == text) {
+        let _ = std::fs::remove_file(path);
+    }
 }
 
 /// The manifest of a run in progress, kept as an abort would write it; its final write goes

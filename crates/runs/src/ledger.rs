@@ -5,8 +5,8 @@
 
 use crate::abort::LiveManifest;
 use crate::error::RunError;
-use crate::manifest::{manifest_path, Manifest, RunKind, ShardId};
-use crate::shard::Shard;
+use crate::manifest::{Manifest, RunKind, ShardId};
+use crate::shard::{manifest_path, Shard};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

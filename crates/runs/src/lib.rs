@@ -15,6 +15,7 @@ mod lot_merge;
 mod lot_run;
 pub mod manifest;
 mod merge;
+mod merge_split;
 pub mod points;
 pub mod records;
 mod resume;

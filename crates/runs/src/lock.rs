@@ -10,7 +10,7 @@
 //! `/proc/<pid>` absent) it is taken over with a warning; from another host it cannot be
 //! checked and is honoured.
 
-use crate::abort;
+use crate::abort::{self, remove_if_ours};
 use crate::error::RunError;
 use crate::manifest::files_like;
 use gyroemu_experiment::Reporter;
@@ -252,14 +252,6 @@ fn create_with(path: &Path, text: &str) -> std::io::Result<()> {
             f.sync_all()
         }
         r => r,
-    }
-}
-
-/// Removes the lock at `path` if it still holds `text` (not a lock another process took
-/// over after this one was found stale).
-pub(crate) fn remove_if_ours(path: &Path, text: &str) {
-    if std::fs::read_to_string(path).is_ok_and(|t| t == text) {
-        let _ = std::fs::remove_file(path);
     }
 }
 

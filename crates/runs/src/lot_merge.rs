@@ -1,4 +1,4 @@
-//! Merging the shards of a lot: the shared checks of [`crate::merge`], then one config text
+//! Merging the shards of a lot: the shared checks of [`crate::merge_split`], then one config text
 //! across the shards (the spec too: it judges every device), the lot's size agreed, every
 //! device's file read back bit for bit, and the lot's files written from them.
 
@@ -6,7 +6,7 @@ use crate::config_diff::{describe_diff, text_diff};
 use crate::device_file::{lot_hash, DeviceFile};
 use crate::error::RunError;
 use crate::lot_run::check_unreliable;
-use crate::merge::{bad, Split};
+use crate::merge_split::{bad, Split};
 use gyroemu_config::parse_config;
 use gyroemu_experiment::Reporter;
 use gyroemu_report::write_lot;

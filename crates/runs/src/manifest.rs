@@ -120,14 +120,6 @@ impl Manifest {
     }
 }
 
-/// The manifest of a run in `out`: `manifest.json`, or the shard's `shard-I-of-N.json`.
-pub(crate) fn manifest_path(out: &Path, shard: Option<&crate::shard::Shard>) -> PathBuf {
-    match shard {
-        Some(s) => out.join(s.manifest_name()),
-        None => out.join(RUN_MANIFEST),
-    }
-}
-
 /// Reads a manifest file.
 pub fn read_manifest(path: &Path) -> Result<Manifest, String> {
     let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;

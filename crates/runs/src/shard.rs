@@ -3,9 +3,9 @@
 //! to shard `p % n`, so the assignment depends on nothing but the config and `n`.
 
 use crate::error::RunError;
-use crate::manifest::{read_manifest, shard_manifest_paths, RunKind};
+use crate::manifest::{read_manifest, shard_manifest_paths, RunKind, RUN_MANIFEST};
 use std::collections::{BTreeMap, BTreeSet};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Shard `index` of `count` (0-based), and where that came from (for messages).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -103,6 +103,14 @@ impl Shard {
             source,
             from,
         })
+    }
+}
+
+/// The manifest of a run in `out`: `manifest.json`, or the shard's `shard-I-of-N.json`.
+pub(crate) fn manifest_path(out: &Path, shard: Option<&Shard>) -> PathBuf {
+    match shard {
+        Some(s) => out.join(s.manifest_name()),
+        None => out.join(RUN_MANIFEST),
     }
 }
 

@@ -1,6 +1,6 @@
 //! The flicker sources' Gaussian streams.
 
-use crate::board::lane_set_rng;
+use crate::seeding::lane_set_rng;
 use gyroemu_core::noise::NoiseRng;
 use gyroemu_core::{f64x4, Sample};
 
