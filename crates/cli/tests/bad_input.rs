@@ -304,3 +304,129 @@ fn global_flags_out_of_range_exit_2_before_any_thread_or_sample() {
         assert!(!out.exists(), "{flags:?}: {out:?} created");
     }
 }
+
+/// The text of `gyroemu config --preset NAME`.
+fn preset(name: &str) -> String {
+    let o = Command::new(env!("CARGO_BIN_EXE_gyroemu"))
+        .args(["config", "--preset", name])
+        .output()
+        .expect("binary runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8(o.stdout).unwrap()
+}
+
+/// The Coriolis preset with the line starting `key = ` replaced by `key = value`.
+fn coriolis_with(key: &str, value: &str) -> String {
+    let text = preset("m2tfg-coriolis");
+    let start = format!("{key} = ");
+    assert!(text.lines().any(|l| l.starts_with(&start)), "{key}");
+    text.lines()
+        .map(|l| {
+            if l.starts_with(&start) {
+                format!("{key} = {value}")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+        + "\n"
+}
+
+#[test]
+fn a_tia_pole_whose_gain_rounds_to_zero_exits_2_naming_the_pole() {
+    // It blamed board.tia_gain_ohm (1e-120, 1e-300), or ran and exited 1 (1e-12 .. 1e-90).
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    for pole in ["1e-300", "1e-120", "1e-90", "1e-12"] {
+        let cfg = write(
+            dir.path(),
+            "pole.toml",
+            coriolis_with("tia_pole_hz", pole).as_bytes(),
+        );
+        refused(
+            pole,
+            &cfg,
+            &out,
+            &[
+                &format!("key `board.tia_pole_hz` = {pole}: "),
+                "must be at least 2.12",
+                "rounds to exactly 1",
+            ],
+        );
+        assert!(!out.exists(), "{pole}: --out was created");
+    }
+}
+
+#[test]
+fn a_dump_starting_past_the_run_exits_2_naming_its_start() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let text = preset("m2tfg-coriolis")
+        + "\n[dump]\nrate_dps = 100.0\nstart_s = 50.0\nduration_s = 0.002\nnodes = [\"tia\"]\n";
+    let cfg = write(dir.path(), "dump.toml", text.as_bytes());
+    refused(
+        "dump start past the run",
+        &cfg,
+        &out,
+        &[
+            "key `dump.start_s` = 50: ",
+            "must start within that point's run (2.71",
+        ],
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_tia_noise_level_that_would_overflow_exits_2_naming_it() {
+    // 1e200 spoke of flicker (with no corner); 1e160 failed at run time; 1e155 exited 1.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    for (key, v) in [
+        ("tia_voltage_noise_v_per_rthz", "1e200"),
+        ("tia_voltage_noise_v_per_rthz", "1e160"),
+        ("tia_voltage_noise_v_per_rthz", "1e155"),
+        ("tia_current_noise_a_per_rthz", "1e155"),
+    ] {
+        let text = preset("m2tfg-coriolis") + &format!("\n[noise]\n{key} = {v}\n");
+        let cfg = write(dir.path(), "noise.toml", text.as_bytes());
+        refused(
+            v,
+            &cfg,
+            &out,
+            &[
+                &format!("key `noise.{key}` = {v}: "),
+                "standard deviation",
+                "must stay within 1e100",
+            ],
+        );
+        let err = String::from_utf8_lossy(&run(&cfg, &out).stderr).into_owned();
+        assert!(!err.contains("flicker"), "{key} = {v}: {err}");
+        assert!(!out.exists());
+    }
+}
+
+#[test]
+fn integers_out_of_range_exit_2_echoed_as_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cases = [
+        (
+            coriolis_with("lpf_order", "9223372036854775807"),
+            "key `board.lpf_order` = 9223372036854775807: must be an integer from 1 to 8",
+        ),
+        (
+            coriolis_with("lpf_order", "99999999999999999999"),
+            "key `board.lpf_order` = 99999999999999999999: too large: at most 18446744073709551615",
+        ),
+        (
+            preset("m2tfg-coriolis") + "\n[noise]\nseed = 18446744073709551616\n",
+            "key `noise.seed` = 18446744073709551616: too large: at most 18446744073709551615",
+        ),
+    ];
+    for (text, needle) in cases {
+        let cfg = write(dir.path(), "int.toml", text.as_bytes());
+        refused(needle, &cfg, &out, &[needle]);
+        assert!(!out.exists());
+    }
+}

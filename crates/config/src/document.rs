@@ -183,9 +183,17 @@ fn rule(kind: Kind, v: &DeValue<'_>) -> Option<String> {
             };
             match (int, v.as_float()) {
                 (Some((s, radix)), _) => {
+                    // Digits past i128 are a (positive) integer too large for any key.
+                    let negative = s.starts_with('-');
                     let n = i128::from_str_radix(s, radix).ok();
                     let ok = n.is_some_and(|n| (0..=max as i128).contains(&n));
-                    (!ok).then(|| format!("expected {range}"))
+                    (!ok).then(|| {
+                        if negative {
+                            format!("expected {range}")
+                        } else {
+                            format!("too large: at most {max}")
+                        }
+                    })
                 }
                 (_, Some(f)) => {
                     let whole = f

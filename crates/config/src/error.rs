@@ -33,12 +33,18 @@ impl ConfigError {
         }
     }
 
-    /// An error about one key's value.
-    pub fn key(key: &str, value: impl fmt::Display, rule: impl fmt::Display) -> Self {
+    /// An error about one key's value (an integer is shown with all its digits, a float
+    /// in exponent form when very large or small).
+    pub fn key(key: &str, value: impl fmt::Display + 'static, rule: impl fmt::Display) -> Self {
+        let shown = if is_integer(&value) {
+            value.to_string()
+        } else {
+            readable(value.to_string())
+        };
         Self {
             location: None,
             key: Some(key.to_string()),
-            detail: format!(" = {}: {rule}", readable(value.to_string())),
+            detail: format!(" = {shown}: {rule}"),
             more: Vec::new(),
         }
     }
@@ -110,6 +116,27 @@ impl fmt::Display for ConfigError {
         }
         Ok(())
     }
+}
+
+/// Whether `v` is of an integer type: its digits are the value as written (through f64,
+/// 9223372036854775807 came out as 9.223372036854776e18).
+fn is_integer(v: &dyn std::any::Any) -> bool {
+    use std::any::TypeId;
+    [
+        TypeId::of::<u8>(),
+        TypeId::of::<u16>(),
+        TypeId::of::<u32>(),
+        TypeId::of::<u64>(),
+        TypeId::of::<u128>(),
+        TypeId::of::<usize>(),
+        TypeId::of::<i8>(),
+        TypeId::of::<i16>(),
+        TypeId::of::<i32>(),
+        TypeId::of::<i64>(),
+        TypeId::of::<i128>(),
+        TypeId::of::<isize>(),
+    ]
+    .contains(&v.type_id())
 }
 
 /// A number as the user would write it: very large or very small magnitudes in exponent

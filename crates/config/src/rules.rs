@@ -88,7 +88,13 @@ impl Rules {
 
     /// The rule `ok` about `key = value`; returns `ok`. A key with a problem already, or
     /// derived from a bad one, is not judged again (returns `false`).
-    pub fn check(&mut self, ok: bool, key: &str, value: impl Display, rule: impl Display) -> bool {
+    pub fn check(
+        &mut self,
+        ok: bool,
+        key: &str,
+        value: impl Display + 'static,
+        rule: impl Display,
+    ) -> bool {
         if self.failed(key) || self.links.iter().any(|&(d, s)| d == key && self.bad(s)) {
             return false;
         }

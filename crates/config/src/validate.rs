@@ -137,13 +137,23 @@ impl Config {
         p.positive("board.tia_gain_ohm", b.tia_gain_ohm);
         if let Some(pole) = b.tia_pole_hz {
             if p.clean(&["board.fs_hz"]) {
-                p.check(
+                let ok = p.check(
                     pole.is_finite() && pole > 0.0 && pole < 0.5 * fs_hz,
                     "board.tia_pole_hz",
                     pole,
                     format!(
                         "must be > 0 and below Nyquist (fs_hz/2 = {} Hz)",
                         0.5 * fs_hz
+                    ),
+                );
+                // The TIA as built: a pole whose coefficient rounds to 1 has a gain of 0.
+                let min = gyroemu_tia::min_pole_hz(fs_hz);
+                p.check(
+                    !ok || gyroemu_tia::pole_coefficient(pole, fs_hz) < 1.0,
+                    "board.tia_pole_hz",
+                    pole,
+                    format!(
+                        "must be at least {min:e} Hz at fs_hz = {fs_hz}: below it the TIA's discretised pole a = exp(-2 pi tia_pole_hz / fs_hz) rounds to exactly 1 (2 pi tia_pole_hz / fs_hz under about 2^-54, half the spacing of doubles below 1), so its gain (1 - a) x tia_gain_ohm is exactly 0 at every frequency and no signal passes; raise it, or remove the key for a wide-band TIA"
                     ),
                 );
             } else {
@@ -407,14 +417,23 @@ impl Config {
                 .saturating_add(pt.n_avg())
                 .saturating_add(1);
             let total = n_out as f64 / self.fs_out_hz();
-            p.check(
-                start_s + duration_s <= total,
-                "dump.duration_s",
-                duration_s,
-                format!(
-                    "the window start_s + duration_s must end within that point's run ({total} s)"
-                ),
+            // A start past the end is the start's fault, whatever the length.
+            let starts_within = p.check(
+                start_s < total,
+                "dump.start_s",
+                start_s,
+                format!("the window must start within that point's run ({total} s)"),
             );
+            if starts_within {
+                p.check(
+                    start_s + duration_s <= total,
+                    "dump.duration_s",
+                    duration_s,
+                    format!(
+                        "the window start_s + duration_s must end within that point's run ({total} s; it starts at start_s = {start_s} s)"
+                    ),
+                );
+            }
         }
         if p.clean(&["board.fs_hz"]) {
             p.check(

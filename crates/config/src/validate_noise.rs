@@ -4,6 +4,20 @@
 use crate::config::Config;
 use crate::rules::Rules;
 use crate::validate::MAX_RUN_SAMPLES;
+use crate::validate_regime::NODE_RANGE;
+use gyroemu_core::flicker::{FlickerDesign, FlickerParams};
+use gyroemu_core::noise::held_white_sigma;
+use gyroemu_core::Response;
+use gyroemu_tia::Tia;
+
+/// The largest of a run's Gaussian draws in standard deviations: of at most 2^53 draws, one
+/// exceeds 9 sigma with probability about 2e-3 (2^53 x P(|g| > 9) = 2^53 x 2.3e-19).
+const PEAK_SIGMAS: f64 = 9.0;
+
+/// The phases the board takes sines of are accurate to about 2e-16 up to this size, rad
+/// (gyroemu_core::detmath; beyond it the reduction loses bits, and far beyond it the sines
+/// are no longer bounded).
+const MAX_PHASE_RAD: f64 = 1e6;
 
 impl Config {
     /// The rules of the `[noise]` and `[selfcal]` sections and of the ADC keys.
@@ -42,9 +56,20 @@ impl Config {
                 "noise.tia_voltage_noise_v_per_rthz",
                 n.tia_voltage_noise_v_per_rthz,
             );
+            // The corner is to blame when the white level's own per-sample deviation is in
+            // the node range (else that level is, as its white rule would say).
+            let i_v = n.tia_voltage_noise_v_per_rthz / b.tia_gain_ohm;
+            if (i_v * i_v * 0.5 * self.fs_hz()).sqrt() <= NODE_RANGE.1 {
+                named[0] = levels[0];
+            }
             let psds = board_noise.flicker_psds_at_1hz(b.tia_gain_ohm);
-            for (((key, v), (_, psd)), ok) in named.into_iter().zip(psds).zip(levels_ok) {
-                if ok && p.clean(&["board.tia_gain_ohm", key]) {
+            // No corner, no TIA flicker: its rule would weigh inf x 0 (the white level's
+            // own rule is `validate_noise_range`).
+            let on = [n.tia_voltage_flicker_corner_hz > 0.0, true, true, true];
+            for ((((key, v), (_, psd)), ok), on) in
+                named.into_iter().zip(psds).zip(levels_ok).zip(on)
+            {
+                if on && ok && p.clean(&["board.tia_gain_ohm", key]) {
                     p.check(
                         psd.is_finite(),
                         key,
@@ -191,6 +216,191 @@ impl Config {
                 "pll.lock_s",
                 t,
                 format!("must cover at least 5 loop time constants 1/(damping 2 pi natural_hz) = {min:.4} s"),
+            );
+        }
+    }
+}
+
+impl Config {
+    /// Each noise source's level against the chain's representable range, once the chain's
+    /// keys and the source's are each valid: the standard deviation the board gives it, per
+    /// sample, carried to each node it reaches, must stay within the node range the regime
+    /// rules hold the signal to (the signal rules cannot see noise, which filled the chain
+    /// with inf and NaN after validation passed). `largest_node` is the largest signal
+    /// amplitude of a node (in its unit).
+    pub(crate) fn validate_noise_range(&self, p: &mut Rules, largest_node: f64) {
+        let Some(n) = &self.noise else {
+            return;
+        };
+        let Ok(tia) = Tia::<f64>::new(&self.board_params().tia) else {
+            return;
+        };
+        let hi = NODE_RANGE.1;
+        let fs = self.fs_hz();
+        let plant = self.resonator_params();
+        let modes = [plant.mode1, plant.mode2];
+        let r = self.board.tia_gain_ohm;
+        let white_gain = tia.white_noise_gain();
+        // A white input current of density `d` A/sqrt(Hz): its largest per-sample deviation
+        // over the modes, as the board draws it, and that through the TIA.
+        let white = |d: f64| {
+            let s = modes
+                .iter()
+                .map(|m| held_white_sigma(d * d, fs, m.f0_hz))
+                .fold(0.0, |a: f64, b| if b.is_nan() { b } else { a.max(b) });
+            (s, s * white_gain)
+        };
+        let within = |x: f64| x <= hi; // NaN is not
+        let rule = |what: &str, s_i: f64, s_v: f64| {
+            format!(
+                "gives {what} a per-sample current of standard deviation {s_i:.3e} A (sqrt(density^2 fs_hz/2) / sinc(f0/fs_hz), as the board draws it) and {s_v:.3e} V at the TIA output (x {white_gain:.3e} ohm, the discretised TIA's white-noise gain tia_gain_ohm sqrt((1 - a)/(1 + a))), which must stay within {hi:e} (the node range, so products of two stay finite): lower it"
+            )
+        };
+        let i_c = n.tia_current_noise_a_per_rthz;
+        let e_n = n.tia_voltage_noise_v_per_rthz;
+        let key_i = "noise.tia_current_noise_a_per_rthz";
+        let key_e = "noise.tia_voltage_noise_v_per_rthz";
+        let (si, vi) = white(i_c);
+        let ok_i = p.clean(&[key_i])
+            && p.check(
+                within(si) && within(vi),
+                key_i,
+                i_c,
+                rule("the TIA's input", si, vi),
+            );
+        let (se, ve) = white(e_n / r);
+        let ok_e = p.clean(&[key_e])
+            && p.check(
+                within(se) && within(ve),
+                key_e,
+                e_n,
+                rule("(as e_n / tia_gain_ohm at the TIA's input)", se, ve),
+            );
+        if ok_i && ok_e {
+            // Both within alone, their sum in power can still leave it.
+            let i_n = gyroemu_tia::input_referred_noise_a_per_rthz(i_c, e_n, r);
+            let (s, v) = white(i_n);
+            let (key, value) = if i_c >= e_n / r {
+                (key_i, i_c)
+            } else {
+                (key_e, e_n)
+            };
+            p.check(
+                within(s) && within(v),
+                key,
+                value,
+                rule("with the other TIA noise density (in power)", s, v),
+            );
+        }
+
+        // Brownian force: per-sample deviation as drawn, then the velocity's stationary
+        // deviation sqrt(S_a Q / (4 w0)) (equipartition, k T / m) through transduction and TIA.
+        if let Some(m) = n.effective_mass_kg {
+            let key = "noise.effective_mass_kg";
+            if p.clean(&[key, "noise.temperature_k"]) {
+                let mut worst: Option<String> = None;
+                for (k, mode) in modes.iter().enumerate() {
+                    let psd = gyroemu_resonator::thermomechanical_accel_psd(
+                        n.temperature_k,
+                        m,
+                        mode.f0_hz,
+                        mode.q,
+                    );
+                    let w0 = core::f64::consts::TAU * mode.f0_hz;
+                    let force = held_white_sigma(psd, fs, mode.f0_hz);
+                    let v = (psd * mode.q / (4.0 * w0)).sqrt();
+                    let i = v * self.device.transduction_a_s_per_m;
+                    let out = i * tia.response(mode.f0_hz).norm();
+                    let nodes = [
+                        ("force per unit mass", force, "m/s^2"),
+                        ("velocity", v, "m/s"),
+                        ("motional current", i, "A"),
+                        ("TIA output", out, "V"),
+                    ];
+                    if let Some((node, x, unit)) = nodes.into_iter().find(|&(_, x, _)| !within(x)) {
+                        worst.get_or_insert(format!(
+                            "with temperature_k = {} gives mode {} a Brownian {node} of standard deviation {x:.3e} {unit} (force: sqrt(4 k temperature_k w0 / (q effective_mass_kg) fs_hz/2) per sample; velocity: sqrt(k temperature_k / effective_mass_kg)), which must stay within {hi:e} (the node range, so products of two stay finite): raise effective_mass_kg or lower temperature_k",
+                            n.temperature_k,
+                            k + 1
+                        ));
+                    }
+                }
+                if let Some(rule) = worst {
+                    p.check(false, key, m, rule);
+                }
+            }
+        }
+
+        // Flicker: the exact stationary deviation of each designed source.
+        if !self.has_flicker() || !p.clean(&["noise.flicker_f_lo_hz"]) {
+            return;
+        }
+        let board_noise = crate::plan::noise_params(n, self.flicker_f_lo_hz());
+        let [(_, tia_s1), (_, amp_s1), (_, drive_phi_s1), (_, carrier_phi_s1)] =
+            board_noise.flicker_psds_at_1hz(r);
+        let fs_out = self.fs_out_hz();
+        let deviation = |s1: f64, rate: f64| {
+            if s1 == 0.0 {
+                return 0.0;
+            }
+            FlickerDesign::new(&FlickerParams {
+                fs_hz: rate,
+                psd_at_1hz: s1,
+                f_lo_hz: self.flicker_f_lo_hz(),
+                f_hi_hz: 0.5 * rate,
+            })
+            .map_or(f64::NAN, |d| d.variance().sqrt())
+        };
+        let key_c = "noise.tia_voltage_flicker_corner_hz";
+        if n.tia_voltage_flicker_corner_hz > 0.0 && p.clean(&[key_c, key_e]) {
+            // Low-frequency current: the TIA passes it with its DC gain, |G| at most.
+            let s = deviation(tia_s1, fs);
+            let v = s * r;
+            p.check(
+                within(s) && within(v),
+                key_c,
+                n.tia_voltage_flicker_corner_hz,
+                format!(
+                    "gives the TIA's voltage flicker ((e_n / tia_gain_ohm)^2 x tia_voltage_flicker_corner_hz / f A^2/Hz, referred to the input) a per-sample current of standard deviation {s:.3e} A and about {v:.3e} V at the TIA output (x tia_gain_ohm), which must stay within {hi:e} (the node range): lower it or noise.tia_voltage_noise_v_per_rthz"
+                ),
+            );
+        }
+        let key_a = "noise.drive_amplitude_flicker_per_rthz";
+        if p.clean(&[key_a]) {
+            let s = deviation(amp_s1, fs_out);
+            let scale = 1.0 + PEAK_SIGMAS * s;
+            p.check(
+                within(scale * largest_node),
+                key_a,
+                n.drive_amplitude_flicker_per_rthz,
+                format!(
+                    "gives each drive a relative amplitude of standard deviation {s:.3e}: at {PEAK_SIGMAS} of them (the largest of a run's draws) it scales the largest node's signal, about {largest_node:.3e}, to {:.3e}, outside the node range (at most {hi:e}, so products of two stay finite): lower it",
+                    scale * largest_node
+                ),
+            );
+        }
+        let keys_phi = [
+            "noise.drive_phase_flicker_rad_per_rthz",
+            "noise.carrier_phase_flicker_rad_per_rthz",
+        ];
+        let levels_phi = [
+            n.drive_phase_flicker_rad_per_rthz,
+            n.carrier_phase_flicker_rad_per_rthz,
+        ];
+        let s_phi = [drive_phi_s1, carrier_phi_s1].map(|s1| deviation(s1, fs_out));
+        if p.clean(&keys_phi) {
+            // The board takes the sine of the carrier's phase plus a drive's.
+            let peak = PEAK_SIGMAS * (s_phi[0] + s_phi[1]);
+            let k = usize::from(s_phi[1] > s_phi[0]);
+            p.check(
+                peak <= MAX_PHASE_RAD,
+                keys_phi[k],
+                levels_phi[k],
+                format!(
+                    "gives a phase of standard deviation {:.3e} rad (drive and carrier phase flicker together: {:.3e} rad at {PEAK_SIGMAS} of them, the largest of a run's draws), beyond the {MAX_PHASE_RAD:e} rad within which the board's sines are accurate: lower it",
+                    s_phi[0] + s_phi[1],
+                    peak
+                ),
             );
         }
     }

@@ -8,7 +8,7 @@ use crate::error::ConfigError;
 use crate::plan::DEG;
 use crate::rules::Rules;
 use gyroemu_board::{ChainResponse, Shape};
-use gyroemu_core::Complex64;
+use gyroemu_core::{Complex64, Response};
 use gyroemu_resonator::continuous_steady_state;
 
 /// |a - b| in mdeg within a half turn: a phase and the same plus 180 degrees read alike (the
@@ -42,11 +42,23 @@ fn node_amplitudes(c: &Config, k: usize) -> [f64; 5] {
     let f = [c.drive.f1, c.f2()][k];
     let v = f * mode.q / w;
     let i = c.device.transduction_a_s_per_m * v;
-    let pole = c
-        .board
-        .tia_pole_hz
-        .map_or(1.0, |fp| 1.0 / (1.0 + (mode.f0_hz / fp).powi(2)).sqrt());
-    [f, v / w, v, i, c.board.tia_gain_ohm * i * pole]
+    [
+        f,
+        v / w,
+        v,
+        i,
+        c.board.tia_gain_ohm * i * tia_pole_factor(c, mode.f0_hz),
+    ]
+}
+
+/// |H(f)| / tia_gain_ohm of the TIA as built (its discretised pole, not the analogue one,
+/// whose factor differs where the pole's coefficient rounds); 1 without a pole.
+fn tia_pole_factor(c: &Config, f_hz: f64) -> f64 {
+    if c.board.tia_pole_hz.is_none() {
+        return 1.0;
+    }
+    gyroemu_tia::Tia::<f64>::new(&c.board_params().tia)
+        .map_or(0.0, |t| t.response(f_hz).norm() / c.board.tia_gain_ohm)
 }
 
 impl Config {
@@ -68,6 +80,10 @@ impl Config {
             p.push(e);
             return;
         }
+        let largest = (0..2)
+            .flat_map(|k| node_amplitudes(self, k))
+            .fold(0.0, f64::max);
+        self.validate_noise_range(p, largest);
         self.validate_converters(p, warnings);
         self.validate_dac_rounding(warnings);
         self.validate_mixer_product(warnings);
@@ -146,6 +162,22 @@ impl Config {
                         "device.transduction_a_s_per_m",
                         self.device.transduction_a_s_per_m,
                     ),
+                    // The pole's attenuation alone took an output the gain keeps in range
+                    // out of it: the pole is the knob.
+                    _ if (lo..=hi).contains(&(self.board.tia_gain_ohm * a[3])) => {
+                        let pole = self.board.tia_pole_hz.unwrap_or(f64::NAN);
+                        return Err(ConfigError::key(
+                            "board.tia_pole_hz",
+                            pole,
+                            format!(
+                                "the TIA output of mode {} would be about {amp:e} V (tia_gain_ohm x motional current = {:e} V, times the pole's attenuation {:e} at {} Hz), outside {lo:e}..{hi:e}: the chain would underflow (subnormal arithmetic, many times slower, rounds the signal away); raise board.tia_pole_hz (or remove it for a wide-band TIA)",
+                                k + 1,
+                                self.board.tia_gain_ohm * a[3],
+                                amp / (self.board.tia_gain_ohm * a[3]),
+                                [self.device.f0_hz, self.f0_mode2_hz()][k],
+                            ),
+                        ));
+                    }
                     _ => ("board.tia_gain_ohm", self.board.tia_gain_ohm),
                 };
                 let what = if amp > hi {

@@ -1556,3 +1556,216 @@ fn validation_problems_are_located_in_the_text_that_set_them() {
         .collect();
     assert_eq!(got, want);
 }
+
+/// The refusal of `text` by validation (it must parse).
+fn invalid_msg(what: &str, text: &str) -> ConfigError {
+    let e = parse_config(text)
+        .unwrap_or_else(|e| panic!("{what}: did not parse: {e}"))
+        .validate()
+        .expect_err(what);
+    assert_eq!(e.problems().len(), 1, "{what}: {e}");
+    e
+}
+
+#[test]
+fn a_tia_pole_too_small_for_its_discretisation_is_named_with_its_bound() {
+    // fs = 240 kHz: exp(-2 pi pole / fs) rounds to 1 below about 2.12e-12 Hz, and the TIA's
+    // gain is exactly 0 (the node-range rule blamed tia_gain_ohm, or nothing refused it).
+    let c = base(C);
+    let min = gyroemu_tia::min_pole_hz(240e3);
+    assert!((2.12e-12..2.13e-12).contains(&min), "{min}");
+    for pole in ["1e-300", "1e-120", "1e-90", "1e-12", "2.12e-12"] {
+        let t = set(&c, "board", "tia_pole_hz", pole).0;
+        let e = invalid_msg(pole, &t);
+        let msg = e.to_string();
+        assert_eq!(e.key.as_deref(), Some("board.tia_pole_hz"), "{msg}");
+        for n in [
+            &format!("= {pole}: "),
+            "must be at least 2.12",
+            "rounds to exactly 1",
+            "exactly 0",
+        ] {
+            assert!(msg.contains(n), "{pole}: `{n}` missing from: {msg}");
+        }
+    }
+    // Poles that work stay valid, the smallest one included (its gain is not 0).
+    for pole in [min, 1e-11, 1e-10, 60000.0] {
+        let t = set(&c, "board", "tia_pole_hz", &format!("{pole:e}")).0;
+        let cfg = parse_config(&t).unwrap();
+        assert!(cfg.validate().is_ok(), "{pole}: {:?}", cfg.validate());
+        let chain = gyroemu_board::ChainResponse::new(&cfg.board_params()).unwrap();
+        assert!(chain.tia(15e3).norm() > 0.0, "{pole}");
+    }
+    // When the pole's attenuation is what takes the TIA output out of the node range (the
+    // gain alone keeps it in), the node-range rule names the pole.
+    let t = set(&c, "board", "tia_gain_ohm", "1e-85").0;
+    assert!(parse_config(&t).unwrap().validate().is_ok());
+    let t = set(&t, "board", "tia_pole_hz", "1e-11").0;
+    let e = invalid_msg("attenuating pole", &t);
+    let msg = e.to_string();
+    assert_eq!(e.key.as_deref(), Some("board.tia_pole_hz"), "{msg}");
+    for n in [
+        "= 1e-11: ",
+        "the TIA output of mode 1",
+        "outside 1e-100..1e100",
+        "raise board.tia_pole_hz",
+    ] {
+        assert!(msg.contains(n), "`{n}` missing from: {msg}");
+    }
+}
+
+#[test]
+fn a_dump_window_starting_past_the_run_names_its_start() {
+    let c = base(C);
+    let dump = |start: &str, duration: &str| {
+        with(
+            c.clone(),
+            &format!("\n[dump]\nrate_dps = 100.0\nstart_s = {start}\nduration_s = {duration}\nnodes = [\"tia\"]\n"),
+        )
+    };
+    let e = invalid_msg("start past the run", &dump("50.0", "0.002"));
+    let msg = e.to_string();
+    assert_eq!(e.key.as_deref(), Some("dump.start_s"), "{msg}");
+    for n in ["= 50: ", "must start within that point's run (2.71"] {
+        assert!(msg.contains(n), "`{n}` missing from: {msg}");
+    }
+    // A start within the run whose window ends past it: the duration, as before.
+    let e = invalid_msg("window past the end", &dump("2.7", "0.2"));
+    let msg = e.to_string();
+    assert_eq!(e.key.as_deref(), Some("dump.duration_s"), "{msg}");
+    assert!(
+        msg.contains("= 0.2: the window start_s + duration_s must end within"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn a_noise_density_that_would_overflow_the_chain_is_refused_by_its_key() {
+    let c = base(C);
+    let noise = |lines: &str| with(c.clone(), &format!("\n[noise]\n{lines}\n"));
+    // White levels, no flicker corner: no word of flicker (it said "flicker density at 1 Hz
+    // of NaN" for 1e200, and nothing refused 1e155..1e199, which failed at run time).
+    for (key, v) in [
+        ("tia_voltage_noise_v_per_rthz", "1e200"),
+        ("tia_voltage_noise_v_per_rthz", "1e160"),
+        ("tia_voltage_noise_v_per_rthz", "1e155"),
+        ("tia_voltage_noise_v_per_rthz", "1e100"),
+        ("tia_current_noise_a_per_rthz", "1e160"),
+        ("tia_current_noise_a_per_rthz", "1e100"),
+    ] {
+        let e = invalid_msg(v, &noise(&format!("{key} = {v}")));
+        let msg = e.to_string();
+        assert_eq!(e.key.as_deref(), Some(&*format!("noise.{key}")), "{msg}");
+        for n in [
+            &format!("= {v}: "),
+            "per-sample current of standard deviation",
+            "at the TIA output",
+            "must stay within 1e100",
+        ] {
+            assert!(msg.contains(n), "{key} = {v}: `{n}` missing from: {msg}");
+        }
+        assert!(!msg.contains("flicker"), "{key} = {v}: {msg}");
+    }
+    // The Brownian force of a tiny mass, the slow flicker sources.
+    for (key, v, rule) in [
+        (
+            "effective_mass_kg",
+            "1e-200",
+            "Brownian force per unit mass",
+        ),
+        (
+            "drive_amplitude_flicker_per_rthz",
+            "1e150",
+            "scales the largest node's signal",
+        ),
+        (
+            "drive_phase_flicker_rad_per_rthz",
+            "1e20",
+            "within which the board's sines are accurate",
+        ),
+        (
+            "carrier_phase_flicker_rad_per_rthz",
+            "1e20",
+            "within which the board's sines are accurate",
+        ),
+    ] {
+        let e = invalid_msg(v, &noise(&format!("{key} = {v}")));
+        let msg = e.to_string();
+        assert_eq!(e.key.as_deref(), Some(&*format!("noise.{key}")), "{msg}");
+        for n in [&format!("= {v}: "), rule] {
+            assert!(msg.contains(n), "{key} = {v}: `{n}` missing from: {msg}");
+        }
+    }
+    // With a corner the TIA's flicker may be spoken of, by the key to blame.
+    let e = invalid_msg(
+        "corner",
+        &noise("tia_voltage_noise_v_per_rthz = 1e-8\ntia_voltage_flicker_corner_hz = 1e300"),
+    );
+    let msg = e.to_string();
+    assert_eq!(
+        e.key.as_deref(),
+        Some("noise.tia_voltage_flicker_corner_hz"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("= 1e300: gives the TIA's voltage flicker"),
+        "{msg}"
+    );
+    assert!(msg.contains("must stay within 1e100"), "{msg}");
+    // Levels within the range stay valid, the presets' too.
+    for lines in [
+        "tia_voltage_noise_v_per_rthz = 1e90",
+        "tia_current_noise_a_per_rthz = 1e90",
+        "tia_voltage_noise_v_per_rthz = 2e-8\ntia_current_noise_a_per_rthz = 5e-14\neffective_mass_kg = 1e-9",
+    ] {
+        let cfg = parse_config(&noise(lines)).unwrap();
+        assert!(cfg.validate().is_ok(), "{lines}: {:?}", cfg.validate());
+    }
+    for name in ["m2tfg-selfcal", M] {
+        let cfg = parse_config(&base(name)).unwrap();
+        assert!(cfg.validate().is_ok(), "{name}: {:?}", cfg.validate());
+    }
+}
+
+#[test]
+fn integers_are_echoed_as_written_and_too_large_ones_say_their_bound() {
+    let c = base(C);
+    let t = set(&c, "board", "lpf_order", "9223372036854775807").0;
+    let msg = invalid_msg("lpf_order i64::MAX", &t).to_string();
+    assert!(
+        msg.contains("key `board.lpf_order` = 9223372036854775807: must be an integer from 1 to 8"),
+        "{msg}"
+    );
+    let noise = with(c.clone(), "\n[noise]\nseed = 1\n");
+    for (section, key, v, max) in [
+        (
+            "board",
+            "lpf_order",
+            "99999999999999999999",
+            usize::MAX as u64,
+        ),
+        ("noise", "seed", "18446744073709551616", u64::MAX),
+        ("board", "dac_bits", "4294967296", u64::from(u32::MAX)),
+    ] {
+        let (t, line) = set(&noise, section, key, v);
+        let e = parse_config(&t).unwrap_err();
+        let msg = e.to_string();
+        assert_eq!(
+            e.key.as_deref(),
+            Some(&*format!("{section}.{key}")),
+            "{msg}"
+        );
+        assert!(msg.contains(&format!("line {line}, column ")), "{msg}");
+        assert!(
+            msg.contains(&format!("= {v}: too large: at most {max}")),
+            "{section}.{key}: {msg}"
+        );
+    }
+    // A negative one is not too large: the kind of value is what is wrong.
+    let t = set(&noise, "noise", "seed", "-1").0;
+    let msg = parse_config(&t).unwrap_err().to_string();
+    assert!(
+        msg.contains("= -1: expected a non-negative integer"),
+        "{msg}"
+    );
+}

@@ -6,7 +6,7 @@
 
 mod tia;
 
-pub use tia::{Tia, TiaParams};
+pub use tia::{min_pole_hz, pole_coefficient, Tia, TiaParams};
 
 mod noise;
 pub use noise::input_referred_noise_a_per_rthz;

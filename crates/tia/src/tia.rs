@@ -50,6 +50,47 @@ pub struct Tia<S> {
     fs_hz: f64,
 }
 
+/// The pole coefficient `a = exp(-2 pi pole / fs)` of the discretised one-pole, exactly as
+/// [`Tia::new`] builds it.
+pub fn pole_coefficient(pole_hz: f64, fs_hz: f64) -> f64 {
+    // The pole is a design value: std exp is fine (it does not feed the signal path except
+    // through this one constant).
+    (-core::f64::consts::TAU * pole_hz / fs_hz).exp()
+}
+
+/// The smallest pole, Hz, that [`Tia::new`] can realise at `fs_hz`: below it
+/// `2 pi pole / fs` is under about 2^-54 (half the spacing of doubles below 1), so
+/// [`pole_coefficient`] rounds to exactly 1 and the gain `(1 - a) G` is exactly 0 at every
+/// frequency. Found on [`pole_coefficient`] itself (bisection over the doubles), not from
+/// the estimate.
+pub fn min_pole_hz(fs_hz: f64) -> f64 {
+    let realised = |f: f64| pole_coefficient(f, fs_hz) < 1.0;
+    let guess = fs_hz * 2f64.powi(-54) / core::f64::consts::TAU;
+    let (lo, hi) = (guess / 4.0, guess * 4.0);
+    if !(fs_hz.is_finite() && fs_hz > 0.0) || realised(lo) || !realised(hi) {
+        return guess; // not reached for a valid rate (exp is monotone near 1)
+    }
+    // Positive doubles are ordered as their bits: bisect the bit patterns.
+    let (mut l, mut h) = (lo.to_bits(), hi.to_bits());
+    while h - l > 1 {
+        let m = l + (h - l) / 2;
+        if realised(f64::from_bits(m)) {
+            h = m;
+        } else {
+            l = m;
+        }
+    }
+    f64::from_bits(h)
+}
+
+/// The rule a pole below [`min_pole_hz`] breaks.
+fn min_pole_rule(fs_hz: f64) -> String {
+    format!(
+        "must be at least {:e} Hz at fs = {fs_hz} Hz: below it the discretised pole a = exp(-2 pi pole / fs) rounds to exactly 1 (2 pi pole / fs under about 2^-54, half the spacing of doubles below 1) and the TIA's gain (1 - a) x gain_ohm is exactly 0 at every frequency",
+        min_pole_hz(fs_hz)
+    )
+}
+
 impl<S: Sample> Tia<S> {
     /// Builds the TIA; every parameter is checked (stage `"tia"`).
     pub fn new(p: &TiaParams) -> ParamResult<Self> {
@@ -69,9 +110,11 @@ impl<S: Sample> Tia<S> {
                         ),
                     ));
                 }
-                // The pole is a design value: std exp is fine (it does not feed the signal
-                // path except through this one constant).
-                (-core::f64::consts::TAU * f / fs).exp()
+                let a = pole_coefficient(f, fs);
+                if a >= 1.0 {
+                    return Err(ParamError::new(STAGE, "pole_hz", f, min_pole_rule(fs)));
+                }
+                a
             }
         };
         let rail = match p.rail_v {
@@ -97,6 +140,14 @@ impl<S: Sample> Tia<S> {
 }
 
 impl Tia<f64> {
+    /// The standard deviation of the output for unit-variance white input samples (rails
+    /// ignored): `|G| sqrt((1 - a) / (1 + a))`, the root of `b^2 / (1 - a^2)`, exact for the
+    /// stage as built (`|G|` without a pole).
+    pub fn white_noise_gain(&self) -> f64 {
+        let a = self.a_f64;
+        self.g_f64.abs() * ((1.0 - a) / (1.0 + a)).sqrt()
+    }
+
     /// The continuous-time prototype `G / (1 + j f/pole)` (or `G` without a pole), for
     /// comparing the discretisation with the analogue circuit.
     pub fn continuous_response(&self, f_hz: f64) -> Complex64 {
@@ -251,5 +302,45 @@ mod tests {
             ..params()
         };
         assert!(Tia::<f64>::new(&no_pole).is_ok());
+    }
+
+    #[test]
+    fn the_smallest_pole_is_the_first_with_a_nonzero_gain() {
+        for fs in [240e3, 1e6, 3.0, 1e12] {
+            let min = min_pole_hz(fs);
+            let below = f64::from_bits(min.to_bits() - 1);
+            assert!(pole_coefficient(min, fs) < 1.0, "{fs}");
+            assert_eq!(pole_coefficient(below, fs), 1.0, "{fs}");
+            // About fs 2^-54 / (2 pi).
+            let est = fs * 2f64.powi(-54) / core::f64::consts::TAU;
+            assert!((min / est - 1.0).abs() < 1e-6, "{fs}: {min} vs {est}");
+            let at = |pole| TiaParams {
+                pole_hz: Some(pole),
+                fs_hz: fs,
+                ..params()
+            };
+            let t = Tia::<f64>::new(&at(min)).unwrap();
+            assert!(t.response(0.25 * fs).norm() > 0.0);
+            for pole in [below, 1e-120, 1e-300, f64::MIN_POSITIVE] {
+                let e = Tia::<f64>::new(&at(pole)).unwrap_err();
+                assert_eq!((e.stage, e.param), ("tia", "pole_hz"), "{e}");
+                assert!(e.rule.contains("exactly 0"), "{e}");
+            }
+        }
+    }
+
+    #[test]
+    fn white_noise_gain_is_the_output_deviation_of_unit_white_input() {
+        // sum of the squared impulse response b^2 a^(2n) = b^2 / (1 - a^2).
+        let t = Tia::<f64>::new(&params()).unwrap();
+        let a = pole_coefficient(1e4, 1e6);
+        let b = (1.0 - a) * 1e5;
+        let want = (b * b / (1.0 - a * a)).sqrt();
+        assert!((t.white_noise_gain() / want - 1.0).abs() < 1e-12);
+        let flat = TiaParams {
+            pole_hz: None,
+            ..params()
+        };
+        assert_eq!(Tia::<f64>::new(&flat).unwrap().white_noise_gain(), 1e5);
     }
 }
