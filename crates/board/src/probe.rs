@@ -34,25 +34,52 @@ pub const DUMP_NODES: [&str; 7] = [
     "stage2",
 ];
 
-const FULL_NODES: [(&str, [&str; 4]); 5] = [
-    ("drive", ["drive1", "drive2", "", ""]),
-    ("displacement", ["q1_m", "q2_m", "", ""]),
-    ("velocity", ["v1_m_s", "v2_m_s", "", ""]),
-    ("tia", ["tia1_v", "tia2_v", "", ""]),
-    ("stage1", ["mix1_i1", "mix1_q1", "mix1_i2", "mix1_q2"]),
+/// A node's channels in recording order, each with its unit.
+type Channels = &'static [(&'static str, &'static str)];
+
+/// The full-rate nodes (in `DUMP_NODES` order) and their channels with units, as
+/// docs/user-guide.md section 5.3 gives them: the dump's metadata takes each channel's unit
+/// from here (the drive and mixer names carry none to read it from).
+const FULL_NODES: [(&str, Channels); 5] = [
+    ("drive", &[("drive1", "m/s²"), ("drive2", "m/s²")]),
+    ("displacement", &[("q1_m", "m"), ("q2_m", "m")]),
+    ("velocity", &[("v1_m_s", "m/s"), ("v2_m_s", "m/s")]),
+    ("tia", &[("tia1_v", "V"), ("tia2_v", "V")]),
+    (
+        "stage1",
+        &[
+            ("mix1_i1", "V"),
+            ("mix1_q1", "V"),
+            ("mix1_i2", "V"),
+            ("mix1_q2", "V"),
+        ],
+    ),
 ];
 
-const DEC_NODES: [(&str, [&str; 8]); 2] = [
+/// The decimated nodes, as [`FULL_NODES`]; the modulation phasor is dimensionless.
+const DEC_NODES: [(&str, Channels); 2] = [
     (
         "lowpass",
-        [
-            "lp_i1", "lp_q1", "lp_i2", "lp_q2", "mod_cos", "mod_sin", "", "",
+        &[
+            ("lp_i1", "V"),
+            ("lp_q1", "V"),
+            ("lp_i2", "V"),
+            ("lp_q2", "V"),
+            ("mod_cos", ""),
+            ("mod_sin", ""),
         ],
     ),
     (
         "stage2",
-        [
-            "c1_i", "c1_q", "s1_i", "s1_q", "c2_i", "c2_q", "s2_i", "s2_q",
+        &[
+            ("c1_i", "V"),
+            ("c1_q", "V"),
+            ("s1_i", "V"),
+            ("s1_q", "V"),
+            ("c2_i", "V"),
+            ("c2_q", "V"),
+            ("s2_i", "V"),
+            ("s2_q", "V"),
         ],
     ),
 ];
@@ -71,22 +98,18 @@ impl Probe {
         for (i, name) in DUMP_NODES.iter().enumerate() {
             on[i] = nodes.iter().any(|n| n == name);
         }
-        let names = |table: &[(&str, &[&str])], offset: usize| -> Vec<String> {
+        // The channels of the nodes asked for, and their units.
+        let channels = |table: &[(&str, Channels)], offset: usize| -> (Vec<String>, Vec<&str>) {
             table
                 .iter()
                 .enumerate()
                 .filter(|(i, _)| on[offset + i])
-                .flat_map(|(_, (_, chans))| {
-                    chans
-                        .iter()
-                        .filter(|c| !c.is_empty())
-                        .map(|c| c.to_string())
-                })
-                .collect()
+                .flat_map(|(_, (_, chans))| chans.iter())
+                .map(|&(name, unit)| (name.to_string(), unit))
+                .unzip()
         };
-        let full_table: Vec<(&str, &[&str])> =
-            FULL_NODES.iter().map(|(n, c)| (*n, &c[..])).collect();
-        let dec_table: Vec<(&str, &[&str])> = DEC_NODES.iter().map(|(n, c)| (*n, &c[..])).collect();
+        let (full_names, full_units) = channels(&FULL_NODES, 0);
+        let (dec_names, dec_units) = channels(&DEC_NODES, FULL_NODES.len());
         let fs_out = fs_hz / decimation as f64;
         let start = (start_s * fs_hz).round() as u64;
         let len = (duration_s * fs_hz).round().max(1.0) as u64;
@@ -95,9 +118,10 @@ impl Probe {
         Self {
             lane,
             nodes: on,
-            full: SignalRecorder::new(names(&full_table, 0), fs_hz, start, len),
+            full: SignalRecorder::new(full_names, fs_hz, start, len).with_units(&full_units),
             // Decimated sample k is formed at input sample kM + M - 1.
-            decimated: SignalRecorder::new(names(&dec_table, 5), fs_out, start_out, len_out)
+            decimated: SignalRecorder::new(dec_names, fs_out, start_out, len_out)
+                .with_units(&dec_units)
                 .with_time_origin((decimation - 1) as f64 / fs_hz),
             check_lanes: 0,
             fault: None,
@@ -111,9 +135,12 @@ impl Probe {
         let fs_out = self.decimated.fs_hz();
         let start = self.decimated.start();
         let names = self.decimated.names().to_vec();
+        let units = self.decimated.units().to_vec();
         let t0 = self.decimated.t0_s();
         let len = (duration_s * fs_out).round().max(1.0) as u64;
-        self.decimated = SignalRecorder::new(names, fs_out, start, len).with_time_origin(t0);
+        self.decimated = SignalRecorder::new(names, fs_out, start, len)
+            .with_units(&units)
+            .with_time_origin(t0);
         self
     }
 
@@ -285,23 +312,32 @@ impl Probe {
         fs_hz: f64,
         decimation: usize,
     ) -> Vec<(&'static str, String)> {
-        let count = |table: &[(&str, &[&str])]| -> u64 {
+        let count = |table: &[(&str, Channels)]| -> u64 {
             table
                 .iter()
                 .filter(|(n, _)| nodes.iter().any(|m| m == n))
-                .map(|(_, c)| c.iter().filter(|c| !c.is_empty()).count() as u64)
+                .map(|(_, c)| c.len() as u64)
                 .sum()
         };
-        let full: Vec<(&str, &[&str])> = FULL_NODES.iter().map(|(n, c)| (*n, &c[..])).collect();
-        let dec: Vec<(&str, &[&str])> = DEC_NODES.iter().map(|(n, c)| (*n, &c[..])).collect();
         [
-            ("full-rate", fs_hz, count(&full)),
-            ("decimated", fs_hz / decimation as f64, count(&dec)),
+            ("full-rate", fs_hz, count(&FULL_NODES)),
+            ("decimated", fs_hz / decimation as f64, count(&DEC_NODES)),
         ]
         .into_iter()
         .filter(|&(_, _, ch)| ch > 0)
         .filter_map(|(what, fs, ch)| Some((what, gyroemu_io::wav_f32_rate_problem(fs, ch)?)))
         .collect()
+    }
+
+    /// The unit of a dump channel of the board (`""`: dimensionless), `None` for a name no
+    /// node records.
+    pub fn channel_unit(name: &str) -> Option<&'static str> {
+        FULL_NODES
+            .iter()
+            .chain(&DEC_NODES)
+            .flat_map(|(_, chans)| chans.iter())
+            .find(|(n, _)| *n == name)
+            .map(|&(_, unit)| unit)
     }
 
     /// The names of every file [`Probe::write`] may write for `stem` (to clear a folder of
@@ -324,5 +360,25 @@ impl Probe {
             files.extend(self.decimated.write(dir, &format!("{stem}_decimated"))?);
         }
         Ok(files)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_channel_tables_follow_the_node_order_and_give_every_channel_its_unit() {
+        // `Probe::new` switches the tables' nodes on by their position in DUMP_NODES.
+        let order: Vec<&str> = FULL_NODES
+            .iter()
+            .chain(&DEC_NODES)
+            .map(|(n, _)| *n)
+            .collect();
+        assert_eq!(order, DUMP_NODES);
+        assert_eq!(Probe::channel_unit("drive2"), Some("m/s²"));
+        assert_eq!(Probe::channel_unit("mix1_q2"), Some("V"));
+        assert_eq!(Probe::channel_unit("mod_sin"), Some(""));
+        assert_eq!(Probe::channel_unit("time_s"), None);
     }
 }

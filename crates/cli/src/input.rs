@@ -80,11 +80,51 @@ pub fn command_line() -> String {
         .join(" ")
 }
 
+/// Per-item files a command saved in one folder of its output (a sweep's points, a lot's
+/// devices): listed as the folder and their count, since there may be thousands.
+#[derive(Clone, Copy, Debug)]
+pub struct ItemFiles<'a> {
+    /// The folder, relative to the output folder (`points`).
+    pub dir: &'a str,
+    /// What each file holds (`point`).
+    pub item: &'a str,
+    /// How many this command wrote.
+    pub count: usize,
+}
+
 /// Lists the files a command wrote, one per line on stderr, relative to `out` where inside it.
 pub fn list_written(out: &Path, files: &[std::path::PathBuf]) {
-    note!("wrote {} files in `{}`:", files.len(), out.display());
+    list_written_with(out, files, None);
+}
+
+/// [`list_written`], then the per-item files `items` as one line: `points/ (3 point files)`.
+pub fn list_written_with(out: &Path, files: &[std::path::PathBuf], items: Option<ItemFiles>) {
+    let items = items.filter(|i| i.count > 0);
+    let total = files.len() + items.map_or(0, |i| i.count);
+    note!("wrote {total} files in `{}`:", out.display());
     for f in files {
         let shown = f.strip_prefix(out).unwrap_or(f);
         note!("  {}", shown.display());
+    }
+    if let Some(i) = items {
+        let s = if i.count == 1 { "" } else { "s" };
+        note!("  {}/ ({} {} file{s})", i.dir, i.count, i.item);
+    }
+}
+
+/// Counts the items a run saves, from its `on_saved` reports (each the running total, which
+/// parallel groups may report out of order).
+#[derive(Debug, Default)]
+pub struct SavedCount(std::sync::atomic::AtomicUsize);
+
+impl SavedCount {
+    /// Records a report of `k` items saved so far.
+    pub fn saved(&self, k: usize) {
+        self.0.fetch_max(k, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// The items saved.
+    pub fn get(&self) -> usize {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
     }
 }

@@ -73,6 +73,10 @@ fn shards_by_flag_and_by_kubernetes_index_merge_to_the_one_machine_lot() {
         out.contains("lot of 6 devices") && out.contains("yield within"),
         "{out}"
     );
+    // Every file written is listed, the device files as `devices/ (6 device files)`.
+    let (files, devices) = written_list(&o);
+    assert_eq!((files, devices.clone()), files_on_disk(&one));
+    assert_eq!(devices["devices"], 6);
     let split = dir.path().join("split");
     for i in 0..2 {
         let sh = format!("{i}/3");
@@ -84,6 +88,12 @@ fn shards_by_flag_and_by_kubernetes_index_merge_to_the_one_machine_lot() {
             &[],
         ));
         assert!(stderr(&o).contains("gyroemu merge"), "{}", stderr(&o));
+        let (files, devices) = written_list(&o);
+        assert!(files.contains(&format!("shard-{i}-of-3.json")), "{files:?}");
+        assert_eq!(devices["devices"], 2, "{}", stderr(&o));
+        if i == 0 {
+            assert_eq!((files, devices), files_on_disk(&split));
+        }
     }
     let env = [("JOB_COMPLETION_INDEX", "2"), ("GYROEMU_SHARD_COUNT", "3")];
     ok(lot(&cfg, &split, "1", &["--devices", "6"], &env));

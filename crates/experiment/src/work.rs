@@ -38,11 +38,16 @@ impl Work {
         }
     }
 
-    /// One line for the user: the plan and, given a throughput on every thread, the time it
+    /// One line for the user: `plan: ` and the [`summary`](Self::summary).
+    pub fn describe(&self, point_samples_per_s: Option<f64>) -> String {
+        format!("plan: {}", self.summary(point_samples_per_s))
+    }
+
+    /// The points, their point-samples and, given a throughput on every thread, the time it
     /// should take: the point-samples at that throughput, or, when longer, the longest point's
     /// lane group alone on one thread (a point's samples run in sequence, so more threads do
     /// not shorten it).
-    pub fn describe(&self, point_samples_per_s: Option<f64>) -> String {
+    pub fn summary(&self, point_samples_per_s: Option<f64>) -> String {
         let time = point_samples_per_s.map_or(String::new(), |r| {
             let lanes = gyroemu_board::max_lanes();
             let even = self.point_samples as f64 / r;
@@ -60,8 +65,11 @@ impl Work {
             )
         });
         format!(
-            "plan: {} operating points, {:.3e} point-samples (longest point {:.4} s of signal){time}",
-            self.points, self.point_samples as f64, self.longest_s
+            "{} operating point{}, {:.3e} point-samples (longest point {:.4} s of signal){time}",
+            self.points,
+            if self.points == 1 { "" } else { "s" },
+            self.point_samples as f64,
+            self.longest_s
         )
     }
 
@@ -88,9 +96,18 @@ impl Work {
 
 /// The work of `cfg`'s sweep.
 pub fn sweep_work(cfg: &Config) -> Work {
-    let points: Vec<Point> = cfg
-        .emulated_rates_dps()
+    let n = cfg.emulated_rates_dps().len();
+    points_work(cfg, &(0..n).collect::<Vec<_>>())
+}
+
+/// The work of the points `indices` of `cfg`'s sweep (a shard's, or those a resumed run has
+/// left to run), grouped as [`sweep_work`] groups the whole sweep. Indices past the sweep are
+/// ignored.
+pub fn points_work(cfg: &Config, indices: &[usize]) -> Work {
+    let rates = cfg.emulated_rates_dps();
+    let points: Vec<Point> = indices
         .iter()
+        .filter_map(|&i| rates.get(i))
         .map(|&r| cfg.plan_point(r))
         .collect();
     let (_, point_samples) = canonical_work(cfg, &points);

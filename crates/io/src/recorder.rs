@@ -16,6 +16,8 @@ use std::path::{Path, PathBuf};
 #[derive(Clone, Debug)]
 pub struct SignalRecorder {
     names: Vec<String>,
+    /// Unit of each channel, written into the SigMF metadata.
+    units: Vec<String>,
     fs_hz: f64,
     /// Time of sample index 0, s (a decimated stream's sample k stands for a later input).
     t0_s: f64,
@@ -39,8 +41,13 @@ impl SignalRecorder {
             .ok()
             .and_then(|l| l.checked_mul(names.len()))
             .expect("SignalRecorder window len_samples * channels overflows usize");
+        let units = names
+            .iter()
+            .map(|n| unit_from_name(n).to_string())
+            .collect();
         SignalRecorder {
             names,
+            units,
             fs_hz,
             t0_s: 0.0,
             start: start_sample,
@@ -55,6 +62,18 @@ impl SignalRecorder {
     /// (M - 1)/fs_in.
     pub fn with_time_origin(mut self, t0_s: f64) -> Self {
         self.t0_s = t0_s;
+        self
+    }
+
+    /// Sets each channel's unit (in `names` order), for channels whose name carries none by the
+    /// suffix rule (the board's drive and mixer outputs). Panics if the counts differ.
+    pub fn with_units<S: AsRef<str>>(mut self, units: &[S]) -> Self {
+        assert_eq!(
+            units.len(),
+            self.names.len(),
+            "SignalRecorder::with_units needs one unit per channel"
+        );
+        self.units = units.iter().map(|u| u.as_ref().to_string()).collect();
         self
     }
 
@@ -118,6 +137,11 @@ impl SignalRecorder {
         &self.names
     }
 
+    /// Channel units in column order (see [`with_units`](Self::with_units)).
+    pub fn units(&self) -> &[String] {
+        &self.units
+    }
+
     /// Number of frames held (highest recorded index - start + 1).
     pub fn len(&self) -> usize {
         if self.names.is_empty() {
@@ -153,8 +177,9 @@ impl SignalRecorder {
     ///   `scipy.io.wavfile.read(path)`, not an audio player;
     /// - `<dir>/<stem>.sigmf-data` + `<dir>/<stem>.sigmf-meta` (SigMF 1.2.0, `rf64_le`, full
     ///   f64 precision at the exact fs_hz; capture `core:global_index` = first sample index,
-    ///   `gyroemu:t0_s` = time origin, `gyroemu:channels` = names with units read from their
-    ///   suffixes): `np.fromfile(path, dtype="<f8").reshape(-1, n_channels)`.
+    ///   `gyroemu:t0_s` = time origin, `gyroemu:channels` = names with their units: those of
+    ///   [`with_units`](Self::with_units), else read from the names' suffixes):
+    ///   `np.fromfile(path, dtype="<f8").reshape(-1, n_channels)`.
     ///
     /// The WAV size and the SigMF request are checked before any file is written. Returns the
     /// paths written (CSV, WAV when written, SigMF data, SigMF meta).
@@ -236,9 +261,10 @@ impl SignalRecorder {
             channels: self
                 .names
                 .iter()
-                .map(|n| SigmfChannel {
+                .zip(&self.units)
+                .map(|(n, u)| SigmfChannel {
                     name: n.clone(),
-                    unit: unit_from_name(n).to_string(),
+                    unit: u.clone(),
                 })
                 .collect(),
             description: format!(

@@ -269,6 +269,31 @@ fn recorder_writes_sigmf_beside_csv_and_wav() {
 }
 
 #[test]
+fn recorder_units_given_for_unsuffixed_names_reach_the_sigmf_meta() {
+    // A drive's name carries no unit to read: the caller gives it, and the meta keeps it.
+    let dir = tempfile::tempdir().unwrap();
+    let mut r = SignalRecorder::new(vec!["drive1".into(), "tia1_v".into()], 1000.0, 0, 4)
+        .with_units(&["m/s²", "V"]);
+    for n in 0..4 {
+        r.record(n, &[1.0, 2.0]);
+    }
+    assert_eq!(r.units(), ["m/s²", "V"]);
+    r.write(dir.path(), "d").unwrap();
+    let m = read_meta(&dir.path().join("d.sigmf-meta"));
+    let units: Vec<&str> = m["global"]["gyroemu:channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["unit"].as_str().unwrap())
+        .collect();
+    assert_eq!(units, ["m/s²", "V"]);
+    // The reader gives them back.
+    let d = gyroemu_io::read_sigmf(&dir.path().join("d.sigmf-meta")).unwrap();
+    let read: Vec<&str> = d.channels.iter().map(|c| c.unit.as_str()).collect();
+    assert_eq!(read, ["m/s²", "V"]);
+}
+
+#[test]
 fn recorder_with_no_channels_fails_before_writing() {
     let dir = tempfile::tempdir().unwrap();
     let r = SignalRecorder::new(vec![], 1000.0, 0, 10);

@@ -23,7 +23,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
-/// How a lot ended.
+/// How a lot ended. The device files saved are not in its lists (a lot may have thousands):
+/// [`RunRequest::on_saved`] counts them.
 #[derive(Clone, Debug, PartialEq)]
 pub enum LotOutcome {
     /// The whole lot is done; these files were written, and these are its figures.
@@ -35,6 +36,8 @@ pub enum LotOutcome {
     ShardComplete {
         /// What to do when every shard is complete.
         next: String,
+        /// The files written: the shard's manifest.
+        files: Vec<PathBuf>,
     },
 }
 
@@ -198,7 +201,8 @@ pub fn run_lot(
     }
     if req.shard.is_some() {
         let next = ledger.shard_complete(&done, out)?;
-        return Ok(LotOutcome::ShardComplete { next });
+        let files = vec![ledger.path().to_path_buf()];
+        return Ok(LotOutcome::ShardComplete { next, files });
     }
     let devices: Vec<DeviceResult> = done.values().cloned().collect();
     let (mut files, summary) =

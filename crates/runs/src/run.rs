@@ -13,7 +13,7 @@ use crate::resume::previous_points;
 use crate::shard::{check_split, manifest_path, Shard};
 use gyroemu_board::LaneResult;
 use gyroemu_config::Config;
-use gyroemu_experiment::work::measured_throughput;
+use gyroemu_experiment::work::{measured_throughput, points_work};
 use gyroemu_experiment::{
     dump_point, finish_sweep, resolve_lock, run_sweep_with, sweep_work, CarrierLock, Reporter,
     SweepOptions, Work,
@@ -43,7 +43,8 @@ pub struct RunRequest<'a> {
     pub on_saved: Option<&'a (dyn Fn(usize) + Sync)>,
 }
 
-/// How a run ended.
+/// How a run ended. The point files saved are not in its lists (a sweep may have thousands):
+/// [`RunRequest::on_saved`] counts them.
 #[derive(Clone, Debug, PartialEq)]
 pub enum RunOutcome {
     /// The whole sweep is done; these files were written.
@@ -52,6 +53,8 @@ pub enum RunOutcome {
     ShardComplete {
         /// What to do when every shard is complete.
         next: String,
+        /// The files written: the dump's when this shard recorded it, and its manifest.
+        files: Vec<PathBuf>,
     },
 }
 
@@ -131,13 +134,10 @@ pub fn check_run(
     if let Some(s) = shard {
         s.check_count(n, "point")?;
     }
-    let mine = shard.map_or(n, |s| s.points(n).len());
     // Refuse an absurd run unless forced.
-    let whole = sweep_work(cfg);
-    let share = Work {
-        points: mine,
-        point_samples: (whole.point_samples as f64 * mine as f64 / n as f64) as u64,
-        ..whole
+    let share = match shard {
+        Some(s) => points_work(cfg, &s.points(n)),
+        None => sweep_work(cfg),
     };
     share.check_cap(force).map_err(RunError::BadInput)?;
     let warning = check_split(out, shard, RunKind::Run, &config_hash(cfg), "point")?;
@@ -156,7 +156,8 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     let mine = Shard::items(req.shard.as_ref(), n);
     // Say what this will cost before anything runs.
     let (share, split_warning) = check_run(cfg, out, req.shard.as_ref(), req.force)?;
-    reporter.note(&share.describe(Some(measured_throughput(cfg))));
+    let throughput = measured_throughput(cfg);
+    reporter.note(&share.describe(Some(throughput)));
     if let Some(w) = split_warning {
         reporter.warn(&w);
     }
@@ -173,7 +174,12 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         &mut prev,
         reporter,
     )?;
-    let reused = mine.iter().filter(|i| prev.contains_key(i)).count();
+    let todo: Vec<usize> = mine
+        .iter()
+        .copied()
+        .filter(|i| !prev.contains_key(i))
+        .collect();
+    let reused = mine.len() - todo.len();
     let what = Shard::describe(req.shard.as_ref(), n, "point");
     let points_dir = out.join(POINTS_DIR);
     reporter.note(&if reused == mine.len() {
@@ -183,9 +189,11 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
             points_dir.display()
         )
     } else if reused > 0 {
+        // The plan above is the whole share; say what is left of it.
         format!(
-            "{what}: resuming, {reused} already computed for this config in `{}`",
-            points_dir.display()
+            "{what}: resuming, {reused} already computed for this config in `{}`; left to run: {}",
+            points_dir.display(),
+            points_work(cfg, &todo).summary(Some(throughput))
         )
     } else {
         what
@@ -248,7 +256,9 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     }
     if req.shard.is_some() {
         let next = ledger.shard_complete(&swept.lanes, out)?;
-        return Ok(RunOutcome::ShardComplete { next });
+        let mut files = swept.dump_files.clone();
+        files.push(ledger.path().to_path_buf());
+        return Ok(RunOutcome::ShardComplete { next, files });
     }
     let written = finish_sweep(&held, &swept.lanes)
         .map_err(RunError::from)

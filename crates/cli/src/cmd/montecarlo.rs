@@ -2,12 +2,15 @@
 //! `--print-device I` (one device's config, for `gyroemu selfcal`).
 
 use crate::cmd::out_args::OutArgs;
-use crate::input::{list_written, print_out, read_config, refused, BadInput};
+use crate::input::{
+    list_written_with, print_out, read_config, refused, BadInput, ItemFiles, SavedCount,
+};
 use crate::progress::Terminal;
 use anyhow::Result;
 use gyroemu_analysis::montecarlo::{
     device_config, draw_device, validate_lot, validate_lot_capped, LotRefusal, LotSummary,
 };
+use gyroemu_runs::device_file::DEVICES_DIR;
 use gyroemu_runs::shard::Shard;
 use gyroemu_runs::{check_lot, run_lot, LotOutcome, RunRequest};
 use std::path::Path;
@@ -62,21 +65,33 @@ pub fn montecarlo_command(a: &MonteCarloArgs) -> Result<()> {
         note!("warning: {}: {w}", a.config.display());
     }
     let (cancel, _lock) = a.out.open(shard.as_ref())?;
+    let saved = SavedCount::default();
+    let on_saved = |k: usize| saved.saved(k);
     let req = RunRequest {
         config: &cfg,
         out: &a.out.out,
         shard,
         force: a.out.force,
         cancel,
-        on_saved: None,
+        on_saved: Some(&on_saved),
     };
-    match run_lot(&req, n, &Terminal)? {
+    let outcome = run_lot(&req, n, &Terminal)?;
+    let devices = ItemFiles {
+        dir: DEVICES_DIR,
+        item: "device",
+        count: saved.get(),
+    };
+    let files = match outcome {
         LotOutcome::Complete { files, summary } => {
             print_out(&summary_text(&summary))?;
-            list_written(&a.out.out, &files);
+            files
         }
-        LotOutcome::ShardComplete { next } => note!("shard complete; {next}"),
-    }
+        LotOutcome::ShardComplete { next, files } => {
+            note!("shard complete; {next}");
+            files
+        }
+    };
+    list_written_with(&a.out.out, &files, Some(devices));
     Ok(())
 }
 

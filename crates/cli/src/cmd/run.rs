@@ -1,9 +1,10 @@
 //! `gyroemu run CONFIG --out DIR [--shard I/N] [--force]`.
 
 use crate::cmd::out_args::OutArgs;
-use crate::input::{list_written, load_config};
+use crate::input::{list_written_with, load_config, ItemFiles, SavedCount};
 use crate::progress::Terminal;
 use anyhow::Result;
+use gyroemu_runs::points::POINTS_DIR;
 use gyroemu_runs::{check_run, run, RunOutcome, RunRequest};
 use std::path::Path;
 
@@ -15,17 +16,29 @@ pub fn run_command(config: &Path, a: &OutArgs) -> Result<()> {
     // so a refused run leaves no folder behind.
     check_run(&cfg, &a.out, shard.as_ref(), a.force)?;
     let (cancel, _lock) = a.open(shard.as_ref())?;
+    let saved = SavedCount::default();
+    let on_saved = |k: usize| saved.saved(k);
     let req = RunRequest {
         config: &cfg,
         out: &a.out,
         shard,
         force: a.force,
         cancel,
-        on_saved: None,
+        on_saved: Some(&on_saved),
     };
-    match run(&req, &Terminal)? {
-        RunOutcome::Complete(files) => list_written(&a.out, &files),
-        RunOutcome::ShardComplete { next } => note!("shard complete; {next}"),
-    }
+    let outcome = run(&req, &Terminal)?;
+    let points = ItemFiles {
+        dir: POINTS_DIR,
+        item: "point",
+        count: saved.get(),
+    };
+    let files = match outcome {
+        RunOutcome::Complete(files) => files,
+        RunOutcome::ShardComplete { next, files } => {
+            note!("shard complete; {next}");
+            files
+        }
+    };
+    list_written_with(&a.out, &files, Some(points));
     Ok(())
 }

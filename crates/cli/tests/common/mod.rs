@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 use serde_json::Value;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -115,3 +116,55 @@ effective_mass_kg = 1e-9
 tia_current_noise_a_per_rthz = 1e-13
 tia_voltage_noise_v_per_rthz = 2e-8
 "#;
+
+/// What a command's closing `wrote N files in ...` list names: the files, and the per-item
+/// folders it summarises as `points/ (3 point files)` with their counts. Checks that N is
+/// their total.
+pub fn written_list(o: &Output) -> (BTreeSet<String>, BTreeMap<String, usize>) {
+    let err = stderr(o);
+    let lines: Vec<&str> = err.lines().collect();
+    let head = lines
+        .iter()
+        .rposition(|l| l.starts_with("wrote "))
+        .unwrap_or_else(|| panic!("no `wrote` list:\n{err}"));
+    let total: usize = lines[head]["wrote ".len()..]
+        .split(' ')
+        .next()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{}", lines[head]));
+    let (mut files, mut folders) = (BTreeSet::new(), BTreeMap::new());
+    for l in lines[head + 1..].iter().take_while(|l| l.starts_with("  ")) {
+        let entry = l.trim();
+        match entry.split_once("/ (") {
+            Some((dir, rest)) => {
+                let n = rest.split(' ').next().unwrap().parse().unwrap();
+                folders.insert(dir.to_string(), n);
+            }
+            None => {
+                files.insert(entry.to_string());
+            }
+        }
+    }
+    assert_eq!(
+        total,
+        files.len() + folders.values().sum::<usize>(),
+        "{err}"
+    );
+    (files, folders)
+}
+
+/// The files in `out` and, for each folder in it, how many files it holds: what
+/// [`written_list`] returns for a command that wrote all of them.
+pub fn files_on_disk(out: &Path) -> (BTreeSet<String>, BTreeMap<String, usize>) {
+    let (mut files, mut folders) = (BTreeSet::new(), BTreeMap::new());
+    for e in std::fs::read_dir(out).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        if p.is_dir() {
+            folders.insert(name, std::fs::read_dir(&p).unwrap().count());
+        } else {
+            files.insert(name);
+        }
+    }
+    (files, folders)
+}
