@@ -1,6 +1,7 @@
 //! A dump as the figures see it: the full-rate and decimated recordings of one run (either
 //! may be missing), read back from disk, and the node each channel belongs to.
 
+use gyroemu_board::Probe;
 use gyroemu_io::{read_dump, Dump, IoError};
 use std::path::{Path, PathBuf};
 
@@ -100,15 +101,21 @@ pub fn read_dump_set(path: &Path) -> Result<DumpSet, IoError> {
     })
 }
 
-/// One node of the board as the figures group it: a title, the channel names it holds (in
-/// order) and the unit of its samples.
+/// One node of the board as the figures group it: a title and the channel names it holds
+/// (in order).
 pub struct Node {
     /// Panel title.
     pub title: &'static str,
     /// Channel names.
     pub channels: &'static [&'static str],
-    /// Unit of the samples (`m/s²` for the drive, whose names carry none).
-    pub unit: &'static str,
+}
+
+impl Node {
+    /// The unit of the node's samples: the probe's, which writes it into every recording
+    /// (one table, so a figure and a recording cannot disagree).
+    pub fn unit(&self) -> &'static str {
+        Probe::channel_unit(self.channels[0]).unwrap_or("")
+    }
 }
 
 /// The board's nodes, in signal order (docs/user-guide.md section 5.3).
@@ -116,57 +123,46 @@ pub const NODES: [Node; 8] = [
     Node {
         title: "Drive (DAC output)",
         channels: &["drive1", "drive2"],
-        unit: "m/s²",
     },
     Node {
         title: "Displacement",
         channels: &["q1_m", "q2_m"],
-        unit: "m",
     },
     Node {
         title: "Velocity",
         channels: &["v1_m_s", "v2_m_s"],
-        unit: "m/s",
     },
     Node {
         title: "TIA output",
         channels: &["tia1_v", "tia2_v"],
-        unit: "V",
     },
     Node {
         title: "Stage-1 mixer I/Q (before the low-pass)",
         channels: &["mix1_i1", "mix1_q1", "mix1_i2", "mix1_q2"],
-        unit: "V",
     },
     Node {
         title: "Low-pass output (decimated)",
         channels: &["lp_i1", "lp_q1", "lp_i2", "lp_q2"],
-        unit: "V",
     },
     Node {
         title: "Modulation phasor cos, sin Ωt",
         channels: &["mod_cos", "mod_sin"],
-        unit: "",
     },
     Node {
         title: "Stage-2 products",
         channels: &[
             "c1_i", "c1_q", "s1_i", "s1_q", "c2_i", "c2_q", "s2_i", "s2_q",
         ],
-        unit: "V",
     },
 ];
 
-/// The unit of a channel: the recording's, or for a board node whose name carries none (the
-/// drive, the mixer and low-pass I/Q) the node's.
+/// The unit of a channel: the recording's, or the probe's for a board channel (a CSV dump
+/// records none).
 pub fn channel_unit<'a>(name: &str, recorded: &'a str) -> &'a str {
     if !recorded.is_empty() {
         return recorded;
     }
-    NODES
-        .iter()
-        .find(|n| n.channels.contains(&name))
-        .map_or(recorded, |n| n.unit)
+    Probe::channel_unit(name).unwrap_or(recorded)
 }
 
 /// A panel's title, its unit and its channels `(name, samples)`.
@@ -188,7 +184,7 @@ pub fn groups(d: &Dump) -> Vec<Group<'_>> {
             })
             .collect();
         if !chans.is_empty() {
-            out.push((node.title.to_string(), node.unit.to_string(), chans));
+            out.push((node.title.to_string(), node.unit().to_string(), chans));
         }
     }
     for (k, c) in d.channels.iter().enumerate().filter(|(k, _)| !used[*k]) {
@@ -199,4 +195,25 @@ pub fn groups(d: &Dump) -> Vec<Group<'_>> {
         ));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_node_of_the_figures_is_a_probe_channel_with_one_unit() {
+        for n in &NODES {
+            let units: Vec<Option<&str>> =
+                n.channels.iter().map(|c| Probe::channel_unit(c)).collect();
+            assert!(units.iter().all(|u| u.is_some()), "{}: {units:?}", n.title);
+            assert!(
+                units.windows(2).all(|w| w[0] == w[1]),
+                "{}: {units:?}",
+                n.title
+            );
+        }
+        assert_eq!(NODES[0].unit(), "m/s²");
+        assert_eq!(NODES[6].unit(), "");
+    }
 }
