@@ -114,7 +114,7 @@ pub(crate) fn read_split(dir: &Path) -> Result<Split, RunError> {
         // dump: shards of different dumps would leave files the merged manifest misdescribes.
         if dump_table(&m.config_toml) != dump_table(&first.config_toml) {
             return Err(bad(format!(
-                "`{name}` and `{first_name}` ran the same sweep with different [dump] sections:                  the folder holds one dump, so rerun the shards with one [dump] (a rerun only                  recomputes the dumped point)"
+                "`{name}` and `{first_name}` ran the same sweep with different [dump] sections: the folder holds one dump, so rerun the shards with one [dump] (a rerun only recomputes the dumped point)"
             )));
         }
     }

@@ -361,6 +361,8 @@ fn merge_refuses_shards_of_different_dumps() {
     assert!(run_shard(&with_dump(50.0), &out, shard(1)).0.is_ok());
     let why = merge_refusal(&out);
     assert!(why.contains("different [dump] sections"), "{why}");
+    // One sentence, not a source line's indentation carried into it.
+    assert!(!why.contains("  "), "{why}");
     // One [dump] for both: the merge goes through.
     assert!(run_shard(&with_dump(25.0), &out, shard(1)).0.is_ok());
     merge(&out, &Quiet).unwrap();
