@@ -1,7 +1,11 @@
 //! Overlapping Allan deviation of a sampled rate (or phase-rate) series, and the two readings
 //! gyro engineers take from it (IEEE Std 952): the angle random walk from the -1/2 slope and
-//! the bias instability from the flat floor.
+//! the bias instability from the flat floor; beside them, the fit of the noise model to the
+//! same points ([`fit`]).
 
+pub mod fit;
+
+use fit::{fit_noise_model, NoiseModelFit};
 use gyroemu_core::flicker::ADEV_PER_BIAS_INSTABILITY;
 use serde::Serialize;
 
@@ -125,6 +129,11 @@ pub struct NoiseReadings {
     /// Why the bias instability is absent, only a bound, or unreliable (`None` when it is the
     /// flat floor of reliable points).
     pub bias_instability_warning: Option<&'static str>,
+    /// The noise-model fit (IEEE Std 952 Annex C) over the same reliable points: N, B and K
+    /// with 95 % intervals, read even where no -1/2 region shows. `selfcal.json` writes it
+    /// beside the readings, as `allan.model_fit`, so `allan.readings` keeps its keys.
+    #[serde(skip)]
+    pub model_fit: NoiseModelFit,
 }
 
 /// Reads ARW and bias instability from an Allan deviation curve of a rate in deg/s (as
@@ -160,6 +169,9 @@ pub fn noise_readings(curve: &[AllanPoint]) -> Option<NoiseReadings> {
 /// `still_falling`), when no point rests on 40
 /// independent differences (then all points past the rise count), or when, with no settling
 /// time given, the minimum lies within half a decade of the curve's first point.
+///
+/// The noise-model fit ([`fit_noise_model`]) takes the same points, past the rise and on 40
+/// independent differences or more; it is not made when none of them is.
 pub fn noise_readings_settled(curve: &[AllanPoint], settled_tau_s: f64) -> Option<NoiseReadings> {
     if curve.len() < 2 {
         return None;
@@ -290,6 +302,17 @@ pub fn noise_readings_settled(curve: &[AllanPoint], settled_tau_s: f64) -> Optio
                 (floor / ADEV_PER_BIAS_INSTABILITY * 3600.0, tau_min, warning)
             }
         };
+    let model_fit = match (any_reliable, start < end) {
+        (false, _) => NoiseModelFit::not_fitted(
+            "no point of the Allan curve rests on 40 independent differences: the record is \
+             too short to fit the noise model",
+        ),
+        (true, false) => NoiseModelFit::not_fitted(
+            "the Allan curve rises over all its reliable points (40 independent differences \
+             or more): nothing past its initial rise to fit the noise model to",
+        ),
+        (true, true) => fit_noise_model(&curve[start..end], tau0, start > 0),
+    };
     Some(NoiseReadings {
         arw_deg_per_rt_h,
         arw_tau_s,
@@ -297,6 +320,7 @@ pub fn noise_readings_settled(curve: &[AllanPoint], settled_tau_s: f64) -> Optio
         bias_instability_deg_per_h,
         tau_at_min_s,
         bias_instability_warning,
+        model_fit,
     })
 }
 

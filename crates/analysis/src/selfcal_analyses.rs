@@ -52,6 +52,14 @@ impl AllanResult {
                 "Allan deviation: angle random walk not read: {why}"
             ));
         }
+        // Beside the refusal, the noise-model fit's number and its method.
+        if r.arw_deg_per_rt_h.is_nan() && r.model_fit.arw_deg_per_rt_h.is_finite() {
+            if let Some(s) = r.model_fit.summary() {
+                w.push(format!(
+                    "Allan deviation: the noise-model fit (IEEE Std 952 Annex C, allan.model_fit) reads {s}"
+                ));
+            }
+        }
         if let Some(why) = r.bias_instability_warning {
             w.push(format!("Allan deviation: bias instability: {why}"));
         }

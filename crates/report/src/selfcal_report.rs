@@ -3,6 +3,7 @@
 
 use crate::error::ReportError;
 use crate::sweep_report::{health_json, with_config_warnings};
+use gyroemu_analysis::allan::fit::{sig3, NoiseModelFit};
 use gyroemu_analysis::allan::AllanPoint;
 use gyroemu_analysis::selfcal::SelfcalCore;
 use gyroemu_analysis::selfcal_analyses::{AllanResult, DriftCase, DriftPoint, TauPoint};
@@ -108,7 +109,7 @@ fn write_selfcal_files(
         },
         "problems": core.rotating.problems.iter().chain(&core.coriolis.problems).collect::<Vec<_>>(),
         "warnings": with_config_warnings(cfg.validate(), &core.rotating.warnings.iter().cloned().chain(core.coriolis.warnings.iter().cloned()).chain(allan.iter().flat_map(|a| a.warnings())).collect::<Vec<_>>()),
-        "allan": allan,
+        "allan": allan.map(allan_json),
         "error_vs_averaging_time": taus,
         "drift": drift,
         "config": cfg,
@@ -283,6 +284,29 @@ fn allan_table(a: &AllanResult) -> CsvTable {
     )
 }
 
+/// `allan` of `selfcal.json`: the Allan result with the noise-model fit beside its readings,
+/// as `model_fit` (null without readings).
+fn allan_json(a: &AllanResult) -> serde_json::Value {
+    let mut v = json!(a);
+    v["model_fit"] = json!(a.readings.map(|r| r.model_fit));
+    v
+}
+
+/// The legend of the fitted curve: its determined terms.
+fn fit_label(f: &NoiseModelFit) -> String {
+    let terms: Vec<String> = [
+        ("N", f.arw_deg_per_rt_h, "deg/sqrt(h)"),
+        ("B", f.bias_instability_deg_per_h, "deg/h"),
+        ("K", f.rate_random_walk_deg_per_h_per_rt_h, "deg/h/sqrt(h)"),
+        ("Q", f.quantisation_deg, "deg"),
+    ]
+    .iter()
+    .filter(|t| t.1.is_finite())
+    .map(|(name, v, unit)| format!("{name} = {} {unit}", sig3(*v)))
+    .collect();
+    format!("noise-model fit (IEEE 952): {}", terms.join(", "))
+}
+
 fn log_series(name: &str, style: SeriesStyle, pts: &[AllanPoint], scale: f64) -> Series {
     Series::new(
         name,
@@ -303,11 +327,18 @@ pub fn allan_title(a: &AllanResult) -> String {
         }
     };
     match a.readings {
-        Some(r) => format!(
-            "Allan deviation at zero rate: ARW {}, bias instability {}",
-            read(r.arw_deg_per_rt_h, "deg/sqrt(h)"),
-            read(r.bias_instability_deg_per_h, "deg/h")
-        ),
+        Some(r) => {
+            let mut t = format!(
+                "Allan deviation at zero rate: ARW {}, bias instability {}",
+                read(r.arw_deg_per_rt_h, "deg/sqrt(h)"),
+                read(r.bias_instability_deg_per_h, "deg/h")
+            );
+            let f = r.model_fit;
+            if f.arw_deg_per_rt_h.is_finite() || f.bias_instability_deg_per_h.is_finite() {
+                t += &format!("; {}", fit_label(&f));
+            }
+            t
+        }
         None => "Allan deviation at zero rate".to_string(),
     }
 }
@@ -321,7 +352,7 @@ pub fn render_allan_png(a: &AllanResult, path: &Path) -> Result<(), ReportError>
 /// The two panels of `allan.png`: the Allan deviation of the mode-1 phase output in degrees
 /// (what the board reads), and of the rate-equivalent output in deg/h (the same curve over the
 /// scale factor, the unit of the readings), with the angle random walk's -1/2 line when it was
-/// read.
+/// read and the noise-model fit over the taus it was fitted on.
 pub fn allan_panels(a: &AllanResult) -> [Figure; 2] {
     let phase = Figure::new(
         "Phase output, mode 1",
@@ -361,6 +392,24 @@ pub fn allan_panels(a: &AllanResult) -> [Figure; 2] {
             SeriesStyle::DashedLine,
             ends.clone(),
             ends.iter().map(|t| n / t.sqrt() * 3600.0).collect(),
+        ));
+    }
+    if let Some(f) = a
+        .readings
+        .map(|r| r.model_fit)
+        .filter(|f| f.warning.is_none())
+    {
+        // 64 points per decade: a smooth curve on the log axes.
+        let decades = (f.tau_max_s / f.tau_min_s).log10();
+        let k = (64.0 * decades).ceil().max(1.0) as usize;
+        let taus: Vec<f64> = (0..=k)
+            .map(|i| f.tau_min_s * 10f64.powf(decades * i as f64 / k as f64))
+            .collect();
+        rate = rate.with(Series::new(
+            fit_label(&f),
+            SeriesStyle::Line,
+            taus.clone(),
+            taus.iter().map(|&t| f.adev_dps(t) * 3600.0).collect(),
         ));
     }
     [phase, rate]

@@ -2,6 +2,7 @@
 //! what is under test): a panel of the phase output in degrees beside the rate-equivalent one
 //! in deg/h, the readings in the title and the angle random walk's line on the rate panel.
 
+use gyroemu_analysis::allan::fit::NoiseModelFit;
 use gyroemu_analysis::allan::{AllanPoint, NoiseReadings};
 use gyroemu_analysis::selfcal_analyses::AllanResult;
 use gyroemu_plot::SeriesStyle;
@@ -42,6 +43,7 @@ fn readings(arw: f64, bi: f64) -> NoiseReadings {
         bias_instability_deg_per_h: bi,
         tau_at_min_s: 100.0,
         bias_instability_warning: None,
+        model_fit: NoiseModelFit::not_fitted("not under test"),
     }
 }
 
@@ -115,4 +117,118 @@ fn allan_png_holds_both_panels() {
     assert_eq!(&png[12..16], b"IHDR");
     let be = |b: &[u8]| u32::from_be_bytes([b[0], b[1], b[2], b[3]]);
     assert_eq!((be(&png[16..20]), be(&png[20..24])), (1600, 650));
+}
+
+/// White rate noise N = 0.035 deg/s*sqrt(s) (ARW 2.1 deg/sqrt(h)) over a floor of B = 950
+/// deg/h (they cross at 0.04 s), exact, from four 1000 s records at tau0 = 0.01 s: no -1/2
+/// half decade to read an ARW from, so the fit's N is what the figure and warnings give.
+fn fitted_allan() -> AllanResult {
+    let (n, b) = (0.035f64, 950.0 / 3600.0);
+    let floor2 = 2.0 * std::f64::consts::LN_2 / std::f64::consts::PI * b * b;
+    let rate: Vec<AllanPoint> = (0..33)
+        .map(|k| {
+            let t = 0.01 * 10f64.powf(k as f64 / 8.0);
+            AllanPoint {
+                tau_s: t,
+                adev: (n * n / t + floor2).sqrt(),
+                n_terms: 4 * (100_000 - 2 * (t / 0.01).round() as usize + 1),
+            }
+        })
+        .collect();
+    let readings = gyroemu_analysis::allan::noise_readings(&rate);
+    AllanResult {
+        tau0_s: 0.01,
+        record_s: 1000.0,
+        phase_deg: rate
+            .iter()
+            .map(|p| AllanPoint {
+                adev: p.adev * SCALE,
+                ..*p
+            })
+            .collect(),
+        rate_dps: rate,
+        readings,
+        scale_deg_per_dps: SCALE,
+    }
+}
+
+#[test]
+fn the_noise_model_fit_is_drawn_named_and_warned() {
+    let a = fitted_allan();
+    let r = a.readings.unwrap();
+    assert!(r.arw_deg_per_rt_h.is_nan(), "{r:?}");
+    let f = r.model_fit;
+    assert!((f.arw_deg_per_rt_h / 2.1 - 1.0).abs() < 1e-6, "{f:?}");
+    assert!(
+        (f.bias_instability_deg_per_h / 950.0 - 1.0).abs() < 1e-6,
+        "{f:?}"
+    );
+    let [_, rate] = allan_panels(&a);
+    // No ARW line; the fit's line over the taus it was fitted on, through the curve.
+    assert_eq!(rate.series.len(), 2, "{:?}", rate.series);
+    let line = &rate.series[1];
+    assert_eq!(line.style, SeriesStyle::Line);
+    assert_eq!(
+        line.name,
+        "noise-model fit (IEEE 952): N = 2.10 deg/sqrt(h), B = 950 deg/h"
+    );
+    assert_eq!(
+        (line.xs[0], *line.xs.last().unwrap()),
+        (f.tau_min_s, f.tau_max_s)
+    );
+    for p in a
+        .rate_dps
+        .iter()
+        .filter(|p| p.tau_s >= f.tau_min_s && p.tau_s <= f.tau_max_s)
+    {
+        let i = line
+            .xs
+            .iter()
+            .position(|&t| (t / p.tau_s - 1.0).abs() < 1e-9)
+            .unwrap_or_else(|| panic!("tau {} not on the line", p.tau_s));
+        assert!((line.ys[i] / (p.adev * 3600.0) - 1.0).abs() < 1e-6);
+    }
+    let title = allan_title(&a);
+    assert!(
+        title.contains("ARW not read (see warnings), bias instability"),
+        "{title}"
+    );
+    assert!(
+        title.ends_with("; noise-model fit (IEEE 952): N = 2.10 deg/sqrt(h), B = 950 deg/h"),
+        "{title}"
+    );
+    // The run's warnings give the fit's N beside the refusal.
+    let fit_note = |a: &AllanResult| {
+        a.warnings()
+            .into_iter()
+            .find(|w| w.contains("noise-model fit"))
+    };
+    let note = fit_note(&a).unwrap();
+    assert!(
+        note.contains("reads N = 2.10 deg/sqrt(h) (95 %: ") && note.contains("B = 950 deg/h"),
+        "{note}"
+    );
+    // None where the slope reading gave an ARW.
+    let mut read = a.clone();
+    read.readings = Some(readings(2.0, 90.0));
+    assert_eq!(fit_note(&read), None);
+}
+
+#[test]
+fn allan_readings_keep_their_json_keys() {
+    // The fit is written beside the readings (`allan.model_fit`), not inside them.
+    let v = serde_json::to_value(fitted_allan().readings.unwrap()).unwrap();
+    let mut keys: Vec<&str> = v.as_object().unwrap().keys().map(|k| k.as_str()).collect();
+    keys.sort();
+    assert_eq!(
+        keys,
+        [
+            "arw_deg_per_rt_h",
+            "arw_tau_s",
+            "arw_warning",
+            "bias_instability_deg_per_h",
+            "bias_instability_warning",
+            "tau_at_min_s"
+        ]
+    );
 }
