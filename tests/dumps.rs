@@ -121,14 +121,20 @@ nodes = ["drive"]
         .validate()
         .unwrap_err()
         .to_string();
-    assert!(e.contains("`dump.start_s` = 2.35") && e.contains("run"), "{e}");
+    assert!(
+        e.contains("`dump.start_s` = 2.35") && e.contains("run"),
+        "{e}"
+    );
     // A start inside the run whose window ends past it: the duration is at fault.
     let e = parse_config(&base(100.0, 2.25, 0.1))
         .unwrap()
         .validate()
         .unwrap_err()
         .to_string();
-    assert!(e.contains("`dump.duration_s` = 0.1") && e.contains("run"), "{e}");
+    assert!(
+        e.contains("`dump.duration_s` = 0.1") && e.contains("run"),
+        "{e}"
+    );
     parse_config(&base(100.0, 2.2, 0.01))
         .unwrap()
         .validate()

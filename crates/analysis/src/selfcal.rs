@@ -227,7 +227,7 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
         }
         for &dt in &s.drift_delta_t_k {
             let (r, c) = sweep_configs(&drifted(cfg, dt));
-            let what = format!("drift scenario at {dt} K");
+            let what = format!("drift scenario at dT = {dt:+} K");
             add(&what, r.validate());
             add(&what, c.validate());
         }

@@ -101,7 +101,8 @@ pub fn list_written(out: &Path, files: &[std::path::PathBuf]) {
 pub fn list_written_with(out: &Path, files: &[std::path::PathBuf], items: Option<ItemFiles>) {
     let items = items.filter(|i| i.count > 0);
     let total = files.len() + items.map_or(0, |i| i.count);
-    note!("wrote {total} files in `{}`:", out.display());
+    let s = if total == 1 { "" } else { "s" };
+    note!("wrote {total} file{s} in `{}`:", out.display());
     for f in files {
         let shown = f.strip_prefix(out).unwrap_or(f);
         note!("  {}", shown.display());

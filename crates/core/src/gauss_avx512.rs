@@ -164,7 +164,7 @@ pub(crate) unsafe fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4]) {
 }
 
 /// The streams whose draw missed its piece's core (bit clear in `core`), finished one by
-/// one by the portable code's scalar ziggurat (`gauss::lane_normal`), each drawing from its
+/// one by the portable code's scalar ziggurat (`gauss_scalar::lane_normal`), each drawing from its
 /// own stream in the register: all eight step, only that one keeps its step. Returns the
 /// state and `x` with those lanes replaced. Lanes move between the vector and general
 /// registers by permutes: through memory (a 64-byte store read back 8 bytes at a time) this

@@ -104,7 +104,7 @@ pub fn lock_subfolders(
         let dir = out.join(n);
         if dir.exists() && !dir.is_dir() {
             return Err(RunError::BadInput(format!(
-                "`{}` is a file, not a folder: this command writes its {n} files there; move it away",
+                "`{}` is a file, not a folder: `{command}` writes its {n} files there; move it away",
                 dir.display()
             )));
         }
