@@ -415,9 +415,15 @@ fn integers_out_of_range_exit_2_echoed_as_written() {
             coriolis_with("lpf_order", "9223372036854775807"),
             "key `board.lpf_order` = 9223372036854775807: must be an integer from 1 to 8",
         ),
+        // Past the type's limit: the key's own range, not the type's (it said "at most
+        // 18446744073709551615", and for dac_bits "at most 4294967295").
         (
             coriolis_with("lpf_order", "99999999999999999999"),
-            "key `board.lpf_order` = 99999999999999999999: too large: at most 18446744073709551615",
+            "key `board.lpf_order` = 99999999999999999999: too large: must be an integer from 1 to 8",
+        ),
+        (
+            preset("m2tfg-coriolis").replace("[board]\n", "[board]\ndac_bits = 4294967296\n"),
+            "key `board.dac_bits` = 4294967296: too large: must be an integer from 2 to 32",
         ),
         (
             preset("m2tfg-coriolis") + "\n[noise]\nseed = 18446744073709551616\n",

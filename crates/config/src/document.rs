@@ -175,11 +175,11 @@ fn rule(kind: Kind, v: &DeValue<'_>) -> Option<String> {
             }
             _ => Some(expected("a number", v)),
         },
-        Kind::Count { max } => {
-            let range = if max > u64::from(u32::MAX) {
-                "a non-negative integer".to_string()
-            } else {
-                format!("an integer from 0 to {max}")
+        Kind::Count { max, range } => {
+            let what = match range {
+                Some(r) => r.what(),
+                None if max > u64::from(u32::MAX) => "a non-negative integer".to_string(),
+                None => format!("an integer from 0 to {max}"),
             };
             match (int, v.as_float()) {
                 (Some((s, radix)), _) => {
@@ -187,12 +187,11 @@ fn rule(kind: Kind, v: &DeValue<'_>) -> Option<String> {
                     let negative = s.starts_with('-');
                     let n = i128::from_str_radix(s, radix).ok();
                     let ok = n.is_some_and(|n| (0..=max as i128).contains(&n));
-                    (!ok).then(|| {
-                        if negative {
-                            format!("expected {range}")
-                        } else {
-                            format!("too large: at most {max}")
-                        }
+                    (!ok).then(|| match range {
+                        _ if negative => format!("expected {what}"),
+                        // The key's own range: the type's limit is no rule of it.
+                        Some(r) => format!("too large: {}", r.rule()),
+                        None => format!("too large: at most {max}"),
                     })
                 }
                 (_, Some(f)) => {
@@ -202,11 +201,11 @@ fn rule(kind: Kind, v: &DeValue<'_>) -> Option<String> {
                         .ok()
                         .filter(|x| x.is_finite() && x.fract() == 0.0 && *x >= 0.0);
                     Some(match whole {
-                        Some(x) => format!("expected {range} (write {x} without a decimal point)"),
-                        None => format!("expected {range}"),
+                        Some(x) => format!("expected {what} (write {x} without a decimal point)"),
+                        None => format!("expected {what}"),
                     })
                 }
-                _ => Some(expected(&range, v)),
+                _ => Some(expected(&what, v)),
             }
         }
         Kind::Bool => (!v.is_bool()).then(|| expected("true or false", v)),

@@ -9,8 +9,9 @@
 pub(crate) enum Kind {
     /// A number: a float, or an integer within the 64-bit range.
     Number,
-    /// An integer from 0 to `max`.
-    Count { max: u64 },
+    /// An integer from 0 to `max` (its type's limit); `range`, when the key has one, is what
+    /// validation accepts, and what the messages about the value's kind give.
+    Count { max: u64, range: Option<IntRange> },
     /// `true` or `false`.
     Bool,
     /// A list of numbers.
@@ -22,6 +23,48 @@ pub(crate) enum Kind {
     /// One of these strings.
     Choice(&'static [&'static str]),
 }
+
+/// The integers a key's validation accepts, `lo..=hi`: the one source of its rule and of
+/// the range the schema's messages give (a value past the type's limit said "at most
+/// 4294967295" for a key that takes 2 to 32).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct IntRange {
+    pub lo: u64,
+    pub hi: u64,
+}
+
+impl IntRange {
+    pub fn contains(self, v: impl TryInto<u64>) -> bool {
+        v.try_into()
+            .is_ok_and(|v: u64| (self.lo..=self.hi).contains(&v))
+    }
+
+    /// `an integer from 2 to 32` (`1 or 2` for two values).
+    pub fn what(self) -> String {
+        if self.hi == self.lo + 1 {
+            format!("{} or {}", self.lo, self.hi)
+        } else {
+            format!("an integer from {} to {}", self.lo, self.hi)
+        }
+    }
+
+    /// `must be an integer from 2 to 32`: the validation rule.
+    pub fn rule(self) -> String {
+        format!("must be {}", self.what())
+    }
+}
+
+/// `board.lpf_order`: the stage-1 low-pass's order.
+pub(crate) const LPF_ORDER: IntRange = IntRange { lo: 1, hi: 8 };
+/// `board.dac_bits`, `board.adc_bits`.
+pub(crate) const CONVERTER_BITS: IntRange = IntRange { lo: 2, hi: 32 };
+/// `sweep.points`.
+pub(crate) const SWEEP_POINTS: IntRange = IntRange {
+    lo: crate::validate_sweep::MIN_SWEEP_POINTS as u64,
+    hi: crate::validate_sweep::MAX_SWEEP_POINTS as u64,
+};
+/// `pll.mode`: the mode whose output the PLL locks on.
+pub(crate) const PLL_MODE: IntRange = IntRange { lo: 1, hi: 2 };
 
 /// One key of a section.
 #[derive(Clone, Copy, Debug)]
@@ -57,15 +100,29 @@ const fn opt(name: &'static str, kind: Kind) -> Field {
 
 use Kind::*;
 
-/// Any non-negative integer a `usize` or `u64` key holds.
+/// Any non-negative integer a `usize` key holds.
 const COUNT: Kind = Count {
     max: usize::MAX as u64,
+    range: None,
 };
+const SEED: Kind = Count {
+    max: u64::MAX,
+    range: None,
+};
+
+/// A `usize` key validated within `range`.
+const fn count_in(range: IntRange) -> Kind {
+    Count {
+        max: usize::MAX as u64,
+        range: Some(range),
+    }
+}
+
 /// A `u32` key (converter bits).
 const BITS: Kind = Count {
     max: u32::MAX as u64,
+    range: Some(CONVERTER_BITS),
 };
-const SEED: Kind = Count { max: u64::MAX };
 
 /// Every section, in the order the user guide documents them.
 pub(crate) const SECTIONS: &[Section] = &[
@@ -100,7 +157,7 @@ pub(crate) const SECTIONS: &[Section] = &[
             opt("tia_pole_hz", Number),
             opt("tia_inverting", Bool),
             opt("tia_rail_v", Number),
-            opt("lpf_order", COUNT),
+            opt("lpf_order", count_in(LPF_ORDER)),
             opt("lpf_cutoff_hz", Number),
             opt("decimation", COUNT),
             opt("dac_bits", BITS),
@@ -166,7 +223,7 @@ pub(crate) const SECTIONS: &[Section] = &[
         fields: &[
             opt("start_hz", Number),
             opt("stop_hz", Number),
-            opt("points", COUNT),
+            opt("points", count_in(SWEEP_POINTS)),
             opt("spacing", Choice(&["resonance", "linear", "log"])),
             opt("settle_s", Number),
             opt("average_s", Number),
@@ -179,7 +236,7 @@ pub(crate) const SECTIONS: &[Section] = &[
             opt("natural_hz", Number),
             opt("damping", Number),
             opt("lock_s", Number),
-            opt("mode", COUNT),
+            opt("mode", count_in(PLL_MODE)),
         ],
     },
     Section {

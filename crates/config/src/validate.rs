@@ -5,6 +5,7 @@
 use crate::config::{Config, ExperimentKind, RateTable};
 use crate::error::ConfigError;
 use crate::rules::Rules;
+use crate::schema::{CONVERTER_BITS, LPF_ORDER};
 use gyroemu_board::DUMP_NODES;
 
 /// Most input samples one operating point may run: 2^53, so every sample index and count
@@ -34,6 +35,7 @@ impl Config {
         let mut warnings = Vec::new();
         self.link_derived(&mut p);
         self.validate_device_board(&mut p);
+        self.warn_tia_pole(&p, &mut warnings);
         self.validate_experiment(&mut p);
         self.validate_noise_adc_selfcal(&mut p, &mut warnings);
         self.validate_montecarlo(&mut p);
@@ -81,6 +83,23 @@ impl Config {
             self.lpf_cutoff_hz(),
         ) {
             p.derived_from("board.lpf_cutoff_hz", "device.f0_hz");
+        }
+        // 0.02 / the longest record: a record refused as too long gave a subnormal corner,
+        // and the flicker design then asked for usize::MAX poles (a panic, not a message).
+        let clear_f_lo = |c: &mut Config| {
+            if let Some(n) = &mut c.noise {
+                n.flicker_f_lo_hz = None;
+            }
+        };
+        if same(raw(&clear_f_lo).flicker_f_lo_hz(), self.flicker_f_lo_hz()) {
+            for source in [
+                "experiment.average_s",
+                "experiment.settle_s",
+                "selfcal.allan_record_s",
+                "selfcal.tau_max_s",
+            ] {
+                p.derived_from("noise.flicker_f_lo_hz", source);
+            }
         }
         if raw(&|c| c.board.decimation = None).decimation() == self.decimation() {
             p.derived_from("board.decimation", "board.fs_hz");
@@ -147,13 +166,13 @@ impl Config {
                     ),
                 );
                 // The TIA as built: a pole whose coefficient rounds to 1 has a gain of 0.
-                let min = gyroemu_tia::min_pole_hz(fs_hz);
                 p.check(
                     !ok || gyroemu_tia::pole_coefficient(pole, fs_hz) < 1.0,
                     "board.tia_pole_hz",
                     pole,
                     format!(
-                        "must be at least {min:e} Hz at fs_hz = {fs_hz}: below it the TIA's discretised pole a = exp(-2 pi tia_pole_hz / fs_hz) rounds to exactly 1 (2 pi tia_pole_hz / fs_hz under about 2^-54, half the spacing of doubles below 1), so its gain (1 - a) x tia_gain_ohm is exactly 0 at every frequency and no signal passes; raise it, or remove the key for a wide-band TIA"
+                        "{}; raise it, or remove the key for a wide-band TIA",
+                        gyroemu_tia::min_pole_rule(fs_hz)
                     ),
                 );
             } else {
@@ -164,10 +183,10 @@ impl Config {
             p.positive("board.tia_rail_v", r);
         }
         p.check(
-            (1..=8).contains(&b.lpf_order),
+            LPF_ORDER.contains(b.lpf_order),
             "board.lpf_order",
             b.lpf_order,
-            "must be an integer from 1 to 8",
+            LPF_ORDER.rule(),
         );
         let decimation = self.decimation();
         p.check(
@@ -209,10 +228,10 @@ impl Config {
         }
         if let Some(bits) = b.dac_bits {
             p.check(
-                (2..=32).contains(&bits),
+                CONVERTER_BITS.contains(bits),
                 "board.dac_bits",
                 bits,
-                "must be an integer from 2 to 32",
+                CONVERTER_BITS.rule(),
             );
         }
         p.positive("board.dac_full_scale", b.dac_full_scale);
@@ -222,6 +241,27 @@ impl Config {
             b.phase_shifter_error_deg,
             "must be finite and within (-90, 90) degrees",
         );
+    }
+
+    /// A valid pole whose coefficient's rounding moves it: near the minimum,
+    /// a = exp(-2 pi pole / fs) steps in units of 2^-53, so the pole realised can be twice the
+    /// one configured.
+    fn warn_tia_pole(&self, p: &Rules, warnings: &mut Vec<String>) {
+        let Some(pole) = self.board.tia_pole_hz else {
+            return;
+        };
+        if !p.clean(&["board.tia_pole_hz", "board.fs_hz"]) {
+            return;
+        }
+        let fs = self.fs_hz();
+        let realised = gyroemu_tia::realised_pole_hz(pole, fs);
+        let rel = realised / pole - 1.0;
+        if rel.abs() > 1e-6 {
+            let always = 2f64.powi(-54) * 1e6 * fs / core::f64::consts::TAU;
+            warnings.push(format!(
+                "board.tia_pole_hz = {pole:e}: the TIA's discretised pole a = exp(-2 pi tia_pole_hz / fs_hz) steps in units of 2^-53 below 1, so the TIA realises a pole of {realised:.6e} Hz (-ln(a) fs_hz / (2 pi)), not {pole:e} Hz: {rel:+.3e} relative. Its gain follows the realised pole, and with it the ADC range, the rails and the noise levels (the read-out's phases do not: it divides by the response as built); above {always:.3e} Hz (2^-54 x 1e6 x fs_hz / (2 pi)) every pole is realised within 1e-6"
+            ));
+        }
     }
 
     fn validate_experiment(&self, p: &mut Rules) {

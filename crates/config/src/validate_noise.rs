@@ -3,6 +3,7 @@
 
 use crate::config::Config;
 use crate::rules::Rules;
+use crate::schema::{CONVERTER_BITS, PLL_MODE};
 use crate::validate::MAX_RUN_SAMPLES;
 use crate::validate_regime::NODE_RANGE;
 use gyroemu_core::flicker::{FlickerDesign, FlickerParams};
@@ -19,16 +20,24 @@ const PEAK_SIGMAS: f64 = 9.0;
 /// are no longer bounded).
 const MAX_PHASE_RAD: f64 = 1e6;
 
+/// The Brownian force per unit mass as the board draws it (`held_white_sigma` of
+/// `thermomechanical_accel_psd`), with sinc(x) = sin(pi x) / (pi x).
+const BROWNIAN_FORCE: &str = "sqrt(4 k temperature_k w0 / (q effective_mass_kg) x fs_hz/2) / sinc(f0/fs_hz), w0 = 2 pi f0, sinc(x) = sin(pi x)/(pi x)";
+
+/// The velocity's stationary deviation: sqrt(S_a q / (4 w0)), i.e. equipartition.
+const BROWNIAN_VELOCITY: &str =
+    "sqrt(k temperature_k / effective_mass_kg), the stationary deviation";
+
 impl Config {
     /// The rules of the `[noise]` and `[selfcal]` sections and of the ADC keys.
     pub(crate) fn validate_noise_adc_selfcal(&self, p: &mut Rules, warnings: &mut Vec<String>) {
         let b = &self.board;
         if let Some(bits) = b.adc_bits {
             p.check(
-                (2..=32).contains(&bits),
+                CONVERTER_BITS.contains(bits),
                 "board.adc_bits",
                 bits,
-                "must be an integer from 2 to 32",
+                CONVERTER_BITS.rule(),
             );
         }
         p.positive("board.adc_full_scale_v", b.adc_full_scale_v);
@@ -91,12 +100,14 @@ impl Config {
                 // The slow sources run at the output rate: two decades of 1/f below its half.
                 let f_lo = self.flicker_f_lo_hz();
                 let max = 0.005 * self.fs_out_hz();
+                // The TIA's flicker runs at fs_hz: the bound of the fastest source serves all.
+                let min = gyroemu_core::flicker::min_f_lo_hz(self.fs_hz());
                 p.check(
-                    f_lo.is_finite() && f_lo > 0.0 && f_lo <= max,
+                    f_lo.is_finite() && f_lo >= min && f_lo <= max,
                     "noise.flicker_f_lo_hz",
                     f_lo,
                     format!(
-                        "must be > 0 and at most fs_out/200 = {max} Hz (the slow flicker sources run at the output rate and need two decades of 1/f below its half)"
+                        "must be from {min:e} Hz (below it the lowest flicker pole at fs_hz, exp(-2 pi f_lo / fs_hz), lies within 1000 ulps of 1 and is realised off by more than 0.1 %) to fs_out/200 = {max} Hz (the slow flicker sources run at the output rate and need two decades of 1/f below its half)"
                     ),
                 );
             }
@@ -179,10 +190,13 @@ impl Config {
     /// the loop can be built in, a lock run long enough to settle.
     fn validate_pll(&self, pll: &crate::config::PllConfig, p: &mut Rules) {
         p.check(
-            pll.mode == 1 || pll.mode == 2,
+            PLL_MODE.contains(pll.mode),
             "pll.mode",
             pll.mode,
-            "must be 1 or 2 (the mode whose output the PLL locks on)",
+            format!(
+                "{} (the mode whose output the PLL locks on)",
+                PLL_MODE.rule()
+            ),
         );
         if !p.positive("pll.damping", pll.damping)
             || !p.clean(&["pll.mode"])
@@ -295,6 +309,8 @@ impl Config {
 
         // Brownian force: per-sample deviation as drawn, then the velocity's stationary
         // deviation sqrt(S_a Q / (4 w0)) (equipartition, k T / m) through transduction and TIA.
+        // Each as sqrt(S_a) times the rest, so a deviation far out of range still prints as
+        // the number its formula gives (S_a fs/2 overflowed to inf from m ~ 1e-300).
         if let Some(m) = n.effective_mass_kg {
             let key = "noise.effective_mass_kg";
             if p.clean(&[key, "noise.temperature_k"]) {
@@ -307,19 +323,36 @@ impl Config {
                         mode.q,
                     );
                     let w0 = core::f64::consts::TAU * mode.f0_hz;
-                    let force = held_white_sigma(psd, fs, mode.f0_hz);
-                    let v = (psd * mode.q / (4.0 * w0)).sqrt();
+                    let force = held_white_sigma(1.0, fs, mode.f0_hz) * psd.sqrt();
+                    let v = psd.sqrt() * (mode.q / (4.0 * w0)).sqrt();
                     let i = v * self.device.transduction_a_s_per_m;
                     let out = i * tia.response(mode.f0_hz).norm();
                     let nodes = [
-                        ("force per unit mass", force, "m/s^2"),
-                        ("velocity", v, "m/s"),
-                        ("motional current", i, "A"),
-                        ("TIA output", out, "V"),
+                        (
+                            "force per unit mass",
+                            force,
+                            "m/s^2 per sample",
+                            BROWNIAN_FORCE,
+                        ),
+                        ("velocity", v, "m/s", BROWNIAN_VELOCITY),
+                        (
+                            "motional current",
+                            i,
+                            "A",
+                            "that velocity x device.transduction_a_s_per_m",
+                        ),
+                        (
+                            "TIA output",
+                            out,
+                            "V",
+                            "that current x |H(f0)| of the TIA as built",
+                        ),
                     ];
-                    if let Some((node, x, unit)) = nodes.into_iter().find(|&(_, x, _)| !within(x)) {
+                    if let Some((node, x, unit, formula)) =
+                        nodes.into_iter().find(|&(_, x, _, _)| !within(x))
+                    {
                         worst.get_or_insert(format!(
-                            "with temperature_k = {} gives mode {} a Brownian {node} of standard deviation {x:.3e} {unit} (force: sqrt(4 k temperature_k w0 / (q effective_mass_kg) fs_hz/2) per sample; velocity: sqrt(k temperature_k / effective_mass_kg)), which must stay within {hi:e} (the node range, so products of two stay finite): raise effective_mass_kg or lower temperature_k",
+                            "with temperature_k = {} gives mode {} a Brownian {node} of standard deviation {x:.3e} {unit} ({formula}), which must stay within {hi:e} (the node range, so products of two stay finite): raise effective_mass_kg or lower temperature_k",
                             n.temperature_k,
                             k + 1
                         ));

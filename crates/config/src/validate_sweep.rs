@@ -4,6 +4,7 @@
 
 use crate::config::Config;
 use crate::rules::Rules;
+use crate::schema::SWEEP_POINTS;
 use crate::validate::MAX_RUN_SAMPLES;
 
 /// Most frequencies a sweep may list.
@@ -86,10 +87,13 @@ impl Config {
             }
         }
         p.check(
-            (MIN_SWEEP_POINTS..=MAX_SWEEP_POINTS).contains(&s.points),
+            SWEEP_POINTS.contains(s.points),
             "sweep.points",
             s.points,
-            format!("must be an integer from {MIN_SWEEP_POINTS} (the resonance fit has four parameters) to {MAX_SWEEP_POINTS}"),
+            format!(
+                "{} (at least {MIN_SWEEP_POINTS}: the resonance fit has four parameters)",
+                SWEEP_POINTS.rule()
+            ),
         );
         if p.clean(&[
             "sweep.start_hz",

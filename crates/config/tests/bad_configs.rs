@@ -285,7 +285,7 @@ fn cases() -> Vec<Case> {
         parse_case(
             "negative for usize",
             set(&c, "board", "lpf_order", "-4"),
-            &["board.lpf_order", "= -4", "expected a non-negative integer"],
+            &["board.lpf_order", "= -4", "expected an integer from 1 to 8"],
         ),
         parse_case(
             "negative seed",
@@ -341,11 +341,7 @@ fn cases() -> Vec<Case> {
         parse_case(
             "negative dac_bits",
             set(&c, "board", "dac_bits", "-1"),
-            &[
-                "board.dac_bits",
-                "= -1",
-                "expected an integer from 0 to 4294967295",
-            ],
+            &["board.dac_bits", "= -1", "expected an integer from 2 to 32"],
         ),
         parse_case(
             "float adc_bits",
@@ -353,7 +349,7 @@ fn cases() -> Vec<Case> {
             &[
                 "board.adc_bits",
                 "= 16.0",
-                "expected an integer from 0 to 4294967295",
+                "expected an integer from 2 to 32",
                 "write 16 without a decimal point",
             ],
         ),
@@ -1469,7 +1465,7 @@ fn a_file_with_several_bad_keys_gets_every_one_in_one_message() {
             "unknown key",
             "expected one of `f1`, `f2`, `carrier_hz`",
         ],
-        &["board.lpf_order", "= -4", "a non-negative integer"],
+        &["board.lpf_order", "= -4", "an integer from 1 to 8"],
         &["experiment.average_s", "is missing"],
     ]) {
         check_needles("several parse problems", line, needles).unwrap();
@@ -1670,7 +1666,7 @@ fn a_noise_density_that_would_overflow_the_chain_is_refused_by_its_key() {
     for (key, v, rule) in [
         (
             "effective_mass_kg",
-            "1e-200",
+            "1e-230",
             "Brownian force per unit mass",
         ),
         (
@@ -1737,15 +1733,51 @@ fn integers_are_echoed_as_written_and_too_large_ones_say_their_bound() {
         "{msg}"
     );
     let noise = with(c.clone(), "\n[noise]\nseed = 1\n");
-    for (section, key, v, max) in [
+    // Past the type's limit: the key's own range when it has one (it said "at most
+    // 4294967295" for dac_bits, then 4294967295 was refused as not 2 to 32), else the limit.
+    for (section, key, v, rule) in [
         (
             "board",
             "lpf_order",
             "99999999999999999999",
-            usize::MAX as u64,
+            "too large: must be an integer from 1 to 8",
         ),
-        ("noise", "seed", "18446744073709551616", u64::MAX),
-        ("board", "dac_bits", "4294967296", u64::from(u32::MAX)),
+        (
+            "noise",
+            "seed",
+            "18446744073709551616",
+            "too large: at most 18446744073709551615",
+        ),
+        (
+            "board",
+            "dac_bits",
+            "4294967296",
+            "too large: must be an integer from 2 to 32",
+        ),
+        (
+            "board",
+            "adc_bits",
+            "0x1_0000_0000",
+            "too large: must be an integer from 2 to 32",
+        ),
+        (
+            "board",
+            "decimation",
+            "18446744073709551616",
+            "too large: at most 18446744073709551615",
+        ),
+        (
+            "sweep",
+            "points",
+            "18446744073709551616",
+            "too large: must be an integer from 5 to 10000",
+        ),
+        (
+            "pll",
+            "mode",
+            "99999999999999999999",
+            "too large: must be 1 or 2",
+        ),
     ] {
         let (t, line) = set(&noise, section, key, v);
         let e = parse_config(&t).unwrap_err();
@@ -1757,8 +1789,34 @@ fn integers_are_echoed_as_written_and_too_large_ones_say_their_bound() {
         );
         assert!(msg.contains(&format!("line {line}, column ")), "{msg}");
         assert!(
-            msg.contains(&format!("= {v}: too large: at most {max}")),
+            msg.contains(&format!("= {v}: {rule}")),
             "{section}.{key}: {msg}"
+        );
+    }
+    // One source: the range a too-large value is told is the one validation enforces.
+    for (section, key, past, big) in [
+        ("board", "lpf_order", "9", "99999999999999999999"),
+        ("board", "dac_bits", "33", "4294967296"),
+        ("board", "adc_bits", "1", "4294967296"),
+        ("sweep", "points", "10001", "99999999999999999999"),
+        ("pll", "mode", "3", "99999999999999999999"),
+    ] {
+        let told = parse_config(&set(&noise, section, key, big).0)
+            .unwrap_err()
+            .to_string();
+        let told = &told[told.find("too large: ").unwrap() + "too large: ".len()..];
+        let cfg = parse_config(&set(&noise, section, key, past).0).unwrap();
+        let e = cfg.validate().unwrap_err();
+        let p = e
+            .problems()
+            .into_iter()
+            .find(|p| p.key.as_deref() == Some(&*format!("{section}.{key}")));
+        let rule = p
+            .unwrap_or_else(|| panic!("{section}.{key} = {past}: {e}"))
+            .detail;
+        assert!(
+            rule.starts_with(&format!(" = {past}: {told}")),
+            "{section}.{key}: {told} vs {rule}"
         );
     }
     // A negative one is not too large: the kind of value is what is wrong.
@@ -1768,4 +1826,117 @@ fn integers_are_echoed_as_written_and_too_large_ones_say_their_bound() {
         msg.contains("= -1: expected a non-negative integer"),
         "{msg}"
     );
+}
+
+#[test]
+fn a_brownian_mass_is_refused_just_past_its_bound_with_the_formula_the_code_applies() {
+    // m2tfg-selfcal: the force node binds. Its per-sample deviation
+    // sqrt(4 k T w0 / (q m) x fs/2) / sinc(f0/fs) reaches 1e100 at
+    // m = 4 k T w0 fs/2 / (q (1e100 sinc)^2), largest for mode 2 (lower Q). The velocity,
+    // sqrt(k T / m), reaches it only at m = k T / 1e200, and current and TIA output (x 1e-6
+    // A s/m, x at most 1e6 ohm) no sooner.
+    let c = base("m2tfg-selfcal");
+    let (k, t, fs) = (1.380_649e-23, 300.0, 240e3);
+    let sinc = |x: f64| (core::f64::consts::PI * x).sin() / (core::f64::consts::PI * x);
+    let bound = [(15e3, 2000.0), (15e3 + 0.02, 1950.0)]
+        .map(|(f0, q): (f64, f64)| {
+            let w0 = core::f64::consts::TAU * f0;
+            4.0 * k * t * w0 * 0.5 * fs / (q * (1e100 * sinc(f0 / fs)).powi(2))
+        })
+        .into_iter()
+        .fold(0.0, f64::max);
+    assert!((9e-214..1e-213).contains(&bound), "{bound:e}");
+    assert!(bound > 1e3 * k * t / 1e200);
+    let mass = |m: f64| set(&c, "noise", "effective_mass_kg", &format!("{m:e}")).0;
+    // 9.7e-211 was refused with a deviation of "inf" (m^2 rounded to 0).
+    for m in [bound * (1.0 + 1e-9), 9.7e-211, 2e-162, 1e-9] {
+        let cfg = parse_config(&mass(m)).unwrap();
+        assert!(cfg.validate().is_ok(), "{m:e}: {:?}", cfg.validate());
+    }
+    for m in [bound * (1.0 - 1e-9), 1e-250, 1e-300, 5e-324] {
+        let e = invalid_msg(&format!("{m:e}"), &mass(m));
+        let msg = e.to_string();
+        assert_eq!(e.key.as_deref(), Some("noise.effective_mass_kg"), "{msg}");
+        // The first mode out of range (just past the bound only mode 2 is), and the
+        // deviation its formula gives, not inf.
+        let (mode, f0, q) = if msg.contains("gives mode 1 ") {
+            (1, 15e3, 2000.0)
+        } else {
+            (2, 15e3 + 0.02, 1950.0)
+        };
+        assert!(mode == 2 || m < bound * 0.9, "{msg}");
+        let w0 = core::f64::consts::TAU * f0;
+        let want = (4.0 * k * t * w0 / (q * m)).sqrt() * (0.5 * fs).sqrt() / sinc(f0 / fs);
+        for n in [
+            &format!("gives mode {mode} a Brownian force per unit mass of standard deviation {want:.3e} m/s^2 per sample"),
+            "sqrt(4 k temperature_k w0 / (q effective_mass_kg) x fs_hz/2) / sinc(f0/fs_hz)",
+            "must stay within 1e100",
+        ] {
+            assert!(msg.contains(n), "{m:e}: `{n}` missing from: {msg}");
+        }
+        assert!(!msg.contains("inf"), "{m:e}: {msg}");
+    }
+}
+
+#[test]
+fn a_tia_pole_realised_off_its_value_is_warned_with_both_poles() {
+    // At 240 kHz, a = exp(-2 pi p / fs) steps in units of 2^-53 below 1: a pole near the
+    // minimum is realised as k 2^-53 fs / (2 pi), k = round(2 pi p / fs 2^53). It validated
+    // with no word (1e-11 Hz gave 15 % less attenuation at 15 kHz than configured).
+    let c = base(C);
+    let fs: f64 = 240e3;
+    let step = 2f64.powi(-53) * fs / core::f64::consts::TAU;
+    let warnings = |pole: &str| {
+        let t = set(&c, "board", "tia_pole_hz", pole).0;
+        let cfg = parse_config(&t).unwrap();
+        cfg.validate()
+            .unwrap_or_else(|e| panic!("{pole}: {e}"))
+            .into_iter()
+            .filter(|w| w.contains("realises a pole"))
+            .collect::<Vec<_>>()
+    };
+    for (pole, k) in [(2.13e-12, 1.0), (1e-11, 2.0), (1e-9, 236.0)] {
+        assert_eq!(k, (pole / step).round(), "{pole}");
+        let realised = k * step;
+        let rel = realised / pole - 1.0;
+        let w = warnings(&format!("{pole:e}"));
+        assert_eq!(w.len(), 1, "{pole}: {w:?}");
+        for n in [
+            &format!("board.tia_pole_hz = {pole:e}: "),
+            &format!("realises a pole of {realised:.6e} Hz"),
+            &format!("not {pole:e} Hz: {rel:+.3e} relative"),
+            "the ADC range, the rails and the noise levels",
+        ] {
+            assert!(w[0].contains(n), "{pole}: `{n}` missing from: {}", w[0]);
+        }
+    }
+    // Above 2^-54 x 1e6 x fs / (2 pi) = 2.1e-6 Hz every pole is realised within 1e-6.
+    for pole in ["2.2e-6", "1e-3", "60000.0", "119000.0"] {
+        assert!(warnings(pole).is_empty(), "{pole}: {:?}", warnings(pole));
+    }
+    // The configured pole's rounding is what is weighed, not a threshold on the pole: one on
+    // the grid (k = 1e5, well below that bound) is realised within 1e-6 and stays quiet.
+    let exact = 1e5 * step;
+    assert!(warnings(&format!("{exact:e}")).is_empty());
+}
+
+#[test]
+fn a_flicker_low_corner_too_low_for_its_poles_is_refused_not_a_panic() {
+    // The lowest pole's radius exp(-2 pi f_lo / fs) must stay 1000 ulps below 1:
+    // f_lo >= 1000 (eps / 2) fs / (2 pi) = 4.24e-9 Hz at 240 kHz. 1e-310 made the pole count
+    // infinite (a panic in validation); 1e-300 blamed other keys with NaN deviations.
+    let c = base("m2tfg-selfcal");
+    let min = 1000.0 * f64::EPSILON / 2.0 * 240e3 / core::f64::consts::TAU;
+    assert!((4.2e-9..4.3e-9).contains(&min), "{min:e}");
+    let text = |v: f64| set(&c, "noise", "flicker_f_lo_hz", &format!("{v:e}")).0;
+    for v in [min * (1.0 + 1e-12), 1e-5] {
+        let cfg = parse_config(&text(v)).unwrap();
+        assert!(cfg.validate().is_ok(), "{v:e}: {:?}", cfg.validate());
+    }
+    for v in [min * (1.0 - 1e-12), 1e-200, 1e-300, 1e-310] {
+        let e = invalid_msg(&format!("{v:e}"), &text(v));
+        let msg = e.to_string();
+        assert_eq!(e.key.as_deref(), Some("noise.flicker_f_lo_hz"), "{msg}");
+        assert!(msg.contains("1000 ulps of 1"), "{msg}");
+    }
 }

@@ -39,6 +39,6 @@ mod stationary;
 pub use design::{FlickerDesign, POLES_PER_DECADE, RIPPLE_DB};
 pub use generator::Flicker;
 pub use params::{
-    flicker_adev, psd_at_1hz_from_bias_instability, psd_at_1hz_from_corner, FlickerParams,
-    ADEV_PER_BIAS_INSTABILITY,
+    flicker_adev, min_f_lo_hz, psd_at_1hz_from_bias_instability, psd_at_1hz_from_corner,
+    FlickerParams, ADEV_PER_BIAS_INSTABILITY,
 };

@@ -6,7 +6,7 @@
 
 mod tia;
 
-pub use tia::{min_pole_hz, pole_coefficient, Tia, TiaParams};
+pub use tia::{min_pole_hz, min_pole_rule, pole_coefficient, realised_pole_hz, Tia, TiaParams};
 
 mod noise;
 pub use noise::input_referred_noise_a_per_rthz;

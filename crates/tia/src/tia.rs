@@ -58,6 +58,15 @@ pub fn pole_coefficient(pole_hz: f64, fs_hz: f64) -> f64 {
     (-core::f64::consts::TAU * pole_hz / fs_hz).exp()
 }
 
+/// The pole, Hz, that [`Tia::new`] realises for `pole_hz`: `-ln(a) fs / (2 pi)` of the
+/// coefficient `a` of [`pole_coefficient`]. Below 1, `a` steps in units of 2^-53, so a pole
+/// near [`min_pole_hz`] is realised up to twice as high (2.13e-12 Hz at 240 kHz as 4.24e-12);
+/// one above 2^-54 x 1e6 x fs / (2 pi) (about 8.8e-12 fs) is always within 1e-6.
+pub fn realised_pole_hz(pole_hz: f64, fs_hz: f64) -> f64 {
+    // a - 1 is exact (Sterbenz): ln_1p keeps the digits ln(a) would lose near 1.
+    -(pole_coefficient(pole_hz, fs_hz) - 1.0).ln_1p() * fs_hz / core::f64::consts::TAU
+}
+
 /// The smallest pole, Hz, that [`Tia::new`] can realise at `fs_hz`: below it
 /// `2 pi pole / fs` is under about 2^-54 (half the spacing of doubles below 1), so
 /// [`pole_coefficient`] rounds to exactly 1 and the gain `(1 - a) G` is exactly 0 at every
@@ -83,10 +92,10 @@ pub fn min_pole_hz(fs_hz: f64) -> f64 {
     f64::from_bits(h)
 }
 
-/// The rule a pole below [`min_pole_hz`] breaks.
-fn min_pole_rule(fs_hz: f64) -> String {
+/// The rule a pole below [`min_pole_hz`] breaks (the config's validation states it too).
+pub fn min_pole_rule(fs_hz: f64) -> String {
     format!(
-        "must be at least {:e} Hz at fs = {fs_hz} Hz: below it the discretised pole a = exp(-2 pi pole / fs) rounds to exactly 1 (2 pi pole / fs under about 2^-54, half the spacing of doubles below 1) and the TIA's gain (1 - a) x gain_ohm is exactly 0 at every frequency",
+        "must be at least {:e} Hz at a sample rate fs of {fs_hz} Hz: below it the TIA's discretised pole a = exp(-2 pi pole / fs) rounds to exactly 1 (2 pi pole / fs under about 2^-54, half the spacing of doubles below 1), so its gain (1 - a) x the transimpedance is exactly 0 at every frequency and no signal passes",
         min_pole_hz(fs_hz)
     )
 }
@@ -326,6 +335,30 @@ mod tests {
                 assert_eq!((e.stage, e.param), ("tia", "pole_hz"), "{e}");
                 assert!(e.rule.contains("exactly 0"), "{e}");
             }
+        }
+    }
+
+    #[test]
+    fn the_realised_pole_is_that_of_the_built_coefficient() {
+        let tau = core::f64::consts::TAU;
+        // Near the minimum a = 1 - k 2^-53 exactly, k = round(2 pi p / fs 2^53), and
+        // -ln(a) = k 2^-53 (1 + k 2^-54 + ...): the pole realised is k 2^-53 fs / (2 pi).
+        let fs = 240e3;
+        for (p, k) in [(2.13e-12, 1.0), (1e-11, 2.0), (4e-11, 9.0)] {
+            assert_eq!(k, (tau * p / fs * 2f64.powi(53)).round(), "{p}");
+            let want = k * 2f64.powi(-53) * fs / tau;
+            let got = realised_pole_hz(p, fs);
+            assert!((got / want - 1.0).abs() < 1e-14, "{p}: {got:e} vs {want:e}");
+        }
+        // 2.13e-12 Hz is realised as 4.24e-12 (+99 %), 1e-11 as 8.48e-12.
+        assert!((realised_pole_hz(2.13e-12, fs) / 4.2407e-12 - 1.0).abs() < 1e-4);
+        // Far from the minimum the quantisation is below 1e-6; the realised pole rebuilds
+        // the same coefficient.
+        for (p, fs) in [(60e3, 240e3), (12e6, 48e6), (1.0, 240e3), (3e-6, 240e3)] {
+            let got = realised_pole_hz(p, fs);
+            assert!((got / p - 1.0).abs() < 1e-6, "{p} at {fs}: {got:e}");
+            let a = pole_coefficient(p, fs);
+            assert_eq!(pole_coefficient(got, fs), a, "{p} at {fs}");
         }
     }
 

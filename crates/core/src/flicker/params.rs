@@ -22,6 +22,14 @@ pub struct FlickerParams {
     pub f_hi_hz: f64,
 }
 
+/// The lowest low corner, Hz, a flicker source at `fs_hz` is built for: its lowest pole's
+/// radius `exp(-2 pi f_lo / fs)` stays 1000 ulps below 1, so that pole is realised within
+/// 0.1 % (closer to 1 it rounds toward an integrator, and the lattice's pole count grows
+/// without bound).
+pub fn min_f_lo_hz(fs_hz: f64) -> f64 {
+    1000.0 * f64::EPSILON / 2.0 * fs_hz / core::f64::consts::TAU
+}
+
 impl FlickerParams {
     /// Checks every field, naming the key, the value and the rule.
     pub fn validate(&self) -> ParamResult<()> {
@@ -35,6 +43,18 @@ impl FlickerParams {
             ));
         }
         positive(STAGE, "f_lo_hz", self.f_lo_hz)?;
+        if self.f_lo_hz < min_f_lo_hz(self.fs_hz) {
+            return Err(ParamError::new(
+                STAGE,
+                "f_lo_hz",
+                self.f_lo_hz,
+                format!(
+                    "must be at least {:e} Hz at fs = {} Hz: below it the lowest pole's radius exp(-2 pi f_lo / fs) lies within 1000 ulps of 1 and is realised off by more than 0.1 %",
+                    min_f_lo_hz(self.fs_hz),
+                    self.fs_hz
+                ),
+            ));
+        }
         if !(self.f_hi_hz.is_finite() && self.f_hi_hz <= 0.5 * self.fs_hz) {
             return Err(ParamError::new(
                 STAGE,
@@ -103,6 +123,24 @@ mod tests {
         let a = flicker_adev(psd_at_1hz_from_bias_instability(b));
         assert!((a / b - ADEV_PER_BIAS_INSTABILITY).abs() < 1e-14);
         assert_eq!(psd_at_1hz_from_corner(4e-18, 250.0), 1e-15);
+    }
+
+    #[test]
+    fn the_lowest_corner_keeps_its_pole_realised_within_a_thousandth() {
+        let fs = ok().fs_hz;
+        let min = min_f_lo_hz(fs);
+        // 1 - exp(-x) at the bound is 1000 ulps of 1 (eps/2 each below 1), to rounding.
+        let gap = -(-core::f64::consts::TAU * min / fs).exp_m1();
+        assert!(
+            (gap / (1000.0 * f64::EPSILON / 2.0) - 1.0).abs() < 1e-3,
+            "{gap:e}"
+        );
+        let at = |f_lo_hz| FlickerParams { f_lo_hz, ..ok() };
+        assert!(at(min).validate().is_ok());
+        for f in [min * (1.0 - 1e-12), 1e-300, 1e-310] {
+            let e = at(f).validate().unwrap_err();
+            assert_eq!(e.param, "f_lo_hz", "{e}");
+        }
     }
 
     #[test]
