@@ -3,17 +3,17 @@
 //! cover the true values at about their stated rate, and terms absent from the record are not
 //! reported.
 
+mod common;
+
+use common::{pooled, rolled_off_record, TAU0};
 use gyroemu_analysis::allan::fit::{fit_noise_model, NoiseModelFit};
-use gyroemu_analysis::allan::{
-    noise_readings, noise_readings_settled, overlapping_adev, AllanPoint,
-};
+use gyroemu_analysis::allan::{noise_readings, noise_readings_settled, AllanPoint};
 use gyroemu_core::flicker::{psd_at_1hz_from_bias_instability, Flicker, FlickerParams};
 use gyroemu_core::noise::NoiseRng;
 use gyroemu_core::{f64x4, Stage};
 
 /// Sample interval (selfcal's block means), s, and samples of one of four pooled records
 /// (1000 s, as the worked example's Allan record).
-const TAU0: f64 = 0.01;
 const N: usize = 100_000;
 
 /// Four lanes of white rate noise (`n` deg/s*sqrt(s)), flicker of bias instability `b` deg/s
@@ -43,14 +43,7 @@ fn record(n: f64, b: f64, k: f64, seed: u64) -> Vec<AllanPoint> {
             .zip(y.to_array())
             .for_each(|(l, v)| l.push(v));
     }
-    let curves: Vec<Vec<AllanPoint>> = lanes.iter().map(|y| overlapping_adev(y, TAU0, 8)).collect();
-    (0..curves[0].len())
-        .map(|j| AllanPoint {
-            tau_s: curves[0][j].tau_s,
-            adev: (curves.iter().map(|c| c[j].adev.powi(2)).sum::<f64>() / 4.0).sqrt(),
-            n_terms: curves.iter().map(|c| c[j].n_terms).sum(),
-        })
-        .collect()
+    pooled(&lanes)
 }
 
 fn fit(curve: &[AllanPoint]) -> NoiseModelFit {
@@ -159,42 +152,6 @@ fn white_noise_alone_gives_n_and_no_floor_or_random_walk() {
     assert!(b_read <= 3 && k_read <= 3, "{b_read} {k_read}");
 }
 
-/// Four lanes of white rate noise (`n`) and flicker (`b`) through a first-order low-pass of
-/// time constant `t_res` (unit DC gain: a resonator's envelope), pooled.
-fn rolled_off_record(n: f64, b: f64, t_res: f64, seed: u64) -> Vec<AllanPoint> {
-    let mut rng = NoiseRng::new(core::array::from_fn(|l| 9000 + 4 * seed + l as u64));
-    let p = FlickerParams {
-        fs_hz: 1.0 / TAU0,
-        psd_at_1hz: psd_at_1hz_from_bias_instability(b),
-        f_lo_hz: 1e-4,
-        f_hi_hz: 0.5 / TAU0,
-    };
-    let mut fl = Flicker::<f64x4>::stationary(&p, || rng.normal_pair().0).unwrap();
-    let a = (-TAU0 / t_res).exp();
-    let mut state = f64x4::splat(0.0);
-    let mut lanes: [Vec<f64>; 4] = core::array::from_fn(|_| Vec::with_capacity(N));
-    let warm = (50.0 * t_res / TAU0) as usize;
-    for i in 0..N + warm {
-        let (w, x) = rng.normal_pair();
-        let input = fl.tick(w) + x * f64x4::splat(n / TAU0.sqrt());
-        state = state * f64x4::splat(a) + input * f64x4::splat(1.0 - a);
-        if i >= warm {
-            lanes
-                .iter_mut()
-                .zip(state.to_array())
-                .for_each(|(l, v)| l.push(v));
-        }
-    }
-    let curves: Vec<Vec<AllanPoint>> = lanes.iter().map(|y| overlapping_adev(y, TAU0, 8)).collect();
-    (0..curves[0].len())
-        .map(|j| AllanPoint {
-            tau_s: curves[0][j].tau_s,
-            adev: (curves.iter().map(|c| c[j].adev.powi(2)).sum::<f64>() / 4.0).sqrt(),
-            n_terms: curves.iter().map(|c| c[j].n_terms).sum(),
-        })
-        .collect()
-}
-
 #[test]
 fn past_a_roll_off_the_white_term_comes_back_within_its_interval() {
     // The worked example's curve: ARW 2.32 deg/sqrt(h) under a 90 deg/h floor, through a
@@ -207,7 +164,7 @@ fn past_a_roll_off_the_white_term_comes_back_within_its_interval() {
     let seeds = 20u64;
     let (mut covered, mut b_covered, mut three_covered) = (0, 0, 0);
     for seed in 0..seeds {
-        let curve = rolled_off_record(n, b, t_res, seed);
+        let curve = rolled_off_record(n, b, t_res, N, 9000, seed);
         let f = noise_readings_settled(&curve, 10.0 * t_res)
             .unwrap()
             .model_fit;
@@ -251,7 +208,7 @@ fn the_slope_readings_are_those_of_before_the_fit() {
     assert_eq!(r.bias_instability_deg_per_h.to_bits(), 4622622481712220071);
     assert_eq!(r.tau_at_min_s, 74.99);
     assert!(r.model_fit.arw_deg_per_rt_h.is_finite(), "{r:?}");
-    let curve = rolled_off_record(2.32 / 60.0, 90.0 / 3600.0, 0.042, 3);
+    let curve = rolled_off_record(2.32 / 60.0, 90.0 / 3600.0, 0.042, N, 9000, 3);
     let r = noise_readings_settled(&curve, 0.42).unwrap();
     assert!(
         r.arw_deg_per_rt_h.is_nan() && r.arw_warning.is_some(),

@@ -3,17 +3,15 @@
 //! bias instability read on the flat floor sqrt(2 ln 2 / pi) B = 0.664 B past a resonator's
 //! roll-off, and every reading that cannot be trusted refused (NaN) or flagged.
 
+mod common;
+
+use common::{rolled_off_record, TAU0};
 use gyroemu_analysis::allan::{
     noise_readings, noise_readings_settled, overlapping_adev, AllanPoint, NoiseReadings,
 };
-use gyroemu_core::flicker::{
-    psd_at_1hz_from_bias_instability, Flicker, FlickerParams, ADEV_PER_BIAS_INSTABILITY,
-};
-use gyroemu_core::noise::NoiseRng;
-use gyroemu_core::{f64x4, Stage};
+use gyroemu_core::flicker::ADEV_PER_BIAS_INSTABILITY;
 
 /// Sample interval (selfcal's block means), s.
-const TAU0: f64 = 0.01;
 /// Samples of one record: 200 s, four records pooled (selfcal's shortest Allan record).
 const N: usize = 20_000;
 const RECORDS: usize = 4;
@@ -139,45 +137,6 @@ fn no_white_noise_region_means_no_arw() {
     }
 }
 
-/// Four lanes of `N` samples at `TAU0` of white rate noise (N = `n_coef`, deg/s*sqrt(s)) plus
-/// flicker of bias instability `b_dps`, both through a first-order low-pass of time constant
-/// `t_res` (unit DC gain: a resonator's envelope), pooled as selfcal pools them.
-fn resonator_record(n_coef: f64, b_dps: f64, t_res: f64, seed: u64) -> Vec<AllanPoint> {
-    let p = FlickerParams {
-        fs_hz: 1.0 / TAU0,
-        psd_at_1hz: psd_at_1hz_from_bias_instability(b_dps),
-        f_lo_hz: 1e-4,
-        f_hi_hz: 0.5 / TAU0,
-    };
-    let sigma_white = n_coef / TAU0.sqrt();
-    let a = (-TAU0 / t_res).exp();
-    let mut rng = NoiseRng::new(core::array::from_fn(|l| 900 + 4 * seed + l as u64));
-    let mut fl = Flicker::<f64x4>::stationary(&p, || rng.normal_pair().0).unwrap();
-    let mut state = f64x4::splat(0.0);
-    let mut lanes: [Vec<f64>; 4] = core::array::from_fn(|_| Vec::with_capacity(N));
-    // Start the low-pass in its stationary regime: run it 50 time constants first.
-    let warm = (50.0 * t_res / TAU0) as usize;
-    for i in 0..N + warm {
-        let (w, x) = rng.normal_pair();
-        let input = fl.tick(w) + x * f64x4::splat(sigma_white);
-        state = state * f64x4::splat(a) + input * f64x4::splat(1.0 - a);
-        if i >= warm {
-            lanes
-                .iter_mut()
-                .zip(state.to_array())
-                .for_each(|(l, v)| l.push(v));
-        }
-    }
-    let curves: Vec<Vec<AllanPoint>> = lanes.iter().map(|y| overlapping_adev(y, TAU0, 8)).collect();
-    (0..curves[0].len())
-        .map(|j| AllanPoint {
-            tau_s: curves[0][j].tau_s,
-            adev: (curves.iter().map(|c| c[j].adev.powi(2)).sum::<f64>() / 4.0).sqrt(),
-            n_terms: curves.iter().map(|c| c[j].n_terms).sum(),
-        })
-        .collect()
-}
-
 #[test]
 fn seeded_records_through_a_resonator_read_b_past_the_roll_off() {
     // A resonator's 42 ms envelope time constant rolls the short taus off: below it the curve
@@ -202,7 +161,7 @@ fn seeded_records_through_a_resonator_read_b_past_the_roll_off() {
     // Flicker alone: no white noise, so no ARW.
     let mut ratios = Vec::new();
     for seed in 0..8u64 {
-        let r = readings(&resonator_record(0.0, b, t_res, seed));
+        let r = readings(&rolled_off_record(0.0, b, t_res, N, 900, seed));
         assert!(
             r.arw_deg_per_rt_h.is_nan() && r.arw_warning.is_some(),
             "{r:?}"
@@ -217,7 +176,7 @@ fn seeded_records_through_a_resonator_read_b_past_the_roll_off() {
     let n = 0.3 / 60.0;
     let mut ratios = Vec::new();
     for seed in 8..16u64 {
-        let r = readings(&resonator_record(n, b, t_res, seed));
+        let r = readings(&rolled_off_record(n, b, t_res, N, 900, seed));
         let arw = r.arw_deg_per_rt_h / (60.0 * n);
         assert!(arw.is_nan() || (arw - 1.0).abs() < 0.1, "{r:?}");
         assert!(r.tau_at_min_s > t_res, "{r:?}");
@@ -235,7 +194,7 @@ fn seeded_records_through_a_resonator_read_b_past_the_roll_off() {
     let n = (0.664 * b) * 30f64.sqrt();
     let mut arws = Vec::new();
     for seed in 16..24u64 {
-        let r = readings(&resonator_record(n, b, t_res, seed));
+        let r = readings(&rolled_off_record(n, b, t_res, N, 900, seed));
         let arw = r.arw_deg_per_rt_h / (60.0 * n);
         assert!((arw - 1.0).abs() < 0.15, "ARW {arw} x N: {r:?}");
         assert!(r.arw_tau_s[0] > 3.0 * t_res, "{r:?}");

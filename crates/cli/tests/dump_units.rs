@@ -10,17 +10,6 @@ use std::path::Path;
 
 /// A rotating sweep dumping every node (the default).
 const ALL_NODES: &str = r#"
-[device]
-f0_hz = 15000.0
-q = 1000.0
-angular_gain = 1.0
-[drive]
-f1 = 1.0
-f2 = 1.0
-[board]
-fs_hz = 240000.0
-lpf_cutoff_hz = 200.0
-decimation = 100
 [experiment]
 kind = "rotating"
 rates_dps = [900.0, 1800.0, 2700.0]
@@ -89,7 +78,7 @@ fn inspected(file: &Path, out: &Path) -> Vec<(String, String)> {
 fn every_dump_channel_has_the_unit_of_the_user_guides_table() {
     let want = guide_units();
     let dir = tempfile::tempdir().unwrap();
-    let cfg = config(dir.path(), "c.toml", ALL_NODES);
+    let cfg = config(dir.path(), "c.toml", &small_board(ALL_NODES));
     let out = dir.path().join("out");
     ok(gyroemu(&["run", s(&cfg), "--out", s(&out)], &[]));
     let mut seen = 0;

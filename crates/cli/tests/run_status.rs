@@ -10,17 +10,6 @@ use std::process::Output;
 
 /// A Coriolis sweep with a dump: four listed rates plus the implicit zero, equal windows.
 const DUMPED: &str = r#"
-[device]
-f0_hz = 15000.0
-q = 1000.0
-angular_gain = 1.0
-[drive]
-f1 = 1.0
-f2 = 1.0
-[board]
-fs_hz = 240000.0
-lpf_cutoff_hz = 200.0
-decimation = 100
 [experiment]
 kind = "coriolis"
 rates_dps = [25.0, 50.0, 75.0, 100.0]
@@ -38,7 +27,7 @@ fn run(cfg: &Path, out: &Path, extra: &[&str]) -> Output {
 #[test]
 fn every_file_a_run_or_a_shard_writes_is_in_its_wrote_list() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = config(dir.path(), "c.toml", DUMPED);
+    let cfg = config(dir.path(), "c.toml", &small_board(DUMPED));
     let mut dumped = 0;
     for i in 0..2 {
         // A fresh folder per shard: what is on disk is what the shard wrote.
@@ -84,7 +73,7 @@ fn number_after(line: &str, key: &str) -> f64 {
 #[test]
 fn a_resumed_run_states_the_work_it_has_left() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = config(dir.path(), "c.toml", DUMPED);
+    let cfg = config(dir.path(), "c.toml", &small_board(DUMPED));
     let out = dir.path().join("out");
     run(&cfg, &out, &["--shard", "0/2"]);
     // The whole run now resumes from shard 0's three points.

@@ -89,6 +89,26 @@ pub fn interrupted(args: &[&str], started: impl Fn() -> bool) -> Output {
     child.wait_with_output().unwrap()
 }
 
+/// A small ideal device (Q 1000 at 15 kHz) on a 240 kHz board with a 200 Hz low-pass and
+/// decimation 100, then `rest` (its `[experiment]` and any other section): a sweep of a
+/// few points in a fraction of a second.
+pub fn small_board(rest: &str) -> String {
+    format!("{SMALL_BOARD}{rest}")
+}
+
+const SMALL_BOARD: &str = r#"[device]
+f0_hz = 15000.0
+q = 1000.0
+angular_gain = 1.0
+[drive]
+f1 = 1.0
+f2 = 1.0
+[board]
+fs_hz = 240000.0
+lpf_cutoff_hz = 200.0
+decimation = 100
+"#;
+
 /// A Coriolis sweep with every noise source (so each point's random stream matters): nine
 /// listed rates plus the implicit zero, three lane groups.
 pub const NOISY: &str = r#"
