@@ -7,10 +7,11 @@ use crate::rules::Rules;
 use crate::schema::SWEEP_POINTS;
 use crate::validate::MAX_RUN_SAMPLES;
 
-/// Most frequencies a sweep may list.
-pub const MAX_SWEEP_POINTS: usize = 10_000;
+/// Most frequencies a sweep may list (the schema's range, one source for the parser's
+/// messages and these rules).
+pub const MAX_SWEEP_POINTS: usize = SWEEP_POINTS.hi as usize;
 /// Fewest frequencies: the resonance fit has four parameters (f0, Q and a complex gain).
-pub const MIN_SWEEP_POINTS: usize = 5;
+pub const MIN_SWEEP_POINTS: usize = SWEEP_POINTS.lo as usize;
 /// A mode's fit wants at least this many frequencies within one half-bandwidth of its
 /// resonance (fewer: a warning, f0 and Q then rest on the skirts).
 pub const MIN_POINTS_NEAR_RESONANCE: usize = 3;
