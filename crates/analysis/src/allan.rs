@@ -6,8 +6,14 @@
 pub mod fit;
 
 use fit::{fit_noise_model, NoiseModelFit};
+
 use gyroemu_core::flicker::ADEV_PER_BIAS_INSTABILITY;
 use serde::Serialize;
+
+/// deg/sqrt(h) per deg/s*sqrt(s): the readings' angle random walk unit.
+const ARW_UNIT: f64 = 60.0;
+/// deg/h per deg/s: the readings' bias instability unit.
+const B_UNIT: f64 = 3600.0;
 
 /// Independent differences (`n_terms / m`) a point must rest on to enter either reading. With
 /// flicker noise an overlapping Allan deviation from them has relative standard error about
@@ -239,7 +245,7 @@ pub fn noise_readings_settled(curve: &[AllanPoint], settled_tau_s: f64) -> Optio
                     sl += w * (p.adev * p.tau_s.sqrt()).ln();
                 }
                 (
-                    60.0 * (sl / sw).exp(),
+                    ARW_UNIT * (sl / sw).exp(),
                     [curve[i].tau_s, curve[j].tau_s],
                     None,
                 )
@@ -299,7 +305,7 @@ pub fn noise_readings_settled(curve: &[AllanPoint], settled_tau_s: f64) -> Optio
                 } else {
                     None
                 };
-                (floor / ADEV_PER_BIAS_INSTABILITY * 3600.0, tau_min, warning)
+                (floor / ADEV_PER_BIAS_INSTABILITY * B_UNIT, tau_min, warning)
             }
         };
     let model_fit = match (any_reliable, start < end) {

@@ -58,9 +58,8 @@ impl IntRange {
 pub(crate) const LPF_ORDER: IntRange = IntRange { lo: 1, hi: 8 };
 /// `board.dac_bits`, `board.adc_bits`.
 pub(crate) const CONVERTER_BITS: IntRange = IntRange { lo: 2, hi: 32 };
-/// `sweep.points`.
-/// Fewest: the resonance fit has four parameters (f0, Q and a complex gain). Most: a bound on
-/// the sweep's work and files.
+/// `sweep.points`: at least five, since the resonance fit has four parameters (f0, Q and a
+/// complex gain); at most a bound on the sweep's work and files.
 pub(crate) const SWEEP_POINTS: IntRange = IntRange { lo: 5, hi: 10_000 };
 /// `pll.mode`: the mode whose output the PLL locks on.
 pub(crate) const PLL_MODE: IntRange = IntRange { lo: 1, hi: 2 };

@@ -5,7 +5,7 @@ use crate::dump_figures::write_dump_figures;
 use crate::dump_set::read_dump_set;
 use crate::error::{check_problems, create_dir, ReportError};
 use crate::sweep_report::{
-    fit_series, line_span, sweep_figure, theory_abscissae, theory_series, write_run,
+    fit_series, line_span, phases, sweep_figure, theory_abscissae, theory_series, write_run,
 };
 use gyroemu_analysis::bandwidth::{
     bandwidth, BandwidthPoint, BANDWIDTH_AMPLITUDE_DPS, BANDWIDTH_FREQS_HZ,
@@ -462,12 +462,11 @@ fn job_index(jobs: &[Job], name: &str) -> usize {
 /// its slope is the self-calibrated Coriolis slope beside the rate table's.
 pub fn fig6(cfg: &Config, cor: &SweepResult, rot: &SweepResult) -> Figure {
     let lambda = cfg.device.angular_gain;
-    let mode1 = |r: &SweepResult| -> Vec<f64> { r.points.iter().map(|p| p.phase_deg[0]).collect() };
     let cor_x: Vec<f64> = cor.points.iter().map(|p| p.rate_dps).collect();
     let rot_x: Vec<f64> = rot.points.iter().map(|p| p.rate_dps / lambda).collect();
     let all_x: Vec<f64> = cor_x.iter().chain(&rot_x).copied().collect();
     let span = line_span(&all_x);
-    let (cor_y, rot_y) = (mode1(cor), mode1(rot));
+    let (cor_y, rot_y) = (phases(cor, 0), phases(rot, 0));
     let rot_fit = LineFit {
         slope: rot.fit[0].slope * lambda,
         slope_std_err: rot.fit[0].slope_std_err * lambda,

@@ -239,7 +239,7 @@ fn points_name(r: &SweepResult, k: usize) -> String {
 }
 
 /// One mode's measured phases, in the order of the points.
-fn phases(r: &SweepResult, k: usize) -> Vec<f64> {
+pub(crate) fn phases(r: &SweepResult, k: usize) -> Vec<f64> {
     r.points.iter().map(|p| p.phase_deg[k]).collect()
 }
 

@@ -4,7 +4,7 @@
 //! quantisation Q), which is linear in their squares. It reads N where the curve never runs
 //! along -1/2 (a flicker floor under the white region), which the slope reading cannot.
 
-use super::AllanPoint;
+use super::{AllanPoint, ARW_UNIT, B_UNIT};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
@@ -175,12 +175,8 @@ pub fn sig3(v: f64) -> String {
     }
 }
 
-/// deg/sqrt(h) per deg/s*sqrt(s).
-const ARW_UNIT: f64 = 60.0;
-/// deg/h per deg/s.
-const B_UNIT: f64 = 3600.0;
 /// deg/h/sqrt(h) per deg/s/sqrt(s): 3600 x 60.
-const K_UNIT: f64 = 216_000.0;
+const K_UNIT: f64 = B_UNIT * ARW_UNIT;
 
 /// The terms of the model, in the order of the coefficients (N^2, B^2, K^2, Q^2).
 #[derive(Clone, Copy, Debug, PartialEq)]
