@@ -48,20 +48,29 @@ fn modulator_blocks_reset_lanes_and_latency() {
             };
             check::latency_matches("am_modulator", lat, |x| s.tick(path(x))[0], 8, 0.0);
         }
-        // Four operating points: the unit-gain shortcut in one lane only must not leak.
-        let scalars: Vec<AmModulator<f64>> = [(1.0, 1.0), (0.3, -2.0), (1e-3, 7.5), (0.0, 1.1)]
-            .iter()
-            .map(|&(a, b)| AmModulator::new(pattern, a, b).unwrap())
-            .collect();
-        check::lanes_match(
-            "am_modulator",
-            &AmModulator::<f64x4>::from_lanes(&scalars),
-            &scalars,
-            drive_input,
-            lane_of,
-            |y, l| y.map(|v| v.lane(l)),
-            check::same,
-        );
+        // Four operating points: the unit-gain shortcut in one lane only must not leak; nor
+        // may it be taken when every lane's gains differ from 1, or only one drive's are 1.
+        let lane_sets: [[(f64, f64); 4]; 4] = [
+            [(1.0, 1.0), (0.3, -2.0), (1e-3, 7.5), (0.0, 1.1)],
+            [(0.3, -2.0), (1e-3, 7.5), (0.0, 1.1), (2.0, 0.5)],
+            [(1.0, 0.5), (1.0, -2.0), (1.0, 7.5), (1.0, 1.1)],
+            [(1.0, 1.0); 4],
+        ];
+        for set in lane_sets {
+            let scalars: Vec<AmModulator<f64>> = set
+                .iter()
+                .map(|&(a, b)| AmModulator::new(pattern, a, b).unwrap())
+                .collect();
+            check::lanes_match(
+                "am_modulator",
+                &AmModulator::<f64x4>::from_lanes(&scalars),
+                &scalars,
+                drive_input,
+                lane_of,
+                |y, l| y.map(|v| v.lane(l)),
+                check::same,
+            );
+        }
     }
 }
 
