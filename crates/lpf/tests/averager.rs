@@ -276,5 +276,23 @@ fn window_response_is_the_direct_sum_of_its_weights() {
                 "{w:?} at {f} cycles/sample: {got} against {want}"
             );
         }
+        // Nothing past the window: the weights there are 0, so a sum over any longer span is
+        // the window's; and the weights add up to its span (Hann: half of it, the mean of
+        // sin^2).
+        let far = w.samples() + 1 + (next() * 1e6) as u64;
+        for j in [w.samples(), w.samples() + 1, far] {
+            assert_eq!(w.weight(j), 0.0, "{w:?} at sample {j}");
+        }
+        let total: f64 = (0..w.samples()).map(|j| w.weight(j)).sum();
+        let want = match w {
+            Window::Boxcar { .. } => w.span(),
+            // sum cos(2 pi (j + 1/2) / n) over a period is 0, except at n = 1 (cos pi).
+            Window::Hann { n: 1 } => 1.0,
+            Window::Hann { n } => n as f64 / 2.0,
+        };
+        assert!(
+            (total - want).abs() < 1e-9 * want,
+            "{w:?}: {total} against {want}"
+        );
     }
 }

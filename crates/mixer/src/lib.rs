@@ -60,4 +60,37 @@ mod tests {
             assert!((turns - turns.round()).abs() < 1e-12);
         }
     }
+
+    #[test]
+    fn wrap_pi_keeps_the_bits_of_an_angle_already_on_its_branch() {
+        // |x| < pi: x / 2 pi rounds to 0, so nothing may be added and taken back (a round
+        // trip through x + 2 pi would lose x's low bits).
+        for k in 1..2000 {
+            let x = PI * (k as f64 / 2000.0).powi(3);
+            for x in [x, -x, x * 1e-9, -x * 1e-9] {
+                assert_eq!(wrap_pi(x).to_bits(), x.to_bits(), "{x}");
+            }
+        }
+    }
+
+    #[test]
+    fn wrap_pi_stays_on_its_branch_next_to_an_odd_multiple_of_pi() {
+        // x - 2 pi round(x / 2 pi) can land an ulp or so above pi far from 0: the last branch
+        // must take it to the lower end, the same angle.
+        let mut upper_end_hit = 0;
+        for k in -3000i64..3000 {
+            let c = (k as f64 + 0.5) * TAU;
+            for d in -40i64..40 {
+                let x = f64::from_bits((c.to_bits() as i64 + d) as u64);
+                let w = wrap_pi(x);
+                assert!(w > -PI && w <= PI, "{x} -> {w}");
+                let turns = (x - w) / TAU;
+                assert!((turns - turns.round()).abs() < 1e-12, "{x} -> {w}");
+                let raw = x - TAU * (x / TAU).round();
+                upper_end_hit += usize::from(raw > PI);
+            }
+        }
+        // The case the branch exists for does occur here.
+        assert!(upper_end_hit > 0);
+    }
 }

@@ -105,3 +105,16 @@ fn single_mixer_mode2_sin_reference_is_even_in_theta() {
         assert!((dc - a * theta.cos()).abs() < 1e-12);
     }
 }
+
+#[test]
+fn the_reported_reference_phase_is_the_one_the_factors_use() {
+    // The board shares one mixer's factors between its two channels when their reported
+    // phases are equal, so the report must be the phase the factors rotate by.
+    for phi in [0.0, -FRAC_PI_2, 0.3, PI, 7.25, -40.0] {
+        let m = Stage1Mixer::<f64>::new(phi).unwrap();
+        assert_eq!(m.ref_phase_rad().to_bits(), phi.to_bits());
+        let (c2, s2) = m.factors(Complex64::new(1.0, 0.0));
+        assert!((c2 - 2.0 * phi.cos()).abs() < 1e-14, "{phi}");
+        assert!((s2 + 2.0 * phi.sin()).abs() < 1e-14, "{phi}");
+    }
+}

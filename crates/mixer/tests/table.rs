@@ -90,3 +90,20 @@ fn whole_period_averages_are_the_harmonics() {
     let ch = table_channel(n as isize + 1, 0, n);
     assert_eq!(&acc[ch..], &vec![0.0; acc.len() - ch][..]);
 }
+
+#[test]
+fn channels_in_use_are_exactly_those_a_tick_writes() {
+    // Each harmonic -N..=N gives I and Q for both modes: 4 (2N + 1) channels, the first ones
+    // of the output, and the rest stay 0 (the averager sums only the channels in use).
+    let z = [Iq::new(0.3, -0.7), Iq::new(-1.1, 0.4)];
+    let b = Complex64::from_polar(1.0, 0.61);
+    for n in 0..=MAX_TABLE_HARMONIC {
+        let mut mix = TableMixer::<f64>::new(n).unwrap();
+        assert_eq!(mix.harmonics(), n);
+        let used = mix.channels();
+        assert_eq!(used, 4 * (2 * n + 1));
+        let out = mix.tick((z, (b.re, b.im)));
+        assert!(out[..used].iter().all(|&v| v != 0.0), "harmonics {n}");
+        assert!(out[used..].iter().all(|&v| v == 0.0), "harmonics {n}");
+    }
+}

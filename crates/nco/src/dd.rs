@@ -109,4 +109,41 @@ mod tests {
         let (_, s) = cos_sin(PI.div_f(6.0));
         assert!(((s.hi - 0.5) + s.lo).abs() < 1e-30);
     }
+
+    /// `x` in units of 2^-90, exactly (every value below is on that grid).
+    fn units(x: f64) -> i128 {
+        let u = x * 2f64.powi(90);
+        assert_eq!(u, u.trunc(), "{x} is off the 2^-90 grid");
+        u as i128
+    }
+
+    #[test]
+    fn add_is_the_exact_sum_to_about_2_to_the_minus_104() {
+        // Integers as the reference: hi on a 2^-20 grid, lo a fraction of hi's ulp on a 2^-90
+        // grid, so both sums are exact in i128 (below 2^122).
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |bits: u32| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> (64 - bits)) as i64
+        };
+        let mut dd = || {
+            let hi = (next(50) - (1 << 49)) as f64 * 2f64.powi(-20);
+            let lo = (next(40) - (1 << 39)) as f64 * 2f64.powi(-90);
+            let r = quick_two_sum(hi, lo);
+            (r, units(hi) + units(lo))
+        };
+        for _ in 0..20_000 {
+            let ((a, ea), (b, eb)) = (dd(), dd());
+            let r = a.add(b);
+            let (got, want) = (units(r.hi) + units(r.lo), ea + eb);
+            assert!(
+                (got - want).abs() <= (want.abs() >> 100) + 1,
+                "{a:?} + {b:?} = {r:?}: {got} against {want}"
+            );
+            // Normalised: lo is below half an ulp of hi.
+            assert_eq!(r.hi + r.lo, r.hi, "{r:?}");
+        }
+    }
 }

@@ -265,3 +265,42 @@ fn bad_parameters_are_refused_naming_them() {
     assert_eq!(agc.tick(Complex64::new(0.0, 0.0)), g);
     assert!(!agc.has_signal() && agc.error_np() == 0.0);
 }
+
+#[test]
+fn the_reported_state_is_what_the_last_tick_saw() {
+    let p = params(); // setpoint 1, gains in [0.25, 4], no signal at |z| <= 1e-3
+    let mut agc = Agc::new(&p).unwrap();
+    assert_eq!(agc.setpoint(), 1.0);
+    assert_eq!(agc.latency_samples(), 0.0);
+    assert!(!agc.has_signal() && !agc.at_limit() && agc.error_np() == 0.0);
+
+    // The error is ln(setpoint / |z|) in neper, and the first output already follows it
+    // (latency 0): an amplitude below the setpoint raises the gain, one above lowers it.
+    let g_low = agc.clone().tick(Complex64::from_polar(0.5, 1.0));
+    let g_high = agc.clone().tick(Complex64::from_polar(2.0, -2.0));
+    assert!(g_low > 1.0 && g_high < 1.0, "{g_low} {g_high}");
+    agc.tick(Complex64::from_polar(0.5, 1.0));
+    assert!(agc.has_signal());
+    assert!((agc.error_np() - 2f64.ln()).abs() < 1e-15);
+    agc.set_setpoint(3.0).unwrap();
+    assert_eq!(agc.setpoint(), 3.0);
+    agc.tick(Complex64::new(0.0, 0.5));
+    assert!((agc.error_np() - 6f64.ln()).abs() < 1e-15);
+
+    // At exactly min_amplitude there is no signal: the gain holds and the error reads 0.
+    let held = agc.gain();
+    assert_eq!(agc.tick(Complex64::new(p.min_amplitude, 0.0)), held);
+    assert!(!agc.has_signal());
+    assert_eq!(agc.error_np(), 0.0);
+
+    // A large amplitude drives the gain down to min_gain, where it sits and says so; an
+    // amplitude a little below the setpoint then lets it leave the floor.
+    agc.reset();
+    for _ in 0..2000 {
+        agc.tick(Complex64::new(1e3, 0.0));
+    }
+    assert_eq!(agc.gain(), p.min_gain);
+    assert!(agc.at_limit());
+    agc.tick(Complex64::new(0.9, 0.0));
+    assert!(agc.gain() > p.min_gain && !agc.at_limit(), "{}", agc.gain());
+}

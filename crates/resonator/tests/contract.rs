@@ -71,6 +71,24 @@ fn lanes_of_four_different_plants_are_bit_exact() {
 }
 
 #[test]
+fn lanes_past_the_slice_repeat_its_last_plant() {
+    // A group with fewer points than lanes: the spare lanes run the last point's plant.
+    let lane = |v: [f64x4; 2], l: usize| v.map(|x| x.lane(l));
+    for given in 1..4 {
+        let scalars: Vec<Resonator<f64>> = (0..4).map(|l| plant(l.min(given - 1))).collect();
+        check::lanes_match(
+            "resonator",
+            &Resonator::<f64x4>::from_lanes(&scalars[..given]),
+            &scalars,
+            force,
+            |x, l| lane(*x, l),
+            |y, l| (lane(y.q, l), lane(y.v, l), lane(y.current, l)),
+            view,
+        );
+    }
+}
+
+#[test]
 fn every_force_path_matches_the_held_steady_state_response() {
     // Low Q so the impulse response decays within n: tau = Q / (pi f0) = 1.6 ms, 25 samples.
     let p = ResonatorParams {
