@@ -66,3 +66,21 @@ fn general_shift_matches_closed_form() {
     let nominal = PhaseShifter::new(FRAC_PI_2).unwrap();
     assert!((nominal.rotation() - PhaseShifter::quadrature().rotation()).norm() < 1e-16);
 }
+
+#[test]
+fn shifter_reports_the_rotation_it_applies() {
+    for shift in [0.0, 0.25, core::f64::consts::FRAC_PI_2, -2.0, 9.0] {
+        let sh = PhaseShifter::new(shift).unwrap();
+        let rot = sh.rotation();
+        // e^{-j shift}, and what apply multiplies by (the image of 1).
+        assert!(
+            (rot - Complex64::from_polar(1.0, -shift)).norm() < 1e-15,
+            "{shift}"
+        );
+        assert_eq!(sh.apply(Complex64::new(1.0, 0.0)), rot);
+    }
+    assert_eq!(
+        PhaseShifter::quadrature().rotation(),
+        Complex64::new(0.0, -1.0)
+    );
+}

@@ -189,3 +189,30 @@ fn rate_split_step_equals_the_full_time_varying_step() {
     let mixed = [plain.clone(), coupled, plain.clone(), plain];
     assert!(!Resonator::<f64x4>::from_lanes(&mixed).rate_split_by_mode());
 }
+
+/// The state a tick leaves is `Phi x + Gamma u` of the reported matrices at the reported
+/// design rate, and `state` reports it.
+#[test]
+fn state_after_a_tick_is_phi_x_plus_gamma_u() {
+    for l in 0..4 {
+        let (p, omega) = lane_params(l);
+        let mut r = Resonator::<f64>::new(&p, omega).unwrap();
+        assert_eq!(r.omega_z_rad_s(), omega);
+        let x = [2e-7, -1e-7, 3e-4, 5e-5];
+        r.set_state(x);
+        assert_eq!(r.state(), x);
+        let u = [0.7, -0.2];
+        r.tick(u);
+        let (phi, gamma) = (r.phi(), r.gamma());
+        let got = r.state();
+        for i in 0..4 {
+            let want: f64 = (0..4).map(|j| phi[i][j] * x[j]).sum::<f64>()
+                + (0..2).map(|k| gamma[i][k] * u[k]).sum::<f64>();
+            let scale: f64 = (0..4).map(|j| (phi[i][j] * x[j]).abs()).sum::<f64>()
+                + (0..2).map(|k| (gamma[i][k] * u[k]).abs()).sum::<f64>();
+            assert!((got[i] - want).abs() <= 1e-14 * scale, "lane {l} state {i}");
+        }
+        r.reset();
+        assert_eq!(r.state(), [0.0; 4]);
+    }
+}
