@@ -184,6 +184,36 @@ mod tests {
     }
 
     #[test]
+    fn realisable_refuses_each_rule_it_states_on_hand_made_sections() {
+        let margin = 1e-15;
+        // A stable low-pass section with unit DC gain passes: poles 0.5 +- 0.3j.
+        let (a1, a2) = (-1.0, 0.34);
+        let g = 1.0 + a1 + a2;
+        assert!(realisable(&Coefs::biquad(g, 0.0, 0.0, a1, a2), margin).is_ok());
+        // Complex poles outside the unit circle that the two sums alone would let through
+        // (1 +- a1 + a2 > 0): only |a2| < 1 refuses them (|z| = sqrt(1.5)).
+        let (a1, a2) = (0.0, 1.5);
+        assert!(poles(a1, a2).iter().all(|p| p.norm() > 1.0));
+        let c = Coefs::biquad(1.0 + a1 + a2, 0.0, 0.0, a1, a2);
+        assert!(realisable(&c, margin).unwrap_err().contains("unit circle"));
+        // A pole at z = 1 (1 + a1 + a2 = 0) and one at z = -1 (1 - a1 + a2 = 0).
+        for (a1, a2) in [(-1.5, 0.5), (1.5, 0.5)] {
+            let c = Coefs::biquad(1.0, 0.0, 0.0, a1, a2);
+            assert!(realisable(&c, margin).unwrap_err().contains("unit circle"));
+        }
+        // Stable but with a DC gain of 2, or 1.02: refused; 1.005 passes (within 1 %).
+        let (a1, a2) = (-1.0, 0.34);
+        let g = 1.0 + a1 + a2;
+        for (k, ok) in [(2.0, false), (1.02, false), (1.005, true)] {
+            let r = realisable(&Coefs::biquad(k * g, 0.0, 0.0, a1, a2), margin);
+            assert_eq!(r.is_ok(), ok, "DC gain {k}: {r:?}");
+        }
+        // Not finite.
+        let c = Coefs::biquad(f64::NAN, 0.0, 0.0, a1, a2);
+        assert!(realisable(&c, margin).unwrap_err().contains("not finite"));
+    }
+
+    #[test]
     fn every_accepted_section_has_its_poles_inside_the_unit_circle() {
         let fs = 1.0e6;
         let mut checked = 0;

@@ -149,3 +149,33 @@ fn process_block_on_random_chunkings_equals_tick_and_reset_reproduces() {
         }
     }
 }
+
+/// A generic caller's tick: the `Stage` trait's, not the inherent method.
+fn stage_tick<T: Stage<Input = f64, Output = Option<f64>>>(s: &mut T, x: f64) -> Option<f64> {
+    s.tick(x)
+}
+
+#[test]
+fn the_stage_trait_ticks_as_the_decimator_does() {
+    // Generic code (the contract harness, the board) reaches the decimator through `Stage`:
+    // the same outputs at the same instants as the inherent `tick`, mean of M for the dump.
+    for mode in modes() {
+        for m in [1usize, 3, 8] {
+            let mut direct = Decimator::<f64>::new(mode, m, FS).unwrap();
+            let mut generic = direct.clone();
+            let mut outputs = 0;
+            for n in 0..400 {
+                let x = (0.37 * n as f64).sin() + 0.25;
+                let (a, b) = (direct.tick(x), stage_tick(&mut generic, x));
+                assert_eq!(
+                    a.map(f64::to_bits),
+                    b.map(f64::to_bits),
+                    "{mode:?} M {m} n {n}"
+                );
+                assert_eq!(b.is_some(), (n + 1) % m == 0, "{mode:?} M {m} n {n}");
+                outputs += usize::from(b.is_some());
+            }
+            assert_eq!(outputs, 400 / m);
+        }
+    }
+}

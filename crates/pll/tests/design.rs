@@ -6,7 +6,7 @@
 
 use core::f64::consts::{PI, TAU};
 use gyroemu_core::{Complex64, Response, Stage};
-use gyroemu_pll::{LoopDesign, Pll, PllParams};
+use gyroemu_pll::{LoopDesign, Pll, PllParams, MAX_NATURAL_PER_UPDATE};
 
 /// The continuous closed-loop poles `s = -zeta wn +- wn sqrt(zeta^2 - 1)`.
 fn continuous_poles(natural_hz: f64, zeta: f64) -> [Complex64; 2] {
@@ -275,4 +275,40 @@ fn bad_parameters_are_refused_naming_them() {
     // The defaults: lock over one natural period.
     assert_eq!(ok.lock_updates, 1000);
     assert!((PllParams::tau_s_of(1e3, 1e3) - 2.0 * 1e3 / (TAU * 1e3)).abs() < 1e-15);
+}
+
+#[test]
+fn each_rule_holds_its_bound_on_the_side_its_message_states() {
+    let (carrier, rate, zeta, tau) = (1e3, 1000.0, 0.7, 0.5);
+    // "at most MAX x update_rate_hz": the bound itself is accepted.
+    let edge = MAX_NATURAL_PER_UPDATE * rate;
+    assert!(Pll::new(&PllParams::new(carrier, rate, edge, zeta, tau)).is_ok());
+    let above = f64::from_bits(edge.to_bits() + 1);
+    assert!(Pll::new(&PllParams::new(carrier, rate, above, zeta, tau)).is_err());
+    // "at least 1 / (4 pi tau_s)" for natural_hz x damping: 2 zeta wn tau = 1 exactly passes.
+    let fnat = 2.0;
+    let wn = TAU * fnat;
+    let mut t = 1.0 / (2.0 * zeta * wn);
+    for _ in 0..8 {
+        if 2.0 * zeta * wn * t < 1.0 {
+            t = f64::from_bits(t.to_bits() + 1);
+        }
+    }
+    assert_eq!(
+        2.0 * zeta * wn * t,
+        1.0,
+        "no tau_s hits the edge exactly here"
+    );
+    assert!(Pll::new(&PllParams::new(carrier, rate, fnat, zeta, t)).is_ok());
+    let below = f64::from_bits(t.to_bits() - 1);
+    assert!(2.0 * zeta * wn * below < 1.0);
+    assert!(Pll::new(&PllParams::new(carrier, rate, fnat, zeta, below)).is_err());
+    // "above carrier_hz" and "below carrier_hz": the carrier itself is refused by both.
+    let mut p = PllParams::new(carrier, rate, 2.0, zeta, tau);
+    p.max_hz = Some(carrier);
+    assert_eq!(Pll::new(&p).unwrap_err().param, "max_hz");
+    p.max_hz = Some(f64::from_bits(carrier.to_bits() + 1));
+    assert!(Pll::new(&p).is_ok());
+    p.min_hz = Some(carrier);
+    assert_eq!(Pll::new(&p).unwrap_err().param, "min_hz");
 }
