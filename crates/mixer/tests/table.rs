@@ -56,6 +56,15 @@ fn an_envelope_around_zero_has_no_phase() {
     // e^{j theta} winds once around 0: its phase is not periodic.
     let h = harmonics(2, |t| Complex64::from_polar(1.0, t));
     assert!(phase_fundamental(&h).is_nan());
+    // Whatever its starting phase and direction, and with a small tone beside it.
+    for phi0 in [-3.0, -1.0, 0.5, 2.0, 3.1] {
+        for k in [0usize, 2] {
+            let mut h = vec![Complex64::new(0.0, 0.0); 3];
+            h[k] = Complex64::from_polar(1.0, phi0);
+            h[1] = Complex64::new(0.2, 0.1);
+            assert!(phase_fundamental(&h).is_nan(), "phi0 {phi0}, harmonic {k}");
+        }
+    }
 }
 
 #[test]
