@@ -79,4 +79,68 @@ mod tests {
         // 5e-324 (smallest subnormal) over itself times 2^-3: 1/8 turn.
         assert_eq!(ratio_to_word(5e-324, 8.0 * 5e-324), 1i64 << 61);
     }
+
+    #[test]
+    fn signs_of_both_operands_count() {
+        assert_eq!(ratio_to_word(1.0, -4.0), -(1i64 << 62));
+        assert_eq!(ratio_to_word(-1.0, -4.0), 1i64 << 62);
+        assert_eq!(ratio_to_word(-3.0, 16.0), -(3i64 << 60));
+    }
+
+    #[test]
+    fn words_below_one_round_to_nearest_ties_to_even() {
+        let p = |e: i32| 2f64.powi(e);
+        // ratio x 2^64 = 0.5, 0.75, 1.25, 1.5, 2.5, 0.25: the last steps before 0.
+        for (num, den, want) in [
+            (1.0, p(65), 0),
+            (3.0, p(66), 1),
+            (5.0, p(66), 1),
+            (3.0, p(65), 2),
+            (5.0, p(65), 2),
+            (1.0, p(66), 0),
+            (-3.0, p(66), -1),
+        ] {
+            assert_eq!(ratio_to_word(num, den), want, "{num} / {den}");
+        }
+    }
+
+    /// `x 2^s`, by steps of 2^+-100 (2^s itself is not a double for s < -1074 or > 1023).
+    fn scale(mut x: f64, mut s: i32) -> f64 {
+        while s != 0 {
+            let k = s.clamp(-100, 100);
+            x *= 2f64.powi(k);
+            s -= k;
+        }
+        x
+    }
+
+    #[test]
+    fn scaling_both_operands_by_a_power_of_two_keeps_the_word() {
+        // num / den is unchanged, so the word must be too, down into the subnormals (20-bit
+        // mantissas stay exact there) and mixing a subnormal with a normal operand.
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let mut checked = 0;
+        for _ in 0..2000 {
+            let den = ((next() >> 44) | 1) as f64; // up to 2^20
+            let below = (0.49 * den).floor().max(1.0); // |num| < den / 2, an integer
+            let sign = if next() & 1 == 0 { 1.0 } else { -1.0 };
+            let num = sign * ((next() >> 44) as f64 % below);
+            let want = ratio_to_word(num, den);
+            for s in [-1070, -1060, -1045, -1030, -1000, -500, 300, 900] {
+                let (n, d) = (scale(num, s), scale(den, s));
+                if scale(n, -s) != num || scale(d, -s) != den || !d.is_finite() {
+                    continue;
+                }
+                assert_eq!(ratio_to_word(n, d), want, "{num} / {den} at 2^{s}");
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 16_000);
+    }
 }
