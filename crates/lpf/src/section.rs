@@ -134,3 +134,30 @@ impl<S: Sample> SectionCoefs<S> {
         y
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_one_pole_is_the_biquad_it_describes() {
+        // k / (1 - (1 - k) z^-1): the direct-form fields (read by the stability rules and
+        // the pole check) describe the same filter as the sums the response uses.
+        for k in [1e-9, 0.01, 0.5, 0.999] {
+            let c = Coefs::one_pole(k);
+            let d = Coefs::biquad(k, 0.0, 0.0, -(1.0 - k), 0.0);
+            assert_eq!(
+                (c.b0, c.b1, c.b2, c.a1, c.a2),
+                (d.b0, d.b1, d.b2, d.a1, d.a2)
+            );
+            // Its pole is at z = 1 - k.
+            assert_eq!(-c.a1, 1.0 - k);
+            for u in [0.0, 0.3, -1.7] {
+                let u = Complex64::new(u, 0.2);
+                let (a, b) = (c.response(u), d.response(u));
+                assert!((a - b).norm() <= 1e-12 * b.norm(), "k {k}, u {u}");
+            }
+            assert_eq!(c.dc_gain(), 1.0);
+        }
+    }
+}

@@ -19,6 +19,7 @@ fn butterworth_magnitude_equals_the_prewarped_closed_form() {
         for fc in [1.0, 20.0, 100.0, 250.0, 300.0, 450.0] {
             let lp = LowPass::<f64>::new(bw(order, fc), fs).unwrap();
             assert_eq!(lp.sections(), order.div_ceil(2));
+            assert_eq!(lp.fs_hz(), fs);
             for i in 0..=997 {
                 let f = i as f64 * 0.5;
                 let r = ((PI * f / fs).tan() / (PI * fc / fs).tan()).powi(2 * order as i32);
