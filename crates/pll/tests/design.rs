@@ -312,3 +312,26 @@ fn each_rule_holds_its_bound_on_the_side_its_message_states() {
     p.min_hz = Some(carrier);
     assert_eq!(Pll::new(&p).unwrap_err().param, "min_hz");
 }
+
+#[test]
+fn the_integrators_share_is_what_the_output_holds_beyond_the_proportional_term() {
+    // Unlimited, the output is carrier + (Kp e + sum Ki T e) / (2 pi): the integrator's share
+    // after n updates of errors e_i is sum Ki T e_i / (2 pi), and the rest is Kp e / (2 pi).
+    let mut pll = Pll::new(&PllParams::new(1e3, 1000.0, 2.0, 0.7, 0.5)).unwrap();
+    let (kp, ki_t) = (pll.design().kp_per_s, pll.design().ki_t_per_s);
+    assert_eq!(pll.integrator_hz(), 0.0);
+    let mut sum = 0.0;
+    for k in 0..50 {
+        let out = pll.tick(Complex64::from_polar(2.0, 0.3 - 0.01 * k as f64));
+        let e = pll.phase_error_rad();
+        sum += ki_t * e;
+        assert!(!pll.at_limit());
+        let want = sum / TAU;
+        assert!(
+            (pll.integrator_hz() - want).abs() <= 1e-12 * want.abs().max(1e-3),
+            "update {k}"
+        );
+        let rest = out - 1e3 - pll.integrator_hz();
+        assert!((rest - kp * e / TAU).abs() <= 1e-9, "update {k}: {rest}");
+    }
+}
