@@ -3,7 +3,7 @@
 //! median density against their definitions. Hand-made spectra where the rule is about
 //! bins, seeded noise where it is about statistics.
 
-use gyroemu_spectrum::{find_tones, tone_near, welch, Psd};
+use gyroemu_spectrum::{find_tones, scale_exponent, tone_near, welch, Psd, SpectrumError};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::PI;
@@ -111,4 +111,25 @@ fn median_density_of_white_noise_sits_just_below_two_sigma_squared_over_fs() {
     // The density itself is power over the window's noise bandwidth.
     let d = psd.density();
     assert!((d[100] - psd.power[100] / psd.enbw_hz).abs() <= 1e-15 * d[100]);
+}
+
+#[test]
+fn four_samples_are_the_shortest_record() {
+    assert!(welch(&[1.0, -2.0, 0.5, 3.0], 100.0, None).is_ok());
+    assert!(matches!(
+        welch(&[1.0, -2.0, 0.5], 100.0, None),
+        Err(SpectrumError::TooShort { got: 3, min: 4 })
+    ));
+}
+
+#[test]
+fn samples_are_scaled_only_outside_2_to_the_plus_minus_300() {
+    for peak in [1e-90, 0.5, 10.0, 3e5, 1e90, 0.0, f64::INFINITY, f64::NAN] {
+        assert_eq!(scale_exponent(peak), 0, "{peak}");
+    }
+    // Beyond, about log2(peak), within +-1000.
+    assert_eq!(scale_exponent(2f64.powi(400)), 400);
+    assert_eq!(scale_exponent(3.0 * 2f64.powi(-400)), -399);
+    assert_eq!(scale_exponent(f64::MAX), 1000);
+    assert_eq!(scale_exponent(5e-324), -1000);
 }
