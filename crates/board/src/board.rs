@@ -126,6 +126,37 @@ pub(crate) fn pattern(shape: Shape) -> DrivePattern {
     }
 }
 
+/// The lanes of one board may start at the input samples `starts` of the time axis
+/// ([`Board::with_starts`]): they share the carrier oscillator, so its phase word must be the
+/// same at every start (its step times each difference of starts is a whole number of turns:
+/// at `fs = 16 f0`, any multiple of 16 samples). Exact integer arithmetic on the words.
+pub fn starts_share_carrier(p: &BoardParams, starts: &[u64]) -> bool {
+    let Ok(carrier) = Nco::new(p.carrier_hz, p.fs_hz(), 0.0) else {
+        return false;
+    };
+    let word = |n: u64| carrier.step_word().wrapping_mul(n);
+    starts.iter().all(|&n| word(n) == word(starts[0]))
+}
+
+/// The rules of [`Board::with_starts`]: starts that share the carrier, and none but 0 on a
+/// rate table.
+fn check_starts(p: &BoardParams, starts: &[u64]) -> Result<(), ParamError> {
+    let bad = |v: String, rule: &str| Err(ParamError::new(crate::params::STAGE, "starts", v, rule));
+    if let (Shape::RateTable { .. }, Some(&n)) = (p.shape, starts.iter().find(|&&n| n != 0)) {
+        return bad(
+            n.to_string(),
+            "a rate table's lanes start at sample 0 (its table phase counts from there)",
+        );
+    }
+    if !starts_share_carrier(p, starts) {
+        return bad(
+            format!("{starts:?}"),
+            "the lanes share the carrier: its phase must be the same at every start (a whole number of carrier turns apart)",
+        );
+    }
+    Ok(())
+}
+
 /// Per-sample work shared by every lane; all fields are built before the first sample.
 #[derive(Clone)]
 pub struct Board<S: Sample> {
@@ -182,7 +213,33 @@ impl<S: Sample> Board<S> {
     /// `i` draws noise stream `streams[i]` (a sweep passes each point's index, so its noise
     /// does not depend on the lane group or shard that runs it).
     pub fn new(p: &BoardParams, rates_rad_s: &[f64], streams: &[u64]) -> Result<Self, ParamError> {
-        Self::build(p, rates_rad_s, None, streams)
+        Self::build(p, rates_rad_s, None, streams, &[0])
+    }
+
+    /// [`Board::new`] with lane `i` starting at input sample `starts[i]` of the run's time
+    /// axis instead of at 0: its oscillators (the modulation's phase at that sample, and the
+    /// shared carrier's) are those of a board that has run `starts[i]` samples, while its
+    /// plant, filters and noise start from rest, as after power-up. So a lane holds the bits
+    /// of a board built with the single start `starts[i]`, and a long point's window can run
+    /// as segments side by side, each settling anew (`gyroemu-experiment`'s split sweeps).
+    /// The lanes share one carrier, so the starts must agree on its phase
+    /// ([`starts_share_carrier`]); a rate table counts its phase from sample 0, so its lanes
+    /// start there. A refusal names the rule.
+    pub fn with_starts(
+        p: &BoardParams,
+        rates_rad_s: &[f64],
+        streams: &[u64],
+        starts: &[u64],
+    ) -> Result<Self, ParamError> {
+        if starts.len() != rates_rad_s.len() {
+            return Err(ParamError::new(
+                crate::params::STAGE,
+                "starts",
+                starts.len(),
+                format!("must list one start per point ({})", rates_rad_s.len()),
+            ));
+        }
+        Self::build(p, rates_rad_s, None, streams, starts)
     }
 
     /// [`Board::new`] for a rate-table board whose lane `i` follows its own table at
@@ -213,7 +270,7 @@ impl<S: Sample> Board<S> {
         for &f in table_hz {
             gyroemu_core::error::positive(crate::params::STAGE, "table_freq_hz", f)?;
         }
-        Self::build(p, rates_rad_s, Some(table_hz), streams)
+        Self::build(p, rates_rad_s, Some(table_hz), streams, &[0])
     }
 
     fn build(
@@ -221,6 +278,7 @@ impl<S: Sample> Board<S> {
         rates_rad_s: &[f64],
         table_hz: Option<&[f64]>,
         streams: &[u64],
+        starts: &[u64],
     ) -> Result<Self, ParamError> {
         let lanes = rates_rad_s.len();
         if lanes == 0 || lanes > S::LANES || streams.len() != lanes {
@@ -236,11 +294,18 @@ impl<S: Sample> Board<S> {
         }
         p.validate()?;
         let lane_rate = |i: usize| rates_rad_s[i.min(lanes - 1)];
+        let lane_start = |i: usize| starts[i.min(starts.len() - 1)];
+        check_starts(p, starts)?;
         let fs = p.fs_hz();
-        let carrier = Nco::new(p.carrier_hz, fs, 0.0)?;
+        let mut carrier = Nco::new(p.carrier_hz, fs, 0.0)?;
+        carrier.jump(starts[0]);
         let modulation: Vec<Nco> = (0..S::LANES)
-            .map(|i| Nco::new(modulation_hz(p.shape, lane_rate(i)), fs, 0.0))
-            .collect::<Result<_, _>>()?;
+            .map(|i| {
+                let mut n = Nco::new(modulation_hz(p.shape, lane_rate(i)), fs, 0.0)?;
+                n.jump(lane_start(i));
+                Ok(n)
+            })
+            .collect::<Result<_, ParamError>>()?;
         let table: Vec<Nco> = match table_hz {
             Some(f) => (0..S::LANES)
                 .map(|i| table_nco_at(f[i.min(lanes - 1)], fs))

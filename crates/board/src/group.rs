@@ -52,6 +52,31 @@ impl GroupBoard {
         Self::with_width(width_for(rates_rad_s.len()), p, rates_rad_s, streams)
     }
 
+    /// [`Board::with_starts`] (lane `i` starting at input sample `starts[i]`) in the lanes
+    /// [`GroupBoard::new`] picks.
+    pub fn with_starts(
+        p: &BoardParams,
+        rates_rad_s: &[f64],
+        streams: &[u64],
+        starts: &[u64],
+    ) -> Result<Self, ParamError> {
+        Ok(Self(match width_for(rates_rad_s.len()) {
+            #[cfg(target_arch = "x86_64")]
+            8 => Lanes::Eight(Box::new(Board::with_starts(
+                p,
+                rates_rad_s,
+                streams,
+                starts,
+            )?)),
+            _ => Lanes::Four(Box::new(Board::with_starts(
+                p,
+                rates_rad_s,
+                streams,
+                starts,
+            )?)),
+        }))
+    }
+
     /// [`Board::with_table_hz`] (a rate table per lane) in the lanes [`GroupBoard::new`]
     /// picks.
     pub fn with_table_hz(
