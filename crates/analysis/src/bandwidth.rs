@@ -3,7 +3,7 @@
 //! low-pass of THEORY.md section 3 (DC gain 2 Q lambda / w0, corner f0/(2Q)).
 
 use gyroemu_config::{Config, RateTable};
-use gyroemu_experiment::{run_table_sweeps, SweepError};
+use gyroemu_experiment::{run_table_sweeps, SweepError, SweepResult};
 use gyroemu_theory::rate_table_gain;
 
 /// Rate-table frequencies of the bandwidth sweep, Hz (the corner is f0/(2Q) = 0.21 Hz at
@@ -35,13 +35,24 @@ pub fn bandwidth(
     base: &Config,
     group_threads: Option<usize>,
 ) -> Result<Vec<BandwidthPoint>, SweepError> {
-    let d = &base.device;
-    let configs: Vec<Config> = BANDWIDTH_FREQS_HZ
+    let runs = run_table_sweeps(&bandwidth_configs(base)?, group_threads)?;
+    Ok(bandwidth_points(base, &runs))
+}
+
+/// The configs of the bandwidth sweep's points, one per [`BANDWIDTH_FREQS_HZ`], validated: what
+/// [`bandwidth`] runs as table sweeps.
+pub fn bandwidth_configs(base: &Config) -> Result<Vec<Config>, SweepError> {
+    BANDWIDTH_FREQS_HZ
         .iter()
         .map(|&f| bandwidth_config(base, f))
-        .collect::<Result<_, SweepError>>()?;
-    let runs = run_table_sweeps(&configs, group_threads)?;
-    Ok(BANDWIDTH_FREQS_HZ
+        .collect()
+}
+
+/// The bandwidth sweep's points from the runs of [`bandwidth_configs`], in order, beside the
+/// first-order model's gain and lag.
+pub fn bandwidth_points(base: &Config, runs: &[SweepResult]) -> Vec<BandwidthPoint> {
+    let d = &base.device;
+    BANDWIDTH_FREQS_HZ
         .iter()
         .zip(runs)
         .map(|(&f, r)| {
@@ -55,7 +66,7 @@ pub fn bandwidth(
                 theory_lag_deg: ph.to_degrees(),
             }
         })
-        .collect())
+        .collect()
 }
 
 /// The config of the bandwidth sweep's point at table frequency `f_hz`.

@@ -8,8 +8,11 @@ pub mod dump;
 pub mod fit;
 pub mod leaks;
 pub mod lock;
+pub mod prepared;
 pub mod progress;
+pub mod queue;
 pub mod readout;
+pub mod split;
 pub mod sweep;
 pub mod table_sweep;
 pub mod work;
@@ -17,13 +20,14 @@ pub mod work;
 pub use dump::{dump_extra, DumpPlan};
 pub use leaks::Stage2Leaks;
 pub use lock::{lock_config_carrier, pll_params, resolve_lock, CarrierLock};
+pub use prepared::{run_sweep, run_sweep_with};
 pub use progress::{Progress, Quiet, Reporter, Task, Written};
 pub use readout::{
     post_process, post_process_with, theory_deg, Compensation, PointResult, SweepResult,
 };
 pub use sweep::{
-    dump_point, finish_sweep, finish_sweep_with, run_sweep, run_sweep_with, OnDump, OnGroup,
-    SweepError, SweepOptions, SweepRun, DUMP_STEM,
+    dump_point, finish_sweep, finish_sweep_with, OnDump, OnGroup, SweepError, SweepOptions,
+    SweepRun, DUMP_STEM,
 };
 pub use table_sweep::run_table_sweeps;
 pub use work::{sweep_work, Work, MAX_POINT_SAMPLES};

@@ -1,18 +1,16 @@
-//! A sweep over operating points: the board runs sample by sample, four or eight points per
-//! SIMD lane group (eight on a CPU with AVX-512), groups in parallel; any subset (a shard, a resumed run) gives every point the bits
-//! of a whole run. `readout.rs` turns the averages into phases.
+//! A sweep over operating points: what it is asked (`SweepOptions`), what it returns
+//! (`SweepRun`) and how its lane results are read out (`finish_sweep`). `prepared.rs` runs it:
+//! the board sample by sample, four or eight points per SIMD lane group (eight on a CPU with
+//! AVX-512), groups in parallel; any subset (a shard, a resumed run) gives every point the
+//! bits of a whole run. `readout.rs` turns the averages into phases.
 
 use crate::dump::DumpPlan;
 use crate::leaks::Stage2Leaks;
 use crate::progress::{Progress, Written};
 use crate::readout::{post_process_with, SweepResult};
-use gyroemu_board::{
-    lane_groups, max_lanes, GroupBoard, LaneResult, NonFinite, Point, Probe, RunOptions,
-    CANONICAL_LANES,
-};
+use gyroemu_board::{LaneResult, NonFinite, Point, Probe, CANONICAL_LANES};
 use gyroemu_config::Config;
 use gyroemu_core::ParamError;
-use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -51,17 +49,6 @@ pub fn dump_point(cfg: &Config) -> Option<usize> {
     let rate = d.rate_dps.unwrap_or(f64::NAN);
     let rates = cfg.emulated_rates_dps();
     Some(rates.iter().position(|&r| r == rate).unwrap_or(0))
-}
-
-/// Runs the whole sweep and reads it out. `dump_dir` receives the probe's files when the
-/// config asks for a dump.
-pub fn run_sweep(
-    cfg: &Config,
-    progress: Progress,
-    dump_dir: Option<&Path>,
-) -> Result<SweepResult, SweepError> {
-    let run = run_sweep_with(cfg, progress, dump_dir, SweepOptions::default())?;
-    finish_sweep(cfg, &run.lanes)
 }
 
 /// Called with each finished lane group's points, `(index in emulated_rates_dps, lane
@@ -105,6 +92,12 @@ pub struct SweepOptions<'a> {
     /// only after the dump is written. `reproduce` gives it: its longest group then no longer
     /// waits on its dump at the end.
     pub on_dump_early: Option<OnDump<'a>>,
+    /// Cuts each long point's window into segments that run as lanes of their own, each
+    /// settling anew ([`crate::split`]: the cut depends on the config alone, and only sweeps
+    /// that can be split are), so that one long point does not keep a run on one thread. Taken
+    /// only by a whole run: with `done`, `only`, `cancel` or `on_group` (point by point
+    /// results) the points run whole.
+    pub split: bool,
 }
 
 /// The points a [`run_sweep_with`] call has, and whether it was cancelled.
@@ -131,7 +124,7 @@ pub struct SweepRun {
 
 impl SweepRun {
     /// Lists a dump written.
-    fn add_dump(&mut self, w: DumpWritten) {
+    pub(crate) fn add_dump(&mut self, w: DumpWritten) {
         self.dump_bytes += w.bytes;
         self.dump_write_s += w.seconds;
         self.dump_files.extend(w.files);
@@ -180,226 +173,8 @@ pub fn add_group_progress(
     progress(all, total);
 }
 
-/// Runs the points of a sweep that `opts` assigns and that are not done yet, in lane groups
-/// of four or eight ([`lane_groups`]), groups in parallel. A group runs as long as its longest
-/// window, so the points are packed by window length (longest first, index order among
-/// equals) and a short window does not idle a lane beside a long one. Each point draws the noise stream of its index, and
-/// lanes do not interact, so any subset or grouping gives every point the same bits.
-pub fn run_sweep_with(
-    cfg: &Config,
-    progress: Progress,
-    dump_dir: Option<&Path>,
-    opts: SweepOptions,
-) -> Result<SweepRun, SweepError> {
-    let rates = cfg.emulated_rates_dps();
-    let todo: Vec<usize> = match &opts.only {
-        Some(only) => {
-            let mut v: Vec<usize> = only.iter().copied().filter(|&i| i < rates.len()).collect();
-            v.sort_unstable();
-            v.dedup();
-            v
-        }
-        None => (0..rates.len()).collect(),
-    }
-    .into_iter()
-    .filter(|i| !opts.done.contains_key(i))
-    .collect();
-    let plan = |i: usize| cfg.plan_point(rates[i]);
-    let mut todo = todo;
-    todo.sort_by_key(|&i| core::cmp::Reverse(plan(i).window.samples()));
-    let n_settle = cfg.n_settle_out();
-    let mut groups: Vec<&[usize]> = Vec::new();
-    let mut rest = &todo[..];
-    let threads = opts
-        .group_threads
-        .unwrap_or_else(rayon::current_num_threads);
-    for size in lane_groups(todo.len(), threads, max_lanes()) {
-        let (g, r) = rest.split_at(size);
-        groups.push(g);
-        rest = r;
-    }
-    let samples_of =
-        |g: &[usize]| group_samples(cfg, &g.iter().map(|&i| plan(i)).collect::<Vec<_>>());
-    let total: u64 = groups.iter().map(|g| samples_of(g)).sum();
-    let done = AtomicU64::new(0);
-    let dump = opts
-        .dump
-        .clone()
-        .or_else(|| DumpPlan::from_config(cfg))
-        .map(|d| {
-            let idx = rates.iter().position(|&r| r == d.rate_dps).unwrap_or(0);
-            (idx, d)
-        });
-    // Raised by the caller's flag (copied at each progress report) or by a failed group.
-    let stop = Arc::new(AtomicBool::new(false));
-    let user_cancel = || {
-        opts.cancel
-            .as_ref()
-            .is_some_and(|c| c.load(Ordering::Relaxed))
-    };
-    // Build every board first, so a bad parameter fails before any sample is computed.
-    let params = cfg.board_params();
-    let mut boards = Vec::with_capacity(groups.len());
-    for g in &groups {
-        let r: Vec<f64> = g.iter().map(|&i| plan(i).rate_rad_s).collect();
-        // Each point draws the noise stream of its index in the emulated rates.
-        let streams: Vec<u64> = g.iter().map(|&i| i as u64).collect();
-        let mut board = GroupBoard::new(&params, &r, &streams)?;
-        board.set_cancel(stop.clone());
-        boards.push(board);
-    }
-    // Per group: skipped (None), or its points, their work, whether all finished, and its
-    // probe when it recorded the dump (then the dump is written and the points passed on
-    // after the parallel section).
-    type Finished = (Vec<(usize, LaneResult)>, u64, bool, Option<Probe>);
-    type Outcome = Option<Result<Finished, SweepError>>;
-    // The dump written early (`on_dump_early`), by the task its recorded probe spawned.
-    let early: std::sync::Mutex<Option<Result<DumpWritten, SweepError>>> = Default::default();
-    let early_on = opts.on_dump_early.zip(dump_dir);
-    let outcomes: Vec<Outcome> = rayon::in_place_scope(|scope| {
-        let early = &early;
-        let hand_on = |p: &Probe| {
-            if let Some((then, dir)) = early_on {
-                let p = p.clone();
-                scope.spawn(move |_| {
-                    let w = write_dump(&p, dir, Some(then));
-                    *early.lock().unwrap_or_else(|e| e.into_inner()) = Some(w);
-                });
-            }
-        };
-        boards
-            .into_par_iter()
-            .zip(groups.par_iter())
-            // A group per task, so a thread freed by other work can take any group not started.
-            .with_max_len(1)
-            .map(|(mut board, g)| {
-                if user_cancel() {
-                    stop.store(true, Ordering::Relaxed);
-                }
-                if stop.load(Ordering::Relaxed) {
-                    return None;
-                }
-                let points: Vec<Point> = g.iter().map(|&i| plan(i)).collect();
-                let mut probe = dump.as_ref().and_then(|(idx, plan)| {
-                    g.iter()
-                        .position(|i| i == idx)
-                        .map(|lane| (lane, plan.probe(cfg, lane)))
-                });
-                let last = AtomicU64::new(0);
-                let report = |n: u64| {
-                    add_group_progress(&done, &last, n, total, progress);
-                    if user_cancel() {
-                        stop.store(true, Ordering::Relaxed);
-                    }
-                };
-                let run_opts = RunOptions {
-                    probe: probe.as_mut().map(|(_, p)| p),
-                    on_probe_recorded: early_on.map(|_| &hand_on as &(dyn Fn(&Probe) + Sync)),
-                    ..Default::default()
-                };
-                let res = board.run(n_settle, &points, run_opts, &report);
-                let finished = (|| {
-                    let out = res?;
-                    // A raised flag may have cut the run short: only the lanes whose own window
-                    // ended before it hold their points' results. The dumped lane waits for a
-                    // whole run, which writes its dump.
-                    let whole = out.complete.iter().all(|&c| c);
-                    let pts: Vec<(usize, LaneResult)> = g
-                        .iter()
-                        .copied()
-                        .zip(out.lanes)
-                        .zip(&out.complete)
-                        .enumerate()
-                        .filter(|(lane, (_, &c))| {
-                            whole || (c && probe.as_ref().is_none_or(|(l, _)| l != lane))
-                        })
-                        .map(|(_, (p, _))| p)
-                        .collect();
-                    // A whole group that recorded the dump hands its probe on.
-                    let probe = probe
-                        .filter(|_| whole && dump_dir.is_some())
-                        .map(|(_, p)| p);
-                    if let (None, Some(f), false) = (&probe, opts.on_group, pts.is_empty()) {
-                        f(&pts).map_err(SweepError::Output)?;
-                    }
-                    let work = if whole {
-                        samples_of(g) * g.len() as u64
-                    } else {
-                        0
-                    };
-                    Ok((pts, work, whole, probe))
-                })();
-                if finished.is_err() {
-                    stop.store(true, Ordering::Relaxed);
-                }
-                Some(finished)
-            })
-            .collect()
-    });
-    let mut early = early.into_inner().unwrap_or_else(|e| e.into_inner());
-    let mut run = SweepRun {
-        lanes: opts.done,
-        computed: Vec::new(),
-        cancelled: false,
-        point_samples: 0,
-        dump_files: Vec::new(),
-        dump_bytes: 0,
-        dump_made: Vec::new(),
-        dump_write_s: 0.0,
-    };
-    let mut first_err = None;
-    for o in outcomes {
-        match o {
-            None => run.cancelled = true,
-            Some(Err(e)) => {
-                first_err.get_or_insert(e);
-            }
-            Some(Ok((pts, work, whole, probe))) => {
-                if let (Some(p), Some(dir)) = (probe, dump_dir) {
-                    // Written early (its task ran within the scope above), else now.
-                    let written = early
-                        .take()
-                        .unwrap_or_else(|| write_dump(&p, dir, early_on.map(|(then, _)| then)));
-                    // The dump first, then its group's points: a failed write leaves them
-                    // unsaved, so a rerun records the dump again.
-                    let written = written.and_then(|w| match opts.on_group {
-                        Some(f) => f(&pts).map(|_| w).map_err(SweepError::Output),
-                        None => Ok(w),
-                    });
-                    match written {
-                        Ok(w) => run.add_dump(w),
-                        Err(e) => {
-                            first_err.get_or_insert(e);
-                            continue;
-                        }
-                    }
-                }
-                run.cancelled |= !whole;
-                run.point_samples += work;
-                for (i, lane) in pts {
-                    run.computed.push(i);
-                    run.lanes.insert(i, lane);
-                }
-            }
-        }
-    }
-    // A dump written early for a group a cancel stopped: its files stay, listed.
-    match early {
-        Some(Ok(w)) => run.add_dump(w),
-        Some(Err(e)) => {
-            first_err.get_or_insert(e);
-        }
-        None => {}
-    }
-    if let Some(e) = first_err {
-        return Err(e);
-    }
-    run.computed.sort_unstable();
-    Ok(run)
-}
-
 /// A dump written, and the files made from it.
-struct DumpWritten {
+pub(crate) struct DumpWritten {
     files: Vec<PathBuf>,
     made: Vec<PathBuf>,
     bytes: u64,
@@ -407,7 +182,11 @@ struct DumpWritten {
 }
 
 /// Writes `p` into `dir`, then runs `then` on its files.
-fn write_dump(p: &Probe, dir: &Path, then: Option<OnDump>) -> Result<DumpWritten, SweepError> {
+pub(crate) fn write_dump(
+    p: &Probe,
+    dir: &Path,
+    then: Option<OnDump>,
+) -> Result<DumpWritten, SweepError> {
     let t = Instant::now();
     let files = p
         .write(dir, DUMP_STEM)
@@ -470,6 +249,7 @@ pub fn finish_sweep_with(
 #[cfg(test)]
 mod resume_tests {
     use super::*;
+    use crate::prepared::{run_sweep, run_sweep_with};
     use std::sync::Mutex;
 
     fn small() -> Config {

@@ -4,7 +4,7 @@
 //! two groups. Every point keeps the bits of its own sweep.
 
 use crate::readout::SweepResult;
-use crate::sweep::{finish_sweep, SweepError};
+use crate::sweep::{finish_sweep, group_samples, SweepError};
 use gyroemu_board::{
     lane_groups, max_lanes, BoardParams, GroupBoard, LaneResult, RunOptions, Shape,
 };
@@ -12,11 +12,16 @@ use gyroemu_config::Config;
 use gyroemu_mixer::MAX_TABLE_HARMONIC;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
+use std::sync::Mutex;
 
 /// A finished lane: its sweep, its index there and its result.
 type Finished = (usize, usize, LaneResult);
 
+/// A group's finished lanes, or why it failed.
+type GroupOutcome = Result<Vec<Finished>, SweepError>;
+
 /// One point of one of the sweeps.
+#[derive(Clone)]
 struct Job {
     /// The sweep (index in the caller's configs) and the point's index in its rates.
     sweep: usize,
@@ -47,106 +52,177 @@ pub fn run_table_sweeps(
     cfgs: &[Config],
     group_threads: Option<usize>,
 ) -> Result<Vec<SweepResult>, SweepError> {
-    let lanes = run_table_lanes(cfgs, group_threads)?;
-    cfgs.iter()
-        .zip(&lanes)
-        .map(|(cfg, l)| finish_sweep(cfg, l))
-        .collect()
+    let tables = PreparedTables::new(cfgs, group_threads)?;
+    tables.run_all();
+    tables.finish()
 }
 
 /// The lane results of [`run_table_sweeps`], per config by point index: those of
 /// [`crate::run_sweep_with`] on each config alone, bit for bit.
+#[cfg(test)]
 fn run_table_lanes(
     cfgs: &[Config],
     group_threads: Option<usize>,
 ) -> Result<Vec<BTreeMap<usize, LaneResult>>, SweepError> {
-    // Classes of configs that can share a group, each with its points.
-    let mut classes: Vec<((BoardParams, u64), Vec<Job>)> = Vec::new();
-    for (sweep, cfg) in cfgs.iter().enumerate() {
-        let p = cfg.board_params();
-        let Shape::RateTable { freq_hz } = p.shape else {
-            return Err(SweepError::Param(gyroemu_core::ParamError::new(
-                "experiment",
-                "rate_table",
-                "constant",
-                "a table sweep takes rate-table configs only",
-            )));
-        };
-        let key = board_key(cfg);
-        let jobs = match classes.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, jobs)) => jobs,
-            None => {
-                classes.push((key, Vec::new()));
-                &mut classes.last_mut().expect("just pushed").1
-            }
-        };
-        for (index, &r) in cfg.emulated_rates_dps().iter().enumerate() {
-            jobs.push(Job {
-                sweep,
-                index,
-                point: cfg.plan_point(r),
-                table_hz: freq_hz,
-                harmonics: p.table_harmonics,
-            });
-        }
-    }
-    let threads = group_threads.unwrap_or_else(rayon::current_num_threads);
-    // Every group's board first, so a bad parameter fails before any sample is computed.
-    let mut groups: Vec<(GroupBoard, Vec<&Job>, u64)> = Vec::new();
-    for ((key, n_settle), jobs) in &classes {
-        let mut order: Vec<&Job> = jobs.iter().collect();
-        // Longest window first, so a group's lanes end together (as in a sweep).
-        order.sort_by_key(|j| core::cmp::Reverse(j.point.window.samples()));
-        let mut rest = &order[..];
-        for size in lane_groups(order.len(), threads, max_lanes()) {
-            let (g, r) = rest.split_at(size);
-            rest = r;
-            // The board demodulates the most harmonics any of its lanes needs; a lane's
-            // harmonics do not depend on how many others are demodulated beside them.
-            let p = BoardParams {
-                shape: Shape::RateTable {
-                    freq_hz: g[0].table_hz,
-                },
-                table_harmonics: g.iter().map(|j| j.harmonics).max().unwrap_or(1),
-                ..*key
+    let tables = PreparedTables::new(cfgs, group_threads)?;
+    tables.run_all();
+    tables.lanes()
+}
+
+/// The table sweeps of [`run_table_sweeps`] with their lane groups planned and boards built,
+/// to run in any order on any threads ([`crate::queue`]).
+pub struct PreparedTables<'c> {
+    cfgs: &'c [Config],
+    /// Each group's board (until its run takes it), its points and its settling.
+    groups: Vec<(Mutex<Option<GroupBoard>>, Vec<Job>, u64)>,
+    outcomes: Vec<Mutex<Option<GroupOutcome>>>,
+}
+
+impl<'c> PreparedTables<'c> {
+    /// Plans the lane groups of `cfgs` and builds every board (so a bad parameter fails
+    /// before any sample is computed).
+    pub fn new(cfgs: &'c [Config], group_threads: Option<usize>) -> Result<Self, SweepError> {
+        // Classes of configs that can share a group, each with its points.
+        let mut classes: Vec<((BoardParams, u64), Vec<Job>)> = Vec::new();
+        for (sweep, cfg) in cfgs.iter().enumerate() {
+            let p = cfg.board_params();
+            let Shape::RateTable { freq_hz } = p.shape else {
+                return Err(SweepError::Param(gyroemu_core::ParamError::new(
+                    "experiment",
+                    "rate_table",
+                    "constant",
+                    "a table sweep takes rate-table configs only",
+                )));
             };
-            let rates: Vec<f64> = g.iter().map(|j| j.point.rate_rad_s).collect();
-            let table_hz: Vec<f64> = g.iter().map(|j| j.table_hz).collect();
-            // Each point draws the stream of its index in its own sweep.
-            let streams: Vec<u64> = g.iter().map(|j| j.index as u64).collect();
-            let board = GroupBoard::with_table_hz(&p, &rates, &table_hz, &streams)?;
-            groups.push((board, g.to_vec(), *n_settle));
+            let key = board_key(cfg);
+            let jobs = match classes.iter_mut().find(|(k, _)| *k == key) {
+                Some((_, jobs)) => jobs,
+                None => {
+                    classes.push((key, Vec::new()));
+                    &mut classes.last_mut().expect("just pushed").1
+                }
+            };
+            for (index, &r) in cfg.emulated_rates_dps().iter().enumerate() {
+                jobs.push(Job {
+                    sweep,
+                    index,
+                    point: cfg.plan_point(r),
+                    table_hz: freq_hz,
+                    harmonics: p.table_harmonics,
+                });
+            }
         }
+        let threads = group_threads.unwrap_or_else(rayon::current_num_threads);
+        let mut groups = Vec::new();
+        for ((key, n_settle), jobs) in &classes {
+            let mut order: Vec<&Job> = jobs.iter().collect();
+            // Longest window first, so a group's lanes end together (as in a sweep).
+            order.sort_by_key(|j| core::cmp::Reverse(j.point.window.samples()));
+            let mut rest = &order[..];
+            for size in lane_groups(order.len(), threads, max_lanes()) {
+                let (g, r) = rest.split_at(size);
+                rest = r;
+                // The board demodulates the most harmonics any of its lanes needs; a lane's
+                // harmonics do not depend on how many others are demodulated beside them.
+                let p = BoardParams {
+                    shape: Shape::RateTable {
+                        freq_hz: g[0].table_hz,
+                    },
+                    table_harmonics: g.iter().map(|j| j.harmonics).max().unwrap_or(1),
+                    ..*key
+                };
+                let rates: Vec<f64> = g.iter().map(|j| j.point.rate_rad_s).collect();
+                let table_hz: Vec<f64> = g.iter().map(|j| j.table_hz).collect();
+                // Each point draws the stream of its index in its own sweep.
+                let streams: Vec<u64> = g.iter().map(|j| j.index as u64).collect();
+                let board = GroupBoard::with_table_hz(&p, &rates, &table_hz, &streams)?;
+                let jobs = g.iter().map(|&j| j.clone()).collect();
+                groups.push((Mutex::new(Some(board)), jobs, *n_settle));
+            }
+        }
+        Ok(Self {
+            cfgs,
+            outcomes: groups.iter().map(|_| Mutex::new(None)).collect(),
+            groups,
+        })
     }
-    let done: Vec<Result<Vec<Finished>, SweepError>> = groups
-        .into_par_iter()
-        .with_max_len(1)
-        .map(|(mut board, g, n_settle)| {
-            let points: Vec<_> = g.iter().map(|j| j.point).collect();
-            let out = board.run(n_settle, &points, RunOptions::default(), &|_| {})?;
-            Ok(g.iter()
-                .zip(out.lanes)
-                .map(|(j, mut lane)| {
-                    // Harmonics beyond the point's own are zero in its own sweep.
-                    for md in 0..2 {
-                        for (i, h) in lane.table_z[md].iter_mut().enumerate() {
-                            if i.abs_diff(MAX_TABLE_HARMONIC) > j.harmonics {
-                                *h = Default::default();
+
+    /// The lane groups to run.
+    pub fn groups(&self) -> usize {
+        self.groups.len()
+    }
+
+    /// The input samples group `g` runs.
+    pub fn group_samples(&self, g: usize) -> u64 {
+        let (_, jobs, _) = &self.groups[g];
+        let points: Vec<_> = jobs.iter().map(|j| j.point).collect();
+        group_samples(&self.cfgs[jobs[0].sweep], &points)
+    }
+
+    /// Runs group `g` (once) on this thread.
+    pub fn run_group(&self, g: usize) {
+        let (board, jobs, n_settle) = &self.groups[g];
+        let Some(mut board) = lock(board).take() else {
+            return;
+        };
+        let points: Vec<_> = jobs.iter().map(|j| j.point).collect();
+        let done = board
+            .run(*n_settle, &points, RunOptions::default(), &|_| {})
+            .map_err(SweepError::from)
+            .map(|out| {
+                jobs.iter()
+                    .zip(out.lanes)
+                    .map(|(j, mut lane)| {
+                        // Harmonics beyond the point's own are zero in its own sweep.
+                        for md in 0..2 {
+                            for (i, h) in lane.table_z[md].iter_mut().enumerate() {
+                                if i.abs_diff(MAX_TABLE_HARMONIC) > j.harmonics {
+                                    *h = Default::default();
+                                }
                             }
                         }
-                    }
-                    (j.sweep, j.index, lane)
-                })
-                .collect())
-        })
-        .collect();
-    let mut lanes: Vec<BTreeMap<usize, LaneResult>> = vec![BTreeMap::new(); cfgs.len()];
-    for g in done {
-        for (sweep, index, lane) in g? {
-            lanes[sweep].insert(index, lane);
-        }
+                        (j.sweep, j.index, lane)
+                    })
+                    .collect()
+            });
+        *lock(&self.outcomes[g]) = Some(done);
     }
-    Ok(lanes)
+
+    /// Runs every group, in parallel.
+    fn run_all(&self) {
+        (0..self.groups())
+            .into_par_iter()
+            .with_max_len(1)
+            .for_each(|g| self.run_group(g));
+    }
+
+    /// Each config's lane results by point index, once every group has run.
+    fn lanes(self) -> Result<Vec<BTreeMap<usize, LaneResult>>, SweepError> {
+        let mut lanes: Vec<BTreeMap<usize, LaneResult>> = vec![BTreeMap::new(); self.cfgs.len()];
+        for o in self.outcomes {
+            let done = o.into_inner().unwrap_or_else(|e| e.into_inner());
+            for (sweep, index, lane) in done.unwrap_or_else(|| Ok(Vec::new()))? {
+                lanes[sweep].insert(index, lane);
+            }
+        }
+        Ok(lanes)
+    }
+
+    /// Each config's result, in order, once every group has run: what
+    /// [`run_table_sweeps`] returns.
+    pub fn finish(self) -> Result<Vec<SweepResult>, SweepError> {
+        let cfgs = self.cfgs;
+        let lanes = self.lanes()?;
+        cfgs.iter()
+            .zip(&lanes)
+            .map(|(cfg, l)| finish_sweep(cfg, l))
+            .collect()
+    }
+}
+
+/// A mutex's value, whether or not a panicking holder poisoned it.
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 #[cfg(test)]

@@ -3,6 +3,7 @@
 //! which a run needs the user's explicit consent (`--force`).
 
 use crate::bench::chain;
+use crate::split::lanes_of;
 use crate::sweep::canonical_work;
 use gyroemu_board::Point;
 use gyroemu_config::Config;
@@ -98,6 +99,19 @@ impl Work {
 pub fn sweep_work(cfg: &Config) -> Work {
     let n = cfg.emulated_rates_dps().len();
     points_work(cfg, &(0..n).collect::<Vec<_>>())
+}
+
+/// [`sweep_work`] of a split sweep ([`crate::split`]; `dump_end_s`: where its dump ends, s
+/// from the start of a run): its longest lane group runs its longest segment.
+pub fn split_work(cfg: &Config, dump_end_s: Option<f64>) -> Work {
+    let rates = cfg.emulated_rates_dps();
+    let todo: Vec<usize> = (0..rates.len()).collect();
+    let (lanes, _) = lanes_of(cfg, &todo, &|i| cfg.plan_point(rates[i]), true, dump_end_s);
+    let longest = lanes.iter().map(|l| l.window.samples()).max().unwrap_or(1);
+    Work {
+        longest_samples: (cfg.n_settle_out() + longest) * cfg.decimation() as u64,
+        ..sweep_work(cfg)
+    }
 }
 
 /// The work of the points `indices` of `cfg`'s sweep (a shard's, or those a resumed run has

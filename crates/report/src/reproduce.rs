@@ -8,14 +8,18 @@ use crate::sweep_report::{
     fit_series, line_span, phases, sweep_figure, theory_abscissae, theory_series, write_run,
 };
 use gyroemu_analysis::bandwidth::{
-    bandwidth, BandwidthPoint, BANDWIDTH_AMPLITUDE_DPS, BANDWIDTH_FREQS_HZ,
+    bandwidth_configs, bandwidth_points, BandwidthPoint, BANDWIDTH_AMPLITUDE_DPS,
+    BANDWIDTH_FREQS_HZ,
 };
 use gyroemu_config::presets::preset;
 use gyroemu_config::{Config, DumpConfig};
 use gyroemu_experiment::fit::LineFit;
+use gyroemu_experiment::prepared::PreparedSweep;
+use gyroemu_experiment::queue::{run_longest_first, sweep_items, table_items, Item};
+use gyroemu_experiment::table_sweep::PreparedTables;
 use gyroemu_experiment::{
-    finish_sweep_with, run_sweep_with, DumpPlan, Reporter, Stage2Leaks, SweepOptions, SweepResult,
-    SweepRun, DUMP_STEM,
+    finish_sweep_with, DumpPlan, Reporter, Stage2Leaks, SweepOptions, SweepResult, SweepRun,
+    DUMP_STEM,
 };
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
 use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
@@ -24,6 +28,7 @@ use rayon::prelude::*;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 
 /// Averaging of Fig. 9 with `--quick`, s (the paper: 500 s).
 const QUICK_AVERAGE_S: f64 = 15.0;
@@ -55,6 +60,22 @@ pub fn reproduce_dump(cfg: &Config) -> DumpPlan {
     }
 }
 
+/// The relative cost of a sample of `cfg`'s chain, for ordering the lane groups: a rate table
+/// steps its time-varying plant, about a third dearer than a constant-rate one.
+fn chain_cost(cfg: &Config) -> f64 {
+    match cfg.board_params().shape {
+        gyroemu_board::Shape::RateTable { .. } => 1.35,
+        _ => 1.0,
+    }
+}
+
+/// The work of an experiment of `reproduce`: its sweep split as it runs, with its dump.
+fn job_work(cfg: &Config) -> gyroemu_experiment::Work {
+    let d = reproduce_dump(cfg);
+    let dump_end_s = d.start_s + d.duration_s.max(d.decimated_duration_s);
+    gyroemu_experiment::work::split_work(cfg, Some(dump_end_s))
+}
+
 struct Job {
     preset: &'static str,
     title: &'static str,
@@ -74,7 +95,7 @@ impl ReproducePlan {
     pub fn work(&self) -> gyroemu_experiment::Work {
         self.jobs
             .iter()
-            .map(|j| gyroemu_experiment::sweep_work(&j.cfg))
+            .map(|j| job_work(&j.cfg))
             .reduce(|a, b| a.plus(b))
             .expect("reproduce has jobs")
     }
@@ -159,65 +180,84 @@ pub fn reproduce(
         task.update(sum(0), sum(1));
     };
     let rt_cfg = &jobs[job_index(jobs, "m2tfg-ratetable")].cfg;
-    // The experiment whose longest point has the most input samples first: its lane group
-    // bounds the run, so it starts at once while the others fill the other threads.
-    let mut order: Vec<usize> = (0..jobs.len()).collect();
-    order.sort_by_key(|&i| {
-        core::cmp::Reverse(gyroemu_experiment::sweep_work(&jobs[i].cfg).longest_samples)
-    });
-    // Each experiment writes its results, its dump's figures and its own figure as soon as
-    // its sweep is done (unless it has problems), while the longest one still runs.
+    let dirs: Vec<PathBuf> = jobs.iter().map(|j| out.join(j.preset)).collect();
+    // The dump and its figures as soon as its window is recorded, in a task taken between
+    // lane groups: the last experiment's would otherwise be drawn at the end of the run.
+    let dump_figures: Vec<_> = dirs
+        .iter()
+        .map(|dir| {
+            move |_: &[PathBuf]| -> Result<Vec<PathBuf>, String> {
+                let set = read_dump_set(&dir.join(DUMP_STEM)).map_err(|e| e.to_string())?;
+                write_dump_figures(&set, dir).map_err(|e| e.to_string())
+            }
+        })
+        .collect();
+    let progress: Vec<_> = (0..jobs.len())
+        .map(|i| move |d: u64, t: u64| report(i, d, t))
+        .collect();
+    // Every board of every experiment built before the first sample.
+    let mut sweeps = Vec::with_capacity(jobs.len());
+    for (i, job) in jobs.iter().enumerate() {
+        // The dump only records: the results are those of a run without it. Groups sized
+        // for one thread and long points split into segments (Fig. 9's 500 s): every group
+        // is as wide as the CPU runs and none is long enough to run alone at the end (bits
+        // do not depend on either).
+        let opts = SweepOptions {
+            dump: Some(reproduce_dump(&job.cfg)),
+            group_threads: Some(1),
+            on_dump_early: Some(&dump_figures[i]),
+            split: true,
+            ..Default::default()
+        };
+        sweeps.push(PreparedSweep::new(
+            &job.cfg,
+            &progress[i],
+            Some(&dirs[i]),
+            opts,
+        )?);
+    }
+    let bandwidth_cfgs = bandwidth_configs(rt_cfg)?;
+    let tables = PreparedTables::new(&bandwidth_cfgs, Some(1))?;
+    // Every lane group of every experiment and of the bandwidth sweep from one queue, the
+    // longest first; beside them the stage-2 leaks, which depend on the configs alone.
+    let leaks: Vec<Mutex<Stage2Leaks>> = jobs.iter().map(|_| Default::default()).collect();
+    let mut items = Vec::new();
+    for (job, sweep) in jobs.iter().zip(&sweeps) {
+        items.extend(sweep_items(sweep, chain_cost(&job.cfg)));
+    }
+    items.extend(table_items(&tables, chain_cost(rt_cfg)));
+    for (job, slot) in jobs.iter().zip(&leaks) {
+        // An error here resurfaces in the read-out.
+        let item: Item = Box::new(move |_| {
+            *slot.lock().unwrap_or_else(|e| e.into_inner()) =
+                Stage2Leaks::of_sweep(&job.cfg).unwrap_or_default();
+        });
+        items.push((0.0, item));
+    }
+    run_longest_first(items);
+    // Then each experiment's read-out and files, and the bandwidth sweep's, in parallel.
     let (swept, bandwidth_files) = rayon::join(
         || {
-            let mut swept: Vec<(usize, Result<_, ReportError>)> = order
-                .par_iter()
+            sweeps
+                .into_par_iter()
+                .zip(leaks)
+                .zip(jobs)
                 .with_max_len(1)
-                .map(|&i| {
-                    let job = &jobs[i];
-                    let dir = out.join(job.preset);
-                    // The dump and its figures as soon as its window is recorded, on a
-                    // thread the groups leave idle: the longest experiment's would otherwise
-                    // be drawn after it, at the end of the run.
-                    let dump_figures = |_: &[PathBuf]| -> Result<Vec<PathBuf>, String> {
-                        let set = read_dump_set(&dir.join(DUMP_STEM)).map_err(|e| e.to_string())?;
-                        write_dump_figures(&set, &dir).map_err(|e| e.to_string())
+                .map(|((sweep, leaks), job)| -> Result<_, ReportError> {
+                    let run = sweep.finish()?;
+                    let leaks = leaks.into_inner().unwrap_or_else(|e| e.into_inner());
+                    let r = finish_sweep_with(&job.cfg, &run.lanes, &leaks)?;
+                    let written = if r.problems.is_empty() {
+                        Some(write_job(out, job, &run, &r))
+                    } else {
+                        None
                     };
-                    // The dump only records: the results are those of a run without it.
-                    // Groups sized for one thread: the pool is shared by every experiment,
-                    // so each group is as wide as the CPU runs (bits do not depend on it).
-                    let opts = SweepOptions {
-                        dump: Some(reproduce_dump(&job.cfg)),
-                        group_threads: Some(1),
-                        on_dump_early: Some(&dump_figures),
-                        ..Default::default()
-                    };
-                    let progress = |d: u64, t: u64| report(i, d, t);
-                    let res = (|| {
-                        // The stage-2 leaks depend on the config alone: a thread the sweeps
-                        // leave idle computes them (rayon steals the oldest work first, so
-                        // other experiments' groups go before them), and the read-out does
-                        // not wait on them. An error here resurfaces in the read-out.
-                        let (run, leaks) = rayon::join(
-                            || run_sweep_with(&job.cfg, &progress, Some(&dir), opts),
-                            || Stage2Leaks::of_sweep(&job.cfg).unwrap_or_default(),
-                        );
-                        let run = run?;
-                        let r = finish_sweep_with(&job.cfg, &run.lanes, &leaks)?;
-                        let written = if r.problems.is_empty() {
-                            Some(write_job(out, job, &run, &r))
-                        } else {
-                            None
-                        };
-                        Ok((run, r, written))
-                    })();
-                    (i, res)
+                    Ok((run, r, written))
                 })
-                .collect();
-            swept.sort_by_key(|(i, _)| *i);
-            swept.into_iter().map(|(_, r)| r).collect::<Vec<_>>()
+                .collect::<Vec<_>>()
         },
         || -> Result<_, ReportError> {
-            let runs = bandwidth(rt_cfg, Some(1))?;
+            let runs = bandwidth_points(rt_cfg, &tables.finish()?);
             let (figure, csv) = bandwidth_outputs(rt_cfg, &runs, out)?;
             let path = out.join("fig_bandwidth.png");
             render_png(&figure, &path)?;

@@ -236,6 +236,8 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         dump: None,
         group_threads: None,
         on_dump_early: None,
+        // Point files are written point by point: a run keeps its points whole.
+        split: false,
     };
     let swept = match run_sweep_with(&held, &|d, t| task.update(d, t), Some(out), opts) {
         Ok(s) => s,

@@ -1,0 +1,389 @@
+//! Split sweeps: a long point's averaging window cut into segments that run as lanes of their
+//! own, side by side, each starting at its own place on the time axis and settling anew from
+//! rest (`Board::with_starts`), so one long point no longer bounds a run to one thread and one
+//! lane. Every sample is still emulated; the segments' averages, weighted by their spans, are
+//! the average over the whole window, up to what each segment's settling leaves of its start
+//! transient (below 1e-7 of the response after the default 16 time constants; THEORY
+//! section 7).
+//!
+//! The cut depends on the config alone (never on the machine), so a split sweep gives the
+//! same bits on every CPU, lane width and thread count.
+
+use gyroemu_board::{starts_share_carrier, LaneResult, Point, MAX_LANES};
+use gyroemu_config::Config;
+use gyroemu_core::Complex64;
+use gyroemu_lpf::Window;
+
+/// A segment's span is at least this many settling times, so re-settling adds at most 1/64
+/// (1.6 %) to the samples a point runs.
+pub const MIN_SEGMENT_SETTLES: u64 = 64;
+
+/// Most segments per point.
+pub const MAX_SEGMENTS: u64 = 64;
+
+/// One lane of a sweep: a whole point, or one segment of a split point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lane {
+    /// The point's index in `emulated_rates_dps`.
+    pub point: usize,
+    /// The segment's index (0 for a whole point).
+    pub segment: usize,
+    /// Where the segment starts on the point's averaging axis, decimated samples (0 for a
+    /// whole point); its board starts that many blocks late and settles as any run does.
+    pub start_block: u64,
+    /// The segment's own window (the point's window for a whole point).
+    pub window: Window,
+}
+
+/// How a split sweep's lanes may share a lane group.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Packing {
+    /// Any segments together: every segment start shares the carrier's phase.
+    Free,
+    /// Only segments that start together (the carrier's phase differs between starts).
+    SameStart,
+}
+
+/// The lanes of the points `todo` of `cfg`'s sweep (point `i` planned as `plan(i)`), split
+/// when `split` is asked and the sweep can be split, else one whole point per lane. A sweep
+/// is split when: its points have boxcar windows on a constant-rate or rotating board without
+/// noise (a rate table counts its phase from sample 0; a noisy point's segments would draw
+/// other streams than the point), and `k`, the smallest number of segments that fills whole
+/// groups of eight lanes (`8 / gcd(points, 8)`, times the largest whole factor that keeps
+/// every segment at least [`MIN_SEGMENT_SETTLES`] settling times long, at most
+/// [`MAX_SEGMENTS`]), is above 1; and the dump (ending at `dump_end_s` from the start of its
+/// run) fits in its point's first segment.
+pub fn lanes_of(
+    cfg: &Config,
+    todo: &[usize],
+    plan: &dyn Fn(usize) -> Point,
+    split: bool,
+    dump_end_s: Option<f64>,
+) -> (Vec<Lane>, Packing) {
+    let whole = || {
+        let lanes = todo
+            .iter()
+            .map(|&i| Lane {
+                point: i,
+                segment: 0,
+                start_block: 0,
+                window: plan(i).window,
+            })
+            .collect();
+        (lanes, Packing::SameStart)
+    };
+    if !split || todo.is_empty() || !splittable(cfg) {
+        return whole();
+    }
+    let windows: Option<Vec<(u64, f64)>> = todo
+        .iter()
+        .map(|&i| match plan(i).window {
+            Window::Boxcar { n, frac } => Some((n, frac)),
+            Window::Hann { .. } => None,
+        })
+        .collect();
+    let Some(windows) = windows else {
+        return whole();
+    };
+    let longest = windows.iter().map(|w| w.0).max().unwrap_or(0);
+    let settle = cfg.n_settle_out().max(1);
+    let fill = (MAX_LANES / gcd(todo.len(), MAX_LANES)) as u64;
+    let most = longest / (MIN_SEGMENT_SETTLES.saturating_mul(settle));
+    let k = fill * (most / fill).min(MAX_SEGMENTS / fill);
+    if k < 2 {
+        return whole();
+    }
+    let (len, packing) = segment_length(cfg, longest.div_ceil(k));
+    let first_end_s = (cfg.n_settle_out() + len) as f64 / cfg.fs_out_hz();
+    if dump_end_s.is_some_and(|e| e > first_end_s) {
+        return whole();
+    }
+    let mut lanes = Vec::new();
+    for (&i, &(n, frac)) in todo.iter().zip(&windows) {
+        let mut a = 0;
+        let mut segment = 0;
+        while a < n || (a == n && segment == 0) {
+            let b = (a + len).min(n);
+            // The point's fractional end sample goes with its last segment.
+            let window = Window::Boxcar {
+                n: b - a,
+                frac: if b == n { frac } else { 0.0 },
+            };
+            lanes.push(Lane {
+                point: i,
+                segment,
+                start_block: a,
+                window,
+            });
+            segment += 1;
+            a = b;
+        }
+    }
+    (lanes, packing)
+}
+
+/// A board `cfg` describes runs segments that start late: constant rate or rotating, no noise.
+fn splittable(cfg: &Config) -> bool {
+    let p = cfg.board_params();
+    p.noise.is_none() && !matches!(p.shape, gyroemu_board::Shape::RateTable { .. })
+}
+
+/// The segment length (decimated samples) for at least `len`: rounded up to a whole number
+/// of the carrier's repeat where that repeat is short (then any segments share a lane group),
+/// else `len` (segments share a group only with those starting with them).
+fn segment_length(cfg: &Config, len: u64) -> (u64, Packing) {
+    let p = cfg.board_params();
+    let m = cfg.decimation() as u64;
+    // The carrier's phase word repeats after a power of two of samples: the first power of
+    // two of blocks at which it does, if one below 1/16 of the segment.
+    (0..=20)
+        .map(|e| 1u64 << e)
+        .take_while(|&u| 16 * u <= len)
+        .find(|&u| starts_share_carrier(&p, &[0, u * m]))
+        .map_or((len, Packing::SameStart), |u| {
+            (len.div_ceil(u) * u, Packing::Free)
+        })
+}
+
+fn gcd(a: usize, b: usize) -> usize {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// The lane groups of `lanes` (in order) whose sizes `sizes` gives for a number of lanes:
+/// any lanes together ([`Packing::Free`]: the longest first, so lanes of one length share a
+/// group), or only lanes with the same start, each start's lanes in order.
+pub fn pack(
+    lanes: &[Lane],
+    packing: Packing,
+    sizes: &dyn Fn(usize) -> Vec<usize>,
+) -> Vec<Vec<Lane>> {
+    let mut sets: Vec<Vec<Lane>> = match packing {
+        Packing::Free => {
+            let mut v = lanes.to_vec();
+            v.sort_by_key(|l| core::cmp::Reverse(l.window.samples()));
+            vec![v]
+        }
+        Packing::SameStart => {
+            let mut starts: Vec<u64> = lanes.iter().map(|l| l.start_block).collect();
+            starts.sort_unstable();
+            starts.dedup();
+            starts
+                .iter()
+                .map(|&s| {
+                    let mut v: Vec<Lane> = lanes
+                        .iter()
+                        .filter(|l| l.start_block == s)
+                        .copied()
+                        .collect();
+                    v.sort_by_key(|l| core::cmp::Reverse(l.window.samples()));
+                    v
+                })
+                .collect()
+        }
+    };
+    let mut groups = Vec::new();
+    for set in sets.iter_mut() {
+        let mut rest = &set[..];
+        for size in sizes(set.len()) {
+            let (g, r) = rest.split_at(size);
+            groups.push(g.to_vec());
+            rest = r;
+        }
+    }
+    groups
+}
+
+/// A split point's result from its segments' (each with its window): every average weighted
+/// by its segment's span, the counts added. A whole point's single lane is its result as is.
+pub fn combine(segments: &[(Window, LaneResult)]) -> LaneResult {
+    if let [(_, only)] = segments {
+        return *only;
+    }
+    let total: f64 = segments.iter().map(|(w, _)| w.span()).sum();
+    let mean = |f: &dyn Fn(&LaneResult) -> Complex64| {
+        segments
+            .iter()
+            .map(|(w, r)| f(r) * w.span())
+            .fold(Complex64::new(0.0, 0.0), |a, b| a + b)
+            / total
+    };
+    let mut out = LaneResult::default();
+    for k in 0..2 {
+        out.z[k] = mean(&|r| r.z[k]);
+        out.c[k] = mean(&|r| r.c[k]);
+        out.s[k] = mean(&|r| r.s[k]);
+    }
+    for (_, r) in segments {
+        out.health.add(&r.health);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gyroemu_config::presets::preset;
+
+    /// Groups of eight lanes, the last of what is left.
+    fn eights(n: usize) -> Vec<usize> {
+        (0..n.div_ceil(8)).map(|g| 8.min(n - 8 * g)).collect()
+    }
+
+    fn lanes(cfg: &Config, split: bool, dump_end_s: Option<f64>) -> (Vec<Lane>, Packing) {
+        let rates = cfg.emulated_rates_dps();
+        let todo: Vec<usize> = (0..rates.len()).collect();
+        lanes_of(cfg, &todo, &|i| cfg.plan_point(rates[i]), split, dump_end_s)
+    }
+
+    /// Each point's segments tile its window: they start at 0 and follow on one another, each
+    /// a boxcar of weight 1, the last with the point's fractional end; their spans add up
+    /// to the window's.
+    fn check_tiling(cfg: &Config, lanes: &[Lane]) {
+        let rates = cfg.emulated_rates_dps();
+        for (i, &r) in rates.iter().enumerate() {
+            let Window::Boxcar { n, frac } = cfg.plan_point(r).window else {
+                panic!("boxcar presets")
+            };
+            let segs: Vec<&Lane> = lanes.iter().filter(|l| l.point == i).collect();
+            let mut at = 0;
+            for (s, l) in segs.iter().enumerate() {
+                assert_eq!((l.segment, l.start_block), (s, at), "point {i}");
+                let Window::Boxcar { n: len, frac: f } = l.window else {
+                    panic!()
+                };
+                let last = s + 1 == segs.len();
+                assert_eq!(f, if last { frac } else { 0.0 }, "point {i} segment {s}");
+                at += len;
+            }
+            assert_eq!(at, n, "point {i}");
+            let spans: f64 = segs.iter().map(|l| l.window.span()).sum();
+            assert_eq!(spans, n as f64 + frac, "point {i}");
+        }
+    }
+
+    #[test]
+    fn fig9s_points_split_into_eight_segments_that_fill_groups_of_eight() {
+        let cfg = preset("m2tfg-rotating").unwrap();
+        let (lanes, packing) = lanes(&cfg, true, None);
+        assert_eq!(packing, Packing::Free);
+        check_tiling(&cfg, &lanes);
+        let settle = cfg.n_settle_out();
+        for i in 0..7 {
+            let segs: Vec<&Lane> = lanes.iter().filter(|l| l.point == i).collect();
+            // The 25 deg/s point's window is a few periods shorter: its last segment too.
+            assert_eq!(segs.len(), 8, "point {i}");
+            for l in &segs[..7] {
+                assert!(l.window.samples() > MIN_SEGMENT_SETTLES * settle, "{l:?}");
+            }
+        }
+        // 56 lanes: seven whole groups of eight (and fourteen of four).
+        assert_eq!(lanes.len() % 8, 0);
+        // Every start shares the carrier (fs = 16 f0, decimation 100: multiples of 4 blocks).
+        let m = cfg.decimation() as u64;
+        let starts: Vec<u64> = lanes.iter().map(|l| l.start_block * m).collect();
+        assert!(starts_share_carrier(&cfg.board_params(), &starts));
+    }
+
+    #[test]
+    fn what_cannot_or_need_not_be_split_runs_whole() {
+        let whole = |cfg: &Config, dump: Option<f64>| {
+            let (l, _) = lanes(cfg, true, dump);
+            l.iter().all(|l| l.segment == 0 && l.start_block == 0)
+                && l.len() == cfg.emulated_rates_dps().len()
+        };
+        let fig9 = preset("m2tfg-rotating").unwrap();
+        assert!(!whole(&fig9, None));
+        // Not asked.
+        let (l, _) = lanes(&fig9, false, None);
+        assert_eq!(l.len(), 7);
+        // Too short for two segments of 64 settling times (the --quick average of 15 s).
+        let mut quick = fig9.clone();
+        quick.experiment.average_s = 15.0;
+        assert!(whole(&quick, None));
+        // Noise: a segment would draw other normals than its point.
+        let mut noisy = fig9.clone();
+        noisy.noise = Some(gyroemu_config::NoiseConfig {
+            seed: 1,
+            tia_current_noise_a_per_rthz: 1e-13,
+            ..Default::default()
+        });
+        assert!(whole(&noisy, None));
+        // A Hann window weighs a sample by where it lies in the whole window.
+        let mut hann = fig9.clone();
+        hann.experiment.window = gyroemu_config::WindowKind::Hann;
+        assert!(whole(&hann, None));
+        // A dump that ends past the first segment.
+        assert!(whole(&fig9, Some(100.0)));
+        assert!(!whole(&fig9, Some(10.0)));
+        // A rate table counts its phase from sample 0.
+        let mut table = preset("m2tfg-ratetable").unwrap();
+        table.experiment.average_s = 2000.0;
+        assert!(whole(&table, None));
+    }
+
+    #[test]
+    fn a_carrier_that_does_not_repeat_packs_segments_by_start() {
+        let mut cfg = preset("m2tfg-rotating").unwrap();
+        // 15 000.1 Hz at 240 kHz: no short repeat of the carrier's phase word.
+        cfg.drive.carrier_hz = Some(15_000.1);
+        let (lanes, packing) = lanes(&cfg, true, None);
+        assert_eq!(packing, Packing::SameStart);
+        check_tiling(&cfg, &lanes);
+        let groups = pack(&lanes, packing, &eights);
+        for g in &groups {
+            assert!(g.iter().all(|l| l.start_block == g[0].start_block), "{g:?}");
+        }
+        // A lane of every point at each start (the longest window sets the length).
+        assert_eq!(groups.iter().map(Vec::len).sum::<usize>(), lanes.len());
+    }
+
+    #[test]
+    fn free_packing_puts_lanes_of_one_length_together() {
+        let cfg = preset("m2tfg-rotating").unwrap();
+        let (lanes, packing) = lanes(&cfg, true, None);
+        let groups = pack(&lanes, packing, &eights);
+        assert_eq!(groups.len(), lanes.len() / 8);
+        let len = |l: &Lane| l.window.samples();
+        // Longest first: no group holds a lane longer than any of an earlier group.
+        for w in groups.windows(2) {
+            let shortest = w[0].iter().map(len).min().unwrap();
+            assert!(w[1].iter().all(|l| len(l) <= shortest));
+        }
+    }
+
+    #[test]
+    fn segments_combine_into_the_mean_of_the_whole_window() {
+        let r = |z: f64, h: u64| LaneResult {
+            z: [Complex64::new(z, -z), Complex64::new(2.0 * z, 0.5)],
+            c: [Complex64::new(z, 1.0), Complex64::new(-z, z)],
+            s: [Complex64::new(3.0, z), Complex64::new(z, z * z)],
+            health: gyroemu_board::Health {
+                samples: h,
+                dac_zero: [h / 2, 1],
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        // Means 0.5 over 3 samples, 2.0 over 4, -1.0 over 2.25: the whole mean is the
+        // sum 1.5 + 8 - 2.25 = 7.25 over 9.25 samples.
+        let parts = [
+            (Window::Boxcar { n: 3, frac: 0.0 }, r(0.5, 10)),
+            (Window::Boxcar { n: 4, frac: 0.0 }, r(2.0, 20)),
+            (Window::Boxcar { n: 2, frac: 0.25 }, r(-1.0, 30)),
+        ];
+        let c = combine(&parts);
+        let want = 7.25 / 9.25;
+        assert!((c.z[0] - Complex64::new(want, -want)).norm() < 1e-15);
+        assert!((c.c[1] - Complex64::new(-want, want)).norm() < 1e-15);
+        // A channel constant over the segments keeps its value.
+        assert!((c.s[0].re - 3.0).abs() < 1e-15 && (c.c[0].im - 1.0).abs() < 1e-15);
+        assert_eq!(c.health.samples, 60);
+        assert_eq!(c.health.dac_zero, [30, 3]);
+        // One segment: its result, bit for bit.
+        assert_eq!(combine(&parts[1..2]), parts[1].1);
+    }
+}
