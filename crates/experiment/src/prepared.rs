@@ -12,7 +12,9 @@ use crate::sweep::{
     add_group_progress, finish_sweep, group_samples, write_dump, DumpWritten, SweepError,
     SweepOptions, SweepRun,
 };
-use gyroemu_board::{lane_groups, max_lanes, GroupBoard, LaneResult, Point, Probe, RunOptions};
+use gyroemu_board::{
+    groups_by_length, lane_groups, max_lanes, GroupBoard, LaneResult, Point, Probe, RunOptions,
+};
 use gyroemu_config::Config;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -45,6 +47,8 @@ pub struct PreparedSweep<'a> {
     dump: Option<(usize, DumpPlan)>,
     total: u64,
     done: AtomicU64,
+    /// The points computed before (`SweepOptions::done`), returned with the new ones.
+    done_points: Mutex<BTreeMap<usize, LaneResult>>,
     /// Raised by the caller's flag (copied at each progress report) or by a failed group.
     stop: Arc<AtomicBool>,
     /// The dump written early (`on_dump_early`), by the task its recorded probe spawned.
@@ -58,7 +62,7 @@ impl<'a> PreparedSweep<'a> {
         cfg: &'a Config,
         progress: Progress<'a>,
         dump_dir: Option<&'a Path>,
-        opts: SweepOptions<'a>,
+        mut opts: SweepOptions<'a>,
     ) -> Result<Self, SweepError> {
         let rates = cfg.emulated_rates_dps();
         let mut todo: Vec<usize> = match &opts.only {
@@ -92,7 +96,9 @@ impl<'a> PreparedSweep<'a> {
             .as_ref()
             .map(|(_, d)| d.start_s + d.duration_s.max(d.decimated_duration_s));
         let (lanes, packing) = lanes_of(cfg, &todo, &plan, opts.split && whole_run, dump_end_s);
-        let groups = pack(&lanes, packing, &|n| lane_groups(n, threads, max_lanes()));
+        let groups = pack(&lanes, packing, &|set| {
+            sizes(set, threads, cfg.n_settle_out())
+        });
         let mut lanes_per_point: BTreeMap<usize, usize> = BTreeMap::new();
         for l in &lanes {
             *lanes_per_point.entry(l.point).or_default() += 1;
@@ -110,8 +116,10 @@ impl<'a> PreparedSweep<'a> {
             board.set_cancel(stop.clone());
             boards.push(Mutex::new(Some(board)));
         }
+        let done_points = Mutex::new(std::mem::take(&mut opts.done));
         let mut s = Self {
             cfg,
+            done_points,
             progress,
             dump_dir,
             opts,
@@ -242,16 +250,18 @@ impl<'a> PreparedSweep<'a> {
 
     /// After every group has run (or been skipped): the dump written (unless it was early),
     /// then the points passed on and put together, as [`crate::run_sweep_with`] returns them.
-    pub fn finish(self) -> Result<SweepRun, SweepError> {
-        let mut early = self.early.into_inner().unwrap_or_else(|e| e.into_inner());
+    /// Called once: it takes the groups' outcomes (so it needs only a shared borrow, and a
+    /// queue can finish a sweep as soon as its last group has run).
+    pub fn finish(&self) -> Result<SweepRun, SweepError> {
+        let mut early = lock(&self.early).take();
         let mut run = SweepRun {
-            lanes: self.opts.done,
+            lanes: std::mem::take(&mut *lock(&self.done_points)),
             ..Default::default()
         };
         let mut first_err = None;
         let mut finished: BTreeMap<usize, Vec<(Lane, LaneResult)>> = BTreeMap::new();
-        for o in self.outcomes {
-            match o.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        for o in &self.outcomes {
+            match lock(o).take() {
                 None => run.cancelled = true,
                 Some(Err(e)) => {
                     first_err.get_or_insert(e);
@@ -346,6 +356,18 @@ pub fn run_sweep_with(
             .for_each(|g| sweep.run_group(g, &hand_on));
     });
     sweep.finish()
+}
+
+/// The sizes of the lane groups of `set` (longest first): sized by the lanes' runs on one
+/// thread (a thread of a pool shared with other work: `reproduce`), else to keep `threads`
+/// threads busy ([`lane_groups`]).
+fn sizes(set: &[Lane], threads: usize, n_settle: u64) -> Vec<usize> {
+    if threads == 1 {
+        let runs: Vec<u64> = set.iter().map(|l| n_settle + l.window.samples()).collect();
+        groups_by_length(&runs, max_lanes())
+    } else {
+        lane_groups(set.len(), threads, max_lanes())
+    }
 }
 
 /// A mutex's value, whether or not a panicking holder poisoned it.

@@ -153,13 +153,13 @@ fn gcd(a: usize, b: usize) -> usize {
     }
 }
 
-/// The lane groups of `lanes` (in order) whose sizes `sizes` gives for a number of lanes:
-/// any lanes together ([`Packing::Free`]: the longest first, so lanes of one length share a
-/// group), or only lanes with the same start, each start's lanes in order.
+/// The lane groups of `lanes`, longest first, cut where `sizes` says for a set of lanes (in
+/// that order): any lanes together ([`Packing::Free`], so lanes of one length share a group),
+/// or only lanes with the same start.
 pub fn pack(
     lanes: &[Lane],
     packing: Packing,
-    sizes: &dyn Fn(usize) -> Vec<usize>,
+    sizes: &dyn Fn(&[Lane]) -> Vec<usize>,
 ) -> Vec<Vec<Lane>> {
     let mut sets: Vec<Vec<Lane>> = match packing {
         Packing::Free => {
@@ -188,7 +188,7 @@ pub fn pack(
     let mut groups = Vec::new();
     for set in sets.iter_mut() {
         let mut rest = &set[..];
-        for size in sizes(set.len()) {
+        for size in sizes(set) {
             let (g, r) = rest.split_at(size);
             groups.push(g.to_vec());
             rest = r;
@@ -229,7 +229,8 @@ mod tests {
     use gyroemu_config::presets::preset;
 
     /// Groups of eight lanes, the last of what is left.
-    fn eights(n: usize) -> Vec<usize> {
+    fn eights(set: &[Lane]) -> Vec<usize> {
+        let n = set.len();
         (0..n.div_ceil(8)).map(|g| 8.min(n - 8 * g)).collect()
     }
 

@@ -6,7 +6,8 @@
 use crate::readout::SweepResult;
 use crate::sweep::{finish_sweep, group_samples, SweepError};
 use gyroemu_board::{
-    lane_groups, max_lanes, BoardParams, GroupBoard, LaneResult, RunOptions, Shape,
+    groups_by_length, lane_groups, max_lanes, BoardParams, GroupBoard, LaneResult, RunOptions,
+    Shape,
 };
 use gyroemu_config::Config;
 use gyroemu_mixer::MAX_TABLE_HARMONIC;
@@ -119,7 +120,17 @@ impl<'c> PreparedTables<'c> {
             // Longest window first, so a group's lanes end together (as in a sweep).
             order.sort_by_key(|j| core::cmp::Reverse(j.point.window.samples()));
             let mut rest = &order[..];
-            for size in lane_groups(order.len(), threads, max_lanes()) {
+            // On one thread (a pool shared with other work), sized by the runs' lengths.
+            let sizes = if threads == 1 {
+                let runs: Vec<u64> = order
+                    .iter()
+                    .map(|j| n_settle + j.point.window.samples())
+                    .collect();
+                groups_by_length(&runs, max_lanes())
+            } else {
+                lane_groups(order.len(), threads, max_lanes())
+            };
+            for size in sizes {
                 let (g, r) = rest.split_at(size);
                 rest = r;
                 // The board demodulates the most harmonics any of its lanes needs; a lane's
@@ -196,11 +207,11 @@ impl<'c> PreparedTables<'c> {
             .for_each(|g| self.run_group(g));
     }
 
-    /// Each config's lane results by point index, once every group has run.
-    fn lanes(self) -> Result<Vec<BTreeMap<usize, LaneResult>>, SweepError> {
+    /// Each config's lane results by point index, once every group has run (taken: once).
+    fn lanes(&self) -> Result<Vec<BTreeMap<usize, LaneResult>>, SweepError> {
         let mut lanes: Vec<BTreeMap<usize, LaneResult>> = vec![BTreeMap::new(); self.cfgs.len()];
-        for o in self.outcomes {
-            let done = o.into_inner().unwrap_or_else(|e| e.into_inner());
+        for o in &self.outcomes {
+            let done = lock(o).take();
             for (sweep, index, lane) in done.unwrap_or_else(|| Ok(Vec::new()))? {
                 lanes[sweep].insert(index, lane);
             }
@@ -209,11 +220,11 @@ impl<'c> PreparedTables<'c> {
     }
 
     /// Each config's result, in order, once every group has run: what
-    /// [`run_table_sweeps`] returns.
-    pub fn finish(self) -> Result<Vec<SweepResult>, SweepError> {
-        let cfgs = self.cfgs;
+    /// [`run_table_sweeps`] returns. Called once.
+    pub fn finish(&self) -> Result<Vec<SweepResult>, SweepError> {
         let lanes = self.lanes()?;
-        cfgs.iter()
+        self.cfgs
+            .iter()
             .zip(&lanes)
             .map(|(cfg, l)| finish_sweep(cfg, l))
             .collect()

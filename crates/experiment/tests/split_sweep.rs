@@ -154,9 +154,9 @@ fn sweeps_run_from_one_queue_give_each_sweep_its_own_bits() {
     let a = PreparedSweep::new(&rot, &|_, _| {}, None, split(1)).unwrap();
     let b = PreparedSweep::new(&coriolis, &|_, _| {}, None, Default::default()).unwrap();
     let t = PreparedTables::new(&table_cfgs, Some(1)).unwrap();
-    let mut items = sweep_items(&a, 1.0);
-    items.extend(sweep_items(&b, 1.0));
-    items.extend(table_items(&t, 1.35));
+    let mut items = sweep_items(&a, 1.0, None);
+    items.extend(sweep_items(&b, 1.0, None));
+    items.extend(table_items(&t, 1.35, None));
     run_longest_first(items);
     assert_eq!(a.finish().unwrap().lanes, sweep(&rot, split(1)).lanes);
     assert_eq!(

@@ -24,11 +24,10 @@ use gyroemu_experiment::{
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
 use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
 use gyroemu_theory::rate_table_gain;
-use rayon::prelude::*;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 /// Averaging of Fig. 9 with `--quick`, s (the paper: 500 s).
 const QUICK_AVERAGE_S: f64 = 15.0;
@@ -58,6 +57,24 @@ pub fn reproduce_dump(cfg: &Config) -> DumpPlan {
         decimated_duration_s: (DUMP_DECIMATED_FRAMES / cfg.fs_out_hz()).min(end_s - d.start_s),
         ..d
     }
+}
+
+/// What an experiment's read-out gives: its run, its result and its files (when it has no
+/// problems), its figure among them.
+type JobOutput = (
+    SweepRun,
+    SweepResult,
+    Option<Result<(Vec<PathBuf>, Option<PathBuf>), ReportError>>,
+);
+
+/// A mutex's value, whether or not a panicking holder poisoned it.
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// What a queue's item left in `m` (every item has run once the queue returns).
+fn taken<T>(m: &Mutex<Option<T>>) -> T {
+    lock(m).take().expect("every item ran")
 }
 
 /// The relative cost of a sample of `cfg`'s chain, for ordering the lane groups: a rate table
@@ -220,51 +237,65 @@ pub fn reproduce(
     let tables = PreparedTables::new(&bandwidth_cfgs, Some(1))?;
     // Every lane group of every experiment and of the bandwidth sweep from one queue, the
     // longest first; beside them the stage-2 leaks, which depend on the configs alone.
-    let leaks: Vec<Mutex<Stage2Leaks>> = jobs.iter().map(|_| Default::default()).collect();
-    let mut items = Vec::new();
-    for (job, sweep) in jobs.iter().zip(&sweeps) {
-        items.extend(sweep_items(sweep, chain_cost(&job.cfg)));
-    }
-    items.extend(table_items(&tables, chain_cost(rt_cfg)));
-    for (job, slot) in jobs.iter().zip(&leaks) {
-        // An error here resurfaces in the read-out.
-        let item: Item = Box::new(move |_| {
-            *slot.lock().unwrap_or_else(|e| e.into_inner()) =
-                Stage2Leaks::of_sweep(&job.cfg).unwrap_or_default();
-        });
-        items.push((0.0, item));
-    }
-    run_longest_first(items);
-    // Then each experiment's read-out and files, and the bandwidth sweep's, in parallel.
-    let (swept, bandwidth_files) = rayon::join(
-        || {
-            sweeps
-                .into_par_iter()
-                .zip(leaks)
-                .zip(jobs)
-                .with_max_len(1)
-                .map(|((sweep, leaks), job)| -> Result<_, ReportError> {
-                    let run = sweep.finish()?;
-                    let leaks = leaks.into_inner().unwrap_or_else(|e| e.into_inner());
-                    let r = finish_sweep_with(&job.cfg, &run.lanes, &leaks)?;
+    // The stage-2 leaks depend on the configs alone: items beside the groups compute them,
+    // or the read-out that needs them first (an error resurfaces in the read-out).
+    let leaks: Vec<OnceLock<Stage2Leaks>> = jobs.iter().map(|_| OnceLock::new()).collect();
+    let leaks_of =
+        |i: usize| leaks[i].get_or_init(|| Stage2Leaks::of_sweep(&jobs[i].cfg).unwrap_or_default());
+    // Each experiment's read-out and files as soon as its last group has run, on that thread,
+    // while the other experiments' groups go on; the bandwidth sweep's likewise.
+    let outputs: Vec<Mutex<Option<Result<JobOutput, ReportError>>>> =
+        jobs.iter().map(|_| Mutex::new(None)).collect();
+    let finishers: Vec<_> = (0..jobs.len())
+        .map(|i| {
+            let (sweeps, outputs) = (&sweeps, &outputs);
+            move || {
+                let job = &jobs[i];
+                let res = (|| -> Result<JobOutput, ReportError> {
+                    let run = sweeps[i].finish()?;
+                    let r = finish_sweep_with(&job.cfg, &run.lanes, leaks_of(i))?;
                     let written = if r.problems.is_empty() {
                         Some(write_job(out, job, &run, &r))
                     } else {
                         None
                     };
                     Ok((run, r, written))
-                })
-                .collect::<Vec<_>>()
-        },
-        || -> Result<_, ReportError> {
+                })();
+                *lock(&outputs[i]) = Some(res);
+            }
+        })
+        .collect();
+    let bandwidth_out: Mutex<Option<Result<[PathBuf; 2], ReportError>>> = Mutex::new(None);
+    let bandwidth_finish = || {
+        let res = (|| -> Result<_, ReportError> {
             let runs = bandwidth_points(rt_cfg, &tables.finish()?);
             let (figure, csv) = bandwidth_outputs(rt_cfg, &runs, out)?;
             let path = out.join("fig_bandwidth.png");
             render_png(&figure, &path)?;
             // The bandwidth sweep's table goes before its figure.
             Ok([csv, path])
-        },
-    );
+        })();
+        *lock(&bandwidth_out) = Some(res);
+    };
+    let mut items = Vec::new();
+    for (i, (job, sweep)) in jobs.iter().zip(&sweeps).enumerate() {
+        let then: &(dyn Fn() + Sync) = &finishers[i];
+        items.extend(sweep_items(sweep, chain_cost(&job.cfg), Some(then)));
+    }
+    items.extend(table_items(
+        &tables,
+        chain_cost(rt_cfg),
+        Some(&bandwidth_finish),
+    ));
+    for i in 0..jobs.len() {
+        let item: Item = Box::new(move |_| {
+            leaks_of(i);
+        });
+        items.push((0.0, item));
+    }
+    run_longest_first(items);
+    let swept: Vec<Result<JobOutput, ReportError>> = outputs.iter().map(taken).collect();
+    let bandwidth_files = taken(&bandwidth_out);
     let mut runs = Vec::with_capacity(jobs.len());
     for s in swept {
         runs.push(s?);
