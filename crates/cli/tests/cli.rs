@@ -266,6 +266,48 @@ fn reproduce_quick_writes_every_figure_and_the_slope_ratio() {
     }
     // Emulation and writing are reported apart.
     assert!(stderr(&o).contains("; writing dumps: "), "{}", stderr(&o));
+    // The closing line counts every point-sample emulated: the five sweeps' (their
+    // summaries') and the bandwidth sweep's, as the plan announced them.
+    let count = |prefix: &str| -> f64 {
+        let line = stderr(&o)
+            .lines()
+            .find(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no `{prefix}` line"))
+            .to_string();
+        let n = line[prefix.len()..]
+            .split(" point-samples")
+            .next()
+            .unwrap()
+            .rsplit(' ')
+            .next()
+            .unwrap()
+            .parse::<f64>();
+        n.unwrap_or_else(|e| panic!("{line}: {e}"))
+    };
+    let (planned, emulated) = (count("plan: "), count("reproduce: "));
+    assert!(
+        (planned / emulated - 1.0).abs() < 1e-3,
+        "{planned} {emulated}"
+    );
+    let swept: f64 = [
+        "m2tfg-coriolis",
+        "m2tfg-rotating",
+        "baw-coriolis",
+        "baw-rotating",
+        "m2tfg-ratetable",
+    ]
+    .iter()
+    .map(|d| {
+        let s: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join(d).join("summary.json")).unwrap(),
+        )
+        .unwrap();
+        s["point_samples_emulated"].as_f64().unwrap()
+    })
+    .sum();
+    // The bandwidth sweep: nine table points of 12.2 s of settling plus max(2/f, 4) s.
+    let bandwidth = emulated - swept;
+    assert!((4.9e7..5.1e7).contains(&bandwidth), "{bandwidth:e}");
     // inspect reads a dump back: the Coriolis drive is F1 cos(w0 t) with F1 = 1, a tone of
     // -3.01 dB re 1 m/s^2 rms at f0 = 15 kHz.
     let o = gyroemu(&[

@@ -102,27 +102,31 @@ struct Job {
 /// What `reproduce` checked before running: every experiment's config, validated.
 pub struct ReproducePlan {
     jobs: Vec<Job>,
+    /// The bandwidth sweep's configs (one per table frequency), validated.
+    bandwidth: Vec<Config>,
     quick: bool,
     /// The configs' warnings, each prefixed with its preset.
     pub warnings: Vec<String>,
 }
 
 impl ReproducePlan {
-    /// The emulation the figures' sweeps will run (the bandwidth sweep adds about 3 %).
+    /// The emulation the figures' sweeps and the bandwidth sweep will run (its points as
+    /// each would run alone: the work the results report).
     pub fn work(&self) -> gyroemu_experiment::Work {
         self.jobs
             .iter()
             .map(|j| job_work(&j.cfg))
+            .chain(self.bandwidth.iter().map(gyroemu_experiment::sweep_work))
             .reduce(|a, b| a.plus(b))
             .expect("reproduce has jobs")
     }
 
-    /// A config of the plan (to measure the chain's throughput on).
     /// The folders, below the output folder, that each preset's files go into.
     pub fn preset_folders(&self) -> Vec<&'static str> {
         self.jobs.iter().map(|j| j.preset).collect()
     }
 
+    /// A config of the plan (to measure the chain's throughput on).
     pub fn first_config(&self) -> &Config {
         &self.jobs[0].cfg
     }
@@ -164,8 +168,11 @@ pub fn plan_reproduce(quick: bool) -> Result<ReproducePlan, ReportError> {
             cfg,
         });
     }
+    let rt_cfg = &jobs[job_index(&jobs, "m2tfg-ratetable")].cfg;
+    let bandwidth = bandwidth_configs(rt_cfg)?;
     Ok(ReproducePlan {
         jobs,
+        bandwidth,
         quick,
         warnings,
     })
@@ -233,8 +240,7 @@ pub fn reproduce(
             opts,
         )?);
     }
-    let bandwidth_cfgs = bandwidth_configs(rt_cfg)?;
-    let tables = PreparedTables::new(&bandwidth_cfgs, Some(1))?;
+    let tables = PreparedTables::new(&plan.bandwidth, Some(1))?;
     // Every lane group of every experiment and of the bandwidth sweep from one queue, the
     // longest first; beside them the stage-2 leaks, which depend on the configs alone.
     // The stage-2 leaks depend on the configs alone: items beside the groups compute them,
@@ -265,15 +271,18 @@ pub fn reproduce(
             }
         })
         .collect();
-    let bandwidth_out: Mutex<Option<Result<[PathBuf; 2], ReportError>>> = Mutex::new(None);
+    // The bandwidth sweep's point-samples and files.
+    let bandwidth_out: Mutex<Option<Result<(u64, [PathBuf; 2]), ReportError>>> = Mutex::new(None);
     let bandwidth_finish = || {
         let res = (|| -> Result<_, ReportError> {
-            let runs = bandwidth_points(rt_cfg, &tables.finish()?);
+            let results = tables.finish()?;
+            let work = results.iter().map(|r| r.point_samples).sum::<u64>();
+            let runs = bandwidth_points(rt_cfg, &results);
             let (figure, csv) = bandwidth_outputs(rt_cfg, &runs, out)?;
             let path = out.join("fig_bandwidth.png");
             render_png(&figure, &path)?;
             // The bandwidth sweep's table goes before its figure.
-            Ok([csv, path])
+            Ok((work, [csv, path]))
         })();
         *lock(&bandwidth_out) = Some(res);
     };
@@ -301,7 +310,10 @@ pub fn reproduce(
         runs.push(s?);
     }
     let bandwidth_files = bandwidth_files?;
-    let point_samples: u64 = runs.iter().map(|(_, r, _)| r.point_samples).sum();
+    // Every point-sample emulated: the figures' sweeps and the bandwidth sweep's.
+    let (bandwidth_work, bandwidth_files) = bandwidth_files;
+    let point_samples: u64 =
+        runs.iter().map(|(_, r, _)| r.point_samples).sum::<u64>() + bandwidth_work;
     let written = runs.iter().map(|(run, _, _)| run.written()).fold(
         Default::default(),
         |a: gyroemu_experiment::Written, w| gyroemu_experiment::Written {
