@@ -67,6 +67,9 @@ type JobOutput = (
     Option<Result<(Vec<PathBuf>, Option<PathBuf>), ReportError>>,
 );
 
+/// What the bandwidth sweep's read-out gives: its point-samples, its table and its figure.
+type BandwidthOutput = (u64, [PathBuf; 2]);
+
 /// A mutex's value, whether or not a panicking holder poisoned it.
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
@@ -272,7 +275,7 @@ pub fn reproduce(
         })
         .collect();
     // The bandwidth sweep's point-samples and files.
-    let bandwidth_out: Mutex<Option<Result<(u64, [PathBuf; 2]), ReportError>>> = Mutex::new(None);
+    let bandwidth_out: Mutex<Option<Result<BandwidthOutput, ReportError>>> = Mutex::new(None);
     let bandwidth_finish = || {
         let res = (|| -> Result<_, ReportError> {
             let results = tables.finish()?;
