@@ -37,46 +37,56 @@ pub fn run_longest_first<'s>(mut items: Vec<(f64, Item<'s>)>) {
     });
 }
 
-/// Runs `then` once after the last of `n` items (each calls the returned closure when done),
-/// on the thread that ran it: a sweep finished as soon as its groups are, while other items
-/// still run.
-fn countdown<'s>(n: usize, then: Option<&'s (dyn Fn() + Sync)>) -> impl Fn() + Send + Sync + 's {
-    let left = Arc::new(AtomicUsize::new(n));
-    move || {
+/// The items of `n` lane groups, group `g` costing `cost(g)` and run by `run(g, scope)`;
+/// `then` runs once right after the last of them, on the thread that ran it (so a sweep is
+/// finished as soon as its groups are, while other items still run), or at once, in an item
+/// of its own, when there is no group to run.
+fn group_items<'s>(
+    n: usize,
+    cost: impl Fn(usize) -> f64,
+    run: impl Fn(usize, &rayon::Scope<'s>) + Send + Sync + 's,
+    then: Option<&'s (dyn Fn() + Sync)>,
+) -> Vec<(f64, Item<'s>)> {
+    let left = Arc::new(AtomicUsize::new(n.max(1)));
+    let done = move || {
         if left.fetch_sub(1, Ordering::AcqRel) == 1 {
             if let Some(f) = then {
                 f();
             }
         }
+    };
+    if n == 0 {
+        return vec![(0.0, Box::new(move |_: &rayon::Scope<'s>| done()))];
     }
+    let (run, done) = (Arc::new(run), Arc::new(done));
+    (0..n)
+        .map(|g| {
+            let (run, done) = (run.clone(), done.clone());
+            let item: Item<'s> = Box::new(move |s: &rayon::Scope<'s>| {
+                run(g, s);
+                done();
+            });
+            (cost(g), item)
+        })
+        .collect()
 }
 
 /// The items of `sweep`'s lane groups, each costing its input samples times `per_sample`
-/// (the chain's relative cost per sample); `then` runs right after the last of them (at once,
-/// in an item of its own, for a sweep with no group to run).
+/// (the chain's relative cost per sample), followed by `then` ([`group_items`]).
 pub fn sweep_items<'s>(
     sweep: &'s PreparedSweep<'s>,
     per_sample: f64,
     then: Option<&'s (dyn Fn() + Sync)>,
 ) -> Vec<(f64, Item<'s>)> {
-    let done = Arc::new(countdown(sweep.groups().max(1), then));
-    if sweep.groups() == 0 {
-        return vec![(0.0, Box::new(move |_: &rayon::Scope<'s>| done()))];
-    }
-    (0..sweep.groups())
-        .map(|g| {
-            let done = done.clone();
-            let item: Item<'s> = Box::new(move |s: &rayon::Scope<'s>| {
-                let hand_on = |p: &Probe| {
-                    let p = p.clone();
-                    s.spawn(move |_| sweep.write_early_dump(&p));
-                };
-                sweep.run_group(g, &hand_on);
-                done();
-            });
-            (sweep.group_samples(g) as f64 * per_sample, item)
-        })
-        .collect()
+    let run = move |g: usize, s: &rayon::Scope<'s>| {
+        let hand_on = |p: &Probe| {
+            let p = p.clone();
+            s.spawn(move |_| sweep.write_early_dump(&p));
+        };
+        sweep.run_group(g, &hand_on);
+    };
+    let cost = |g: usize| sweep.group_samples(g) as f64 * per_sample;
+    group_items(sweep.groups(), cost, run, then)
 }
 
 /// The items of the table sweeps' lane groups, costed and followed by `then` as in
@@ -86,18 +96,7 @@ pub fn table_items<'s>(
     per_sample: f64,
     then: Option<&'s (dyn Fn() + Sync)>,
 ) -> Vec<(f64, Item<'s>)> {
-    let done = Arc::new(countdown(tables.groups().max(1), then));
-    if tables.groups() == 0 {
-        return vec![(0.0, Box::new(move |_: &rayon::Scope<'s>| done()))];
-    }
-    (0..tables.groups())
-        .map(|g| {
-            let done = done.clone();
-            let item: Item<'s> = Box::new(move |_: &rayon::Scope<'s>| {
-                tables.run_group(g);
-                done();
-            });
-            (tables.group_samples(g) as f64 * per_sample, item)
-        })
-        .collect()
+    let run = move |g: usize, _: &rayon::Scope<'s>| tables.run_group(g);
+    let cost = |g: usize| tables.group_samples(g) as f64 * per_sample;
+    group_items(tables.groups(), cost, run, then)
 }

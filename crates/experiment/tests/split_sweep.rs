@@ -202,3 +202,23 @@ fn the_queue_takes_the_costliest_item_first_and_runs_what_items_spawn() {
     spawned.sort_unstable();
     assert_eq!(spawned, [10, 11, 12, 13, 14]);
 }
+
+#[test]
+fn a_sweep_is_finished_once_right_after_its_last_group() {
+    let cfg = rotating();
+    let prepared = PreparedSweep::new(&cfg, &|_, _| {}, None, split(3)).unwrap();
+    assert!(prepared.groups() >= 2, "{} groups", prepared.groups());
+    let runs = Mutex::new(Vec::new());
+    let then = || runs.lock().unwrap().push(prepared.finish().unwrap());
+    let mut items = sweep_items(&prepared, 1.0, Some(&then));
+    // Other work in the queue, before and after the sweep's groups.
+    for c in [1e12, 0.0] {
+        let item: Item = Box::new(|_| {});
+        items.push((c, item));
+    }
+    run_longest_first(items);
+    let runs = runs.into_inner().unwrap();
+    // Once, and only when every group had run: both points are whole.
+    assert_eq!(runs.len(), 1);
+    assert_eq!(runs[0].lanes, sweep(&cfg, split(1)).lanes);
+}
