@@ -192,6 +192,9 @@ pub struct Board<S: Sample> {
     /// Phase-shifter error on the modulation's quadrature copy (rotating runs): (cos, sin).
     pub(crate) mod_shift: Option<(S, S)>,
     pub(crate) noise: NoiseState<S>,
+    /// Each lane's first input sample on the run's time axis ([`Board::with_starts`]; lanes
+    /// past the points repeat the last).
+    pub(crate) starts: [u64; MAX_LANES],
     /// The flicker sources (absent: none asked for).
     pub(crate) flicker: Option<FlickerSources<S>>,
     /// ADC after each TIA (absent: ideal).
@@ -361,6 +364,7 @@ impl<S: Sample> Board<S> {
                 sigma_current: sigma_current.map(S::splat),
             },
             adc,
+            starts: core::array::from_fn(lane_start),
             noise_on: p.noise.is_some(),
             flicker: FlickerSources::new(p, streams)?,
             imperfect,

@@ -8,7 +8,8 @@
 pub struct NonFinite {
     /// The first stage (in chain order) whose output was not finite.
     pub stage: &'static str,
-    /// Input sample index from the start of the run.
+    /// Input sample index from the start of the run (of the point's time axis, for a lane
+    /// that started late: `Board::with_starts`).
     pub sample: u64,
     /// The same as a time, s.
     pub time_s: f64,

@@ -521,13 +521,17 @@ impl<S: Sample> Board<S> {
     #[cold]
     pub(crate) fn locate_fault(&self, k_bad: u64) -> NonFinite {
         let m = self.decimation as u64;
-        let rate_dps = |lane: usize| self.rate.lane(lane).to_degrees();
-        let fallback = NonFinite {
-            stage: "lowpass",
-            sample: k_bad * m + m - 1,
-            time_s: (k_bad * m + m - 1) as f64 / self.fs_hz,
-            rate_dps: rate_dps(0),
+        // On the run's time axis: a lane that started late counts from where it started.
+        let at = |stage: &'static str, local: u64, lane: usize| {
+            let sample = self.starts[lane] + local;
+            NonFinite {
+                stage,
+                sample,
+                time_s: sample as f64 / self.fs_hz,
+                rate_dps: self.rate.lane(lane).to_degrees(),
+            }
         };
+        let fallback = at("lowpass", k_bad * m + m - 1, 0);
         let Some(pristine) = &self.pristine else {
             return fallback;
         };
@@ -539,12 +543,7 @@ impl<S: Sample> Board<S> {
                 for k in 0..=k_bad {
                     board.replay_block(k * m, &mut probe);
                     if let Some((stage, sample, lane)) = probe.fault() {
-                        return NonFinite {
-                            stage,
-                            sample,
-                            time_s: sample as f64 / self.fs_hz,
-                            rate_dps: rate_dps(lane),
-                        };
+                        return at(stage, sample, lane);
                     }
                 }
                 fallback

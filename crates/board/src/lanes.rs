@@ -94,6 +94,7 @@ pub const FOUR_LANE_COST: f64 = 1.5;
 /// short ones run in a group of four of their own rather than keep seven lanes idle.
 pub fn groups_by_length(samples: &[u64], width: usize) -> Vec<usize> {
     let n = samples.len();
+    let width = width.max(1);
     let cost = |first: usize, size: usize| {
         let lanes = if size <= 4 { 4.0 * FOUR_LANE_COST } else { 8.0 };
         samples[first] as f64 * lanes

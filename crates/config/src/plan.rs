@@ -43,11 +43,17 @@ impl Config {
     /// The settling time used: the configured one, or 16 mechanical time constants (phase
     /// error below 0.01 mdeg, THEORY.md section 7) plus 40 low-pass time constants.
     pub fn settle_s(&self) -> f64 {
-        self.experiment.settle_s.unwrap_or_else(|| {
-            let q = self.device.q.max(self.device.q_mode2.unwrap_or(0.0));
-            16.0 * mechanical_tau_s(self.device.f0_hz, q)
-                + 40.0 / (2.0 * core::f64::consts::PI * self.lpf_cutoff_hz())
-        })
+        self.experiment
+            .settle_s
+            .unwrap_or_else(|| self.default_settle_s())
+    }
+
+    /// The default settling: 16 mechanical time constants (of the higher Q) plus 40 of the
+    /// low-pass.
+    pub fn default_settle_s(&self) -> f64 {
+        let q = self.device.q.max(self.device.q_mode2.unwrap_or(0.0));
+        16.0 * mechanical_tau_s(self.device.f0_hz, q)
+            + 40.0 / (2.0 * core::f64::consts::PI * self.lpf_cutoff_hz())
     }
 
     /// Settling in decimated samples (the whole output periods that cover `settle_s`).

@@ -169,18 +169,26 @@ impl<'a> PreparedSweep<'a> {
     /// Runs group `g` (once) on this thread; `hand_on` receives the dump's probe as soon as
     /// its windows are recorded (see [`SweepOptions::on_dump_early`]), when asked for.
     pub fn run_group(&self, g: usize, hand_on: &(dyn Fn(&Probe) + Sync)) {
-        let outcome = self.run_group_inner(g, hand_on);
+        // A group runs once: a second call leaves its outcome as it is.
+        let Some(board) = lock(&self.boards[g]).take() else {
+            return;
+        };
+        let outcome = self.run_group_inner(g, board, hand_on);
         if matches!(outcome, Some(Err(_))) {
             self.stop.store(true, Ordering::Relaxed);
         }
         *lock(&self.outcomes[g]) = outcome;
     }
 
-    fn run_group_inner(&self, g: usize, hand_on: &(dyn Fn(&Probe) + Sync)) -> Outcome {
+    fn run_group_inner(
+        &self,
+        g: usize,
+        mut board: GroupBoard,
+        hand_on: &(dyn Fn(&Probe) + Sync),
+    ) -> Outcome {
         if self.user_cancel() {
             self.stop.store(true, Ordering::Relaxed);
         }
-        let mut board = lock(&self.boards[g]).take()?;
         if self.stop.load(Ordering::Relaxed) {
             return None;
         }

@@ -3,8 +3,9 @@
 //! rest (`Board::with_starts`), so one long point no longer bounds a run to one thread and one
 //! lane. Every sample is still emulated; the segments' averages, weighted by their spans, are
 //! the average over the whole window, up to what each segment's settling leaves of its start
-//! transient (below 1e-7 of the response after the default 16 time constants; THEORY
-//! section 7).
+//! transient (e^-16 = 1.1e-7 of the response after the default 16 time constants, THEORY
+//! section 7, decaying within a time constant of the segment). A sweep whose settling is
+//! shorter than the default runs whole.
 //!
 //! The cut depends on the config alone (never on the machine), so a split sweep gives the
 //! same bits on every CPU, lane width and thread count.
@@ -48,11 +49,13 @@ pub enum Packing {
 /// when `split` is asked and the sweep can be split, else one whole point per lane. A sweep
 /// is split when: its points have boxcar windows on a constant-rate or rotating board without
 /// noise (a rate table counts its phase from sample 0; a noisy point's segments would draw
-/// other streams than the point), and `k`, the smallest number of segments that fills whole
-/// groups of eight lanes (`8 / gcd(points, 8)`, times the largest whole factor that keeps
-/// every segment at least [`MIN_SEGMENT_SETTLES`] settling times long, at most
-/// [`MAX_SEGMENTS`]), is above 1; and the dump (ending at `dump_end_s` from the start of its
-/// run) fits in its point's first segment.
+/// other streams than the point), settling at least the default time; `k`, the smallest
+/// number of segments that fills whole groups of eight lanes (`8 / gcd(points, 8)`), times
+/// the largest whole factor that keeps the longest point's segments at least
+/// [`MIN_SEGMENT_SETTLES`] settling times long (at most [`MAX_SEGMENTS`]), is above 1; and the
+/// dump (ending at `dump_end_s` from the start of its run) fits in its point's first segment.
+/// A dump that does not fit keeps the sweep whole: its bits are then a continuous run's, not a
+/// split one's (a dump of the first second, as `reproduce` records, always fits).
 pub fn lanes_of(
     cfg: &Config,
     todo: &[usize],
@@ -122,10 +125,14 @@ pub fn lanes_of(
     (lanes, packing)
 }
 
-/// A board `cfg` describes runs segments that start late: constant rate or rotating, no noise.
+/// A board `cfg` describes runs segments that start late (constant rate or rotating, no
+/// noise), and each settles at least the default time: the start transient a split point
+/// averages is each segment's, so it must be as small as the one a whole run leaves.
 fn splittable(cfg: &Config) -> bool {
     let p = cfg.board_params();
-    p.noise.is_none() && !matches!(p.shape, gyroemu_board::Shape::RateTable { .. })
+    p.noise.is_none()
+        && !matches!(p.shape, gyroemu_board::Shape::RateTable { .. })
+        && cfg.settle_s() >= cfg.default_settle_s()
 }
 
 /// The segment length (decimated samples) for at least `len`: rounded up to a whole number
@@ -317,6 +324,14 @@ mod tests {
         let mut hann = fig9.clone();
         hann.experiment.window = gyroemu_config::WindowKind::Hann;
         assert!(whole(&hann, None));
+        // A settling shorter than the default would leave a larger transient in every
+        // segment; a longer one keeps the split (while segments stay 64 settlings long).
+        let mut short = fig9.clone();
+        short.experiment.settle_s = Some(0.9 * fig9.default_settle_s());
+        assert!(whole(&short, None));
+        let mut long = fig9.clone();
+        long.experiment.settle_s = Some(1.2 * fig9.default_settle_s());
+        assert!(!whole(&long, None));
         // A dump that ends past the first segment.
         assert!(whole(&fig9, Some(100.0)));
         assert!(!whole(&fig9, Some(10.0)));

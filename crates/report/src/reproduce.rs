@@ -208,8 +208,8 @@ pub fn reproduce(
     };
     let rt_cfg = &jobs[job_index(jobs, "m2tfg-ratetable")].cfg;
     let dirs: Vec<PathBuf> = jobs.iter().map(|j| out.join(j.preset)).collect();
-    // The dump and its figures as soon as its window is recorded, in a task taken between
-    // lane groups: the last experiment's would otherwise be drawn at the end of the run.
+    // The dump and its figures as soon as its window is recorded, by the group that recorded
+    // it: the last experiment's would otherwise be drawn at the end of the run.
     let dump_figures: Vec<_> = dirs
         .iter()
         .map(|dir| {
@@ -300,7 +300,7 @@ pub fn reproduce(
         Some(&bandwidth_finish),
     ));
     for i in 0..jobs.len() {
-        let item: Item = Box::new(move |_| {
+        let item: Item = Box::new(move || {
             leaks_of(i);
         });
         items.push((0.0, item));
@@ -313,7 +313,8 @@ pub fn reproduce(
         runs.push(s?);
     }
     let bandwidth_files = bandwidth_files?;
-    // Every point-sample emulated: the figures' sweeps and the bandwidth sweep's.
+    // The work of every point: the figures' sweeps' and the bandwidth sweep's (each point as
+    // it would run alone; Fig. 9's split points run 1 % more, their segments' settling).
     let (bandwidth_work, bandwidth_files) = bandwidth_files;
     let point_samples: u64 =
         runs.iter().map(|(_, r, _)| r.point_samples).sum::<u64>() + bandwidth_work;
@@ -590,4 +591,33 @@ pub fn fig6(cfg: &Config, cor: &SweepResult, rot: &SweepResult) -> Figure {
         fig = fig.with(s);
     }
     fig
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_full_plan_splits_fig9_and_counts_the_bandwidth_sweep() {
+        let full = plan_reproduce(false).unwrap();
+        let w = full.work();
+        // The five presets' 37 points and the bandwidth sweep's 9.
+        assert_eq!(w.points, 37 + 9);
+        // Fig. 9's points are 500.6 s of signal (0.71 s of settling and up to 499.9 s of
+        // averaging); split into eight segments, its longest lane runs 63.2 s.
+        assert!((w.longest_s - 500.6).abs() < 0.05, "{}", w.longest_s);
+        let rot = &full.jobs[job_index(&full.jobs, "m2tfg-rotating")].cfg;
+        let whole = gyroemu_experiment::sweep_work(rot).longest_samples;
+        let split = job_work(rot).longest_samples;
+        let segment_s = split as f64 / rot.fs_hz();
+        assert!((segment_s - 63.2).abs() < 0.05, "{segment_s} s");
+        assert!(split < whole / 7, "{split} of {whole}");
+        // --quick's 15 s is too short to split.
+        let quick = plan_reproduce(true).unwrap();
+        let rot = &quick.jobs[job_index(&quick.jobs, "m2tfg-rotating")].cfg;
+        assert_eq!(
+            job_work(rot).longest_samples,
+            gyroemu_experiment::sweep_work(rot).longest_samples
+        );
+    }
 }
