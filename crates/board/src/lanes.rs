@@ -117,6 +117,18 @@ pub fn groups_by_length(samples: &[u64], width: usize) -> Vec<usize> {
     sizes
 }
 
+/// The sizes of the lane groups of points whose runs are `samples` input samples (longest
+/// first) for `threads` threads: cut by the runs ([`groups_by_length`]) on one thread (a
+/// thread of a pool shared with other work), else to keep every thread busy
+/// ([`lane_groups`]); each at most [`max_lanes`].
+pub fn group_sizes(samples: &[u64], threads: usize) -> Vec<usize> {
+    if threads == 1 {
+        groups_by_length(samples, max_lanes())
+    } else {
+        lane_groups(samples.len(), threads, max_lanes())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -31,7 +31,7 @@ pub use fault::NonFinite;
 pub use group::GroupBoard;
 pub use health::Health;
 pub use lanes::{
-    eight_lanes_available, groups_by_length, lane_groups, max_lanes, set_max_lanes,
+    eight_lanes_available, group_sizes, groups_by_length, lane_groups, max_lanes, set_max_lanes,
     CANONICAL_LANES, FOUR_LANE_COST, MAX_LANES,
 };
 pub use lock::{lock_carrier, LockRun, LockSample};

@@ -1,8 +1,8 @@
 //! A sweep taken apart for whoever runs it: [`PreparedSweep::new`] plans its lane groups and
 //! builds every board (so a bad parameter fails before any sample), [`PreparedSweep::run_group`]
 //! runs one group on the calling thread, and [`PreparedSweep::finish`] writes the dump and puts
-//! the points together. [`crate::run_sweep_with`] runs one sweep's groups in parallel;
-//! [`crate::run_sweeps`] runs several sweeps' groups from one queue, longest first.
+//! the points together. [`run_sweep_with`] runs one sweep's groups in parallel;
+//! [`crate::queue`] runs several sweeps' groups from one queue, the costliest first.
 
 use crate::dump::DumpPlan;
 use crate::progress::Progress;
@@ -12,9 +12,7 @@ use crate::sweep::{
     add_group_progress, finish_sweep, group_samples, write_dump, DumpWritten, SweepError,
     SweepOptions, SweepRun,
 };
-use gyroemu_board::{
-    groups_by_length, lane_groups, max_lanes, GroupBoard, LaneResult, Point, Probe, RunOptions,
-};
+use gyroemu_board::{group_sizes, GroupBoard, LaneResult, Point, Probe, RunOptions};
 use gyroemu_config::Config;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -51,7 +49,8 @@ pub struct PreparedSweep<'a> {
     done_points: Mutex<BTreeMap<usize, LaneResult>>,
     /// Raised by the caller's flag (copied at each progress report) or by a failed group.
     stop: Arc<AtomicBool>,
-    /// The dump written early (`on_dump_early`), by the task its recorded probe spawned.
+    /// The dump written early (`on_dump_early`) by [`PreparedSweep::write_early_dump`], which
+    /// the recording group's hand-on calls (or a task it spawns).
     early: Mutex<Option<Result<DumpWritten, SweepError>>>,
 }
 
@@ -97,7 +96,11 @@ impl<'a> PreparedSweep<'a> {
             .map(|(_, d)| d.start_s + d.duration_s.max(d.decimated_duration_s));
         let (lanes, packing) = lanes_of(cfg, &todo, &plan, opts.split && whole_run, dump_end_s);
         let groups = pack(&lanes, packing, &|set| {
-            sizes(set, threads, cfg.n_settle_out())
+            let runs: Vec<u64> = set
+                .iter()
+                .map(|l| cfg.n_settle_out() + l.window.samples())
+                .collect();
+            group_sizes(&runs, threads)
         });
         let mut lanes_per_point: BTreeMap<usize, usize> = BTreeMap::new();
         for l in &lanes {
@@ -248,8 +251,9 @@ impl<'a> PreparedSweep<'a> {
         })())
     }
 
-    /// Writes the dump recorded by the group that handed its probe on: the work of the task
-    /// [`PreparedSweep::run_group`]'s `hand_on` spawns.
+    /// Writes the dump recorded by the group that handed its probe on (with `on_dump_early`):
+    /// what [`PreparedSweep::run_group`]'s `hand_on` calls, on the group's thread (the queue)
+    /// or in a task it spawns ([`run_sweep_with`]).
     pub fn write_early_dump(&self, p: &Probe) {
         if let (Some(then), Some(dir)) = (self.opts.on_dump_early, self.dump_dir) {
             *lock(&self.early) = Some(write_dump(p, dir, Some(then)));
@@ -340,10 +344,13 @@ pub fn run_sweep(
 }
 
 /// Runs the points of a sweep that `opts` assigns and that are not done yet, in lane groups
-/// of four or eight ([`lane_groups`]), groups in parallel. A group runs as long as its longest
-/// window, so the points are packed by window length (longest first, index order among
-/// equals) and a short window does not idle a lane beside a long one. Each point draws the noise stream of its index, and
-/// lanes do not interact, so any subset or grouping gives every point the same bits.
+/// of four or eight ([`group_sizes`]: cut by the lanes' runs when sized for one thread),
+/// groups in parallel; long points split into segments when
+/// [`SweepOptions::split`] asks and the sweep can be ([`crate::split`]). A group runs as long
+/// as its longest window, so the points are packed by window length (longest first, index
+/// order among equals) and a short window does not idle a lane beside a long one. Each point
+/// draws the noise stream of its index, and lanes do not interact, so any subset or grouping
+/// gives every point the same bits.
 pub fn run_sweep_with(
     cfg: &Config,
     progress: Progress,
@@ -364,18 +371,6 @@ pub fn run_sweep_with(
             .for_each(|g| sweep.run_group(g, &hand_on));
     });
     sweep.finish()
-}
-
-/// The sizes of the lane groups of `set` (longest first): sized by the lanes' runs on one
-/// thread (a thread of a pool shared with other work: `reproduce`), else to keep `threads`
-/// threads busy ([`lane_groups`]).
-fn sizes(set: &[Lane], threads: usize, n_settle: u64) -> Vec<usize> {
-    if threads == 1 {
-        let runs: Vec<u64> = set.iter().map(|l| n_settle + l.window.samples()).collect();
-        groups_by_length(&runs, max_lanes())
-    } else {
-        lane_groups(set.len(), threads, max_lanes())
-    }
 }
 
 /// A mutex's value, whether or not a panicking holder poisoned it.

@@ -168,7 +168,7 @@ pub fn pack(
     packing: Packing,
     sizes: &dyn Fn(&[Lane]) -> Vec<usize>,
 ) -> Vec<Vec<Lane>> {
-    let mut sets: Vec<Vec<Lane>> = match packing {
+    let sets: Vec<Vec<Lane>> = match packing {
         Packing::Free => {
             let mut v = lanes.to_vec();
             v.sort_by_key(|l| core::cmp::Reverse(l.window.samples()));
@@ -193,7 +193,7 @@ pub fn pack(
         }
     };
     let mut groups = Vec::new();
-    for set in sets.iter_mut() {
+    for set in &sets {
         let mut rest = &set[..];
         for size in sizes(set) {
             let (g, r) = rest.split_at(size);

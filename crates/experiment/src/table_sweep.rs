@@ -5,10 +5,7 @@
 
 use crate::readout::SweepResult;
 use crate::sweep::{finish_sweep, group_samples, SweepError};
-use gyroemu_board::{
-    groups_by_length, lane_groups, max_lanes, BoardParams, GroupBoard, LaneResult, RunOptions,
-    Shape,
-};
+use gyroemu_board::{group_sizes, BoardParams, GroupBoard, LaneResult, RunOptions, Shape};
 use gyroemu_config::Config;
 use gyroemu_mixer::MAX_TABLE_HARMONIC;
 use rayon::prelude::*;
@@ -120,17 +117,11 @@ impl<'c> PreparedTables<'c> {
             // Longest window first, so a group's lanes end together (as in a sweep).
             order.sort_by_key(|j| core::cmp::Reverse(j.point.window.samples()));
             let mut rest = &order[..];
-            // On one thread (a pool shared with other work), sized by the runs' lengths.
-            let sizes = if threads == 1 {
-                let runs: Vec<u64> = order
-                    .iter()
-                    .map(|j| n_settle + j.point.window.samples())
-                    .collect();
-                groups_by_length(&runs, max_lanes())
-            } else {
-                lane_groups(order.len(), threads, max_lanes())
-            };
-            for size in sizes {
+            let runs: Vec<u64> = order
+                .iter()
+                .map(|j| n_settle + j.point.window.samples())
+                .collect();
+            for size in group_sizes(&runs, threads) {
                 let (g, r) = rest.split_at(size);
                 rest = r;
                 // The board demodulates the most harmonics any of its lanes needs; a lane's

@@ -184,10 +184,11 @@ pub fn plan_reproduce(quick: bool) -> Result<ReproducePlan, ReportError> {
 /// Runs every figure's experiment of `plan` and writes the figures and summaries into `out`
 /// (which must exist); returns the files written.
 ///
-/// Every experiment's lane groups and the bandwidth sweep run in one parallel pool (one
-/// experiment alone often has fewer lane groups than the machine has cores), reported as one
-/// task; then each experiment's files and every figure are written in parallel. The files and
-/// their order are those of a sequential run.
+/// Every lane group of every experiment and of the bandwidth sweep runs from one queue, the
+/// costliest first (one experiment alone often has fewer lane groups than the machine has
+/// cores; Fig. 9's long points are split so that none bounds the run), reported as one task;
+/// each experiment's files and figure are written as soon as its last group has run. The
+/// files and their order are those of a sequential run.
 pub fn reproduce(
     plan: &ReproducePlan,
     out: &Path,
@@ -244,10 +245,10 @@ pub fn reproduce(
         )?);
     }
     let tables = PreparedTables::new(&plan.bandwidth, Some(1))?;
-    // Every lane group of every experiment and of the bandwidth sweep from one queue, the
-    // longest first; beside them the stage-2 leaks, which depend on the configs alone.
-    // The stage-2 leaks depend on the configs alone: items beside the groups compute them,
-    // or the read-out that needs them first (an error resurfaces in the read-out).
+    // Every lane group of every experiment and of the bandwidth sweep runs from one queue,
+    // the costliest first. The stage-2 leaks depend on the configs alone: items beside the
+    // groups compute them, or the read-out that needs them first (an error resurfaces in the
+    // read-out).
     let leaks: Vec<OnceLock<Stage2Leaks>> = jobs.iter().map(|_| OnceLock::new()).collect();
     let leaks_of =
         |i: usize| leaks[i].get_or_init(|| Stage2Leaks::of_sweep(&jobs[i].cfg).unwrap_or_default());
