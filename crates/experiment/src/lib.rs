@@ -8,6 +8,7 @@ pub mod dump;
 pub mod fit;
 pub mod leaks;
 pub mod lock;
+pub mod mutex;
 pub mod prepared;
 pub mod progress;
 pub mod queue;

@@ -5,6 +5,7 @@
 //! [`crate::queue`] runs several sweeps' groups from one queue, the costliest first.
 
 use crate::dump::DumpPlan;
+use crate::mutex::lock;
 use crate::progress::Progress;
 use crate::readout::SweepResult;
 use crate::split::{combine, lanes_of, pack, Lane};
@@ -371,11 +372,6 @@ pub fn run_sweep_with(
             .for_each(|g| sweep.run_group(g, &hand_on));
     });
     sweep.finish()
-}
-
-/// A mutex's value, whether or not a panicking holder poisoned it.
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// A group's finished lanes by point index (lanes of whole points only: a split sweep has no

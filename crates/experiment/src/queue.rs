@@ -5,6 +5,7 @@
 //! are estimates, and a sweep's read-out runs inside its last item), where items taken in any
 //! other order leave a long group to start late and run alone.
 
+use crate::mutex::lock;
 use crate::prepared::PreparedSweep;
 use crate::table_sweep::PreparedTables;
 use gyroemu_board::Probe;
@@ -25,7 +26,7 @@ pub fn run_longest_first<'s>(mut items: Vec<(f64, Item<'s>)>) {
         for _ in 0..threads {
             let queue = queue.clone();
             s.spawn(move |_| loop {
-                let next = queue.lock().unwrap_or_else(|e| e.into_inner()).next();
+                let next = lock(&queue).next();
                 let Some((_, item)) = next else { break };
                 item();
             });

@@ -3,6 +3,7 @@
 //! table. Run one by one, each would be a group of one point; packed, nine frequencies take
 //! two groups. Every point keeps the bits of its own sweep.
 
+use crate::mutex::lock;
 use crate::readout::SweepResult;
 use crate::sweep::{finish_sweep, group_samples, SweepError};
 use gyroemu_board::{group_sizes, BoardParams, GroupBoard, LaneResult, RunOptions, Shape};
@@ -220,11 +221,6 @@ impl<'c> PreparedTables<'c> {
             .map(|(cfg, l)| finish_sweep(cfg, l))
             .collect()
     }
-}
-
-/// A mutex's value, whether or not a panicking holder poisoned it.
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@ use gyroemu_analysis::bandwidth::{
 use gyroemu_config::presets::preset;
 use gyroemu_config::{Config, DumpConfig};
 use gyroemu_experiment::fit::LineFit;
+use gyroemu_experiment::mutex::lock;
 use gyroemu_experiment::prepared::PreparedSweep;
 use gyroemu_experiment::queue::{run_longest_first, sweep_items, table_items, Item};
 use gyroemu_experiment::table_sweep::PreparedTables;
@@ -69,11 +70,6 @@ type JobOutput = (
 
 /// What the bandwidth sweep's read-out gives: its point-samples, its table and its figure.
 type BandwidthOutput = (u64, [PathBuf; 2]);
-
-/// A mutex's value, whether or not a panicking holder poisoned it.
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
-}
 
 /// What a queue's item left in `m` (every item has run once the queue returns).
 fn taken<T>(m: &Mutex<Option<T>>) -> T {
