@@ -7,6 +7,7 @@
 mod axis;
 mod draw;
 mod error;
+mod fast_lines;
 mod figure;
 mod font;
 mod render;
