@@ -124,15 +124,13 @@ pub fn phase_fundamental(h: &[Complex64]) -> Complex64 {
     let mut prev = f64::NAN;
     let mut unwrapped = 0.0;
     let mut first = 0.0;
-    for g in 0..=G {
-        let (s, c) = sin_cos_turns(g as f64 / G as f64);
-        let base = Complex64::new(c, s);
-        // V(theta) by Horner in e^{j theta}, starting from the highest harmonic.
-        let mut v = Complex64::new(0.0, 0.0);
-        for x in h.iter().rev() {
-            v = v * base + x;
-        }
-        v *= Complex64::new(c, -s).powi(nh as i32);
+    // The grid's (sin, cos), once per process (the same bits as computing them here).
+    static GRID: std::sync::OnceLock<Box<[(f64, f64); G + 1]>> = std::sync::OnceLock::new();
+    let grid =
+        GRID.get_or_init(|| Box::new(core::array::from_fn(|g| sin_cos_turns(g as f64 / G as f64))));
+    let values = envelope_on_grid(h, &grid[..]);
+    for (g, (&(s, c), &v)) in grid.iter().zip(&values).enumerate() {
+        let v = v * Complex64::new(c, -s).powi(nh as i32);
         let ph = -v.arg();
         unwrapped = if prev.is_nan() {
             ph
@@ -152,4 +150,26 @@ pub fn phase_fundamental(h: &[Complex64]) -> Complex64 {
         return Complex64::new(f64::NAN, f64::NAN);
     }
     acc * (2.0 / G as f64)
+}
+
+/// `sum_n h[n] e^{j n theta}` at each grid point `(sin, cos)` of `theta`, by Horner from the
+/// highest harmonic. Eight grid points at a time, each with the operations of its own
+/// Horner (the same bits): one point's Horner is a chain of dependent products, and a
+/// theory curve's read-outs (49 harmonics, 1025 points each) waited on it.
+fn envelope_on_grid(h: &[Complex64], grid: &[(f64, f64)]) -> Vec<Complex64> {
+    const W: usize = 8;
+    let zero = Complex64::new(0.0, 0.0);
+    let mut out = Vec::with_capacity(grid.len());
+    for chunk in grid.chunks(W) {
+        let base: [Complex64; W] =
+            core::array::from_fn(|k| chunk.get(k).map_or(zero, |&(s, c)| Complex64::new(c, s)));
+        let mut v = [zero; W];
+        for x in h.iter().rev() {
+            for k in 0..W {
+                v[k] = v[k] * base[k] + x;
+            }
+        }
+        out.extend_from_slice(&v[..chunk.len()]);
+    }
+    out
 }
