@@ -634,17 +634,19 @@ impl AmpSpan {
 /// harmonics `-N ..= N`), on 16 (2N + 1) points per period: over a grid step near an
 /// extreme the envelope (its square a trigonometric polynomial of degree 2N) moves by about
 /// N^2 sum|h| (step/2)^2 / 2 (Bernstein), under 0.5 % of sum|h|.
+/// The modulus drops the common factor `e^{-j N phi}`, so each point is a polynomial in
+/// `e^{j phi}` by Horner: one `sin_cos` per point instead of one per harmonic (the validation
+/// of a rate-table sweep took 0.6 % of a `reproduce` with one per harmonic).
 fn envelope_extremes(h: &[Complex64]) -> (f64, f64) {
-    let n = (h.len() / 2) as f64;
     let points = 16 * h.len().max(1);
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for i in 0..points {
         let phi = core::f64::consts::TAU * i as f64 / points as f64;
-        let v: Complex64 = h
+        let base = Complex64::from_polar(1.0, phi);
+        let v = h
             .iter()
-            .enumerate()
-            .map(|(m, &x)| x * Complex64::from_polar(1.0, (m as f64 - n) * phi))
-            .sum();
+            .rev()
+            .fold(Complex64::new(0.0, 0.0), |v, &x| v * base + x);
         let a = v.norm();
         if a.is_nan() {
             return (f64::NAN, f64::NAN);
@@ -653,4 +655,58 @@ fn envelope_extremes(h: &[Complex64]) -> (f64, f64) {
         hi = hi.max(a);
     }
     (lo, hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn envelope_extremes_of_two_harmonics_in_closed_form() {
+        // |a e^{-j phi} + b e^{j phi}| for real a, b: a + b at phi = 0 and |a - b| at
+        // phi = pi / 2, both on the 48-point grid of three harmonics.
+        for (a, b) in [(1.0, 0.25), (0.3, 2.0), (1.0, 1.0)] {
+            let h = [
+                Complex64::new(a, 0.0),
+                Complex64::new(0.0, 0.0),
+                Complex64::new(b, 0.0),
+            ];
+            let (lo, hi) = envelope_extremes(&h);
+            assert!((hi - (a + b)).abs() < 1e-14, "{a}, {b}: max {hi}");
+            assert!((lo - (a - b).abs()).abs() < 1e-14, "{a}, {b}: min {lo}");
+        }
+    }
+
+    #[test]
+    fn envelope_extremes_match_the_sum_term_by_term() {
+        // The definition on the same grid, each harmonic's phasor on its own.
+        let mut x: u64 = 12345;
+        let mut next = move || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for len in [1usize, 3, 5, 9, 15] {
+            let h: Vec<Complex64> = (0..len).map(|_| Complex64::new(next(), next())).collect();
+            let n = (len / 2) as f64;
+            let points = 16 * len;
+            let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+            for i in 0..points {
+                let phi = core::f64::consts::TAU * i as f64 / points as f64;
+                let v: Complex64 = h
+                    .iter()
+                    .enumerate()
+                    .map(|(m, &x)| x * Complex64::from_polar(1.0, (m as f64 - n) * phi))
+                    .sum();
+                lo = lo.min(v.norm());
+                hi = hi.max(v.norm());
+            }
+            let (l, u) = envelope_extremes(&h);
+            assert!(
+                (l - lo).abs() < 1e-13 && (u - hi).abs() < 1e-13,
+                "{len}: {l} {u} vs {lo} {hi}"
+            );
+        }
+    }
 }
