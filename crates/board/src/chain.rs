@@ -83,8 +83,10 @@ impl ChainResponse {
     /// `Z_m` of `z`; [`unleak_table_harmonics`] solves it.
     pub fn table_leak(&self, point: &Point, n_settle: u64, harmonics: usize) -> Vec<Complex64> {
         let m = self.decimation as u64;
-        let nd = 4 * harmonics + 1;
-        let mut sum: Vec<[KahanSum<f64>; 2]> = vec![[KahanSum::new(), KahanSum::new()]; nd];
+        let top = 2 * harmonics;
+        // K(d) for d = 0 ..= 2N; the weights are real, so K(-d) = conj K(d), whose sums are
+        // the same sums negated (rounding to nearest is symmetric): half the work.
+        let mut sum: Vec<[KahanSum<f64>; 2]> = vec![[KahanSum::new(), KahanSum::new()]; top + 1];
         let mut wsum = KahanSum::<f64>::new();
         for j in 0..point.window.samples() {
             let w = point.window.weight(j);
@@ -93,24 +95,24 @@ impl ChainResponse {
             }
             let n = (n_settle + j) * m + m - 1;
             let e = table_reference(n, self.table_hz, self.fs_hz).conj();
-            // e^{j d theta} for d = 0 ..= 2N, the negative ones as conjugates.
             let mut p = Complex64::new(w, 0.0);
-            for d in 0..=2 * harmonics {
-                for (idx, v) in [(2 * harmonics + d, p), (2 * harmonics - d, p.conj())] {
-                    sum[idx][0].add(v.re);
-                    sum[idx][1].add(v.im);
-                }
+            for s in sum.iter_mut() {
+                s[0].add(p.re);
+                s[1].add(p.im);
                 p *= e;
             }
             wsum.add(w);
         }
-        let mut k: Vec<Complex64> = sum
-            .iter()
-            .map(|[re, im]| Complex64::new(re.value(), im.value()) / wsum.value())
-            .collect();
-        // d = 0 was added twice.
-        k[2 * harmonics] *= 0.5;
-        k
+        let k = |d: usize| {
+            let [re, im] = &sum[d];
+            Complex64::new(re.value(), im.value()) / wsum.value()
+        };
+        (0..=2 * top)
+            .map(|i| match i.checked_sub(top) {
+                Some(d) => k(d),
+                None => k(top - i).conj(),
+            })
+            .collect()
     }
 
     /// The table frequency the board realises, Hz (0 outside rate-table runs).
