@@ -44,8 +44,16 @@ fn check_target(path: &Path, w: u32, h: u32) -> Result<(), PlotError> {
 /// Averages each `k` x `k` block of an RGB image `w` x `h` (multiples of `k`) into one pixel,
 /// rounding to nearest: the image's mean intensity is kept to within half a level.
 pub fn downsample_rgb(src: &[u8], w: usize, h: usize, k: usize) -> Vec<u8> {
+    let mut out = Vec::new();
+    downsample_into(src, w, h, k, &mut out);
+    out
+}
+
+/// [`downsample_rgb`] into `out` (resized; every byte written).
+fn downsample_into(src: &[u8], w: usize, h: usize, k: usize, out: &mut Vec<u8>) {
     let (ow, oh) = (w / k, h / k);
-    let mut out = vec![0u8; ow * oh * 3];
+    out.clear();
+    out.resize(ow * oh * 3, 0);
     if k == 2 {
         // The PNG path: two rows at a time, two pixels (6 bytes) per output pixel.
         for (oy, o) in out.chunks_exact_mut(ow * 3).enumerate() {
@@ -65,7 +73,7 @@ pub fn downsample_rgb(src: &[u8], w: usize, h: usize, k: usize) -> Vec<u8> {
                 }
             }
         }
-        return out;
+        return;
     }
     let n = (k * k) as u32;
     for oy in 0..oh {
@@ -85,11 +93,11 @@ pub fn downsample_rgb(src: &[u8], w: usize, h: usize, k: usize) -> Vec<u8> {
             }
         }
     }
-    out
 }
 
-/// Draws `draw` onto a white `w * k` x `h * k` canvas and returns it averaged down to `w` x `h`.
-fn supersampled<F>(w: u32, h: u32, k: u32, draw: F) -> Result<Vec<u8>, PlotError>
+/// Draws `draw` onto a white `w * k` x `h * k` canvas and leaves it averaged down to `w` x `h`
+/// in `out`.
+fn supersampled<F>(w: u32, h: u32, k: u32, draw: F, out: &mut Vec<u8>) -> Result<(), PlotError>
 where
     F: FnOnce(&Area) -> DrawResult,
 {
@@ -106,19 +114,51 @@ where
         root.present()?;
         Ok(())
     })();
-    let out = match drawn {
+    let res = match drawn {
         Err(source) => Err(gyroemu_io::IoError::Producer {
             path: "<memory>".into(),
             reason: source,
         }
         .into()),
-        Ok(()) if k == 1 => return Ok(buf),
-        Ok(()) => Ok(downsample_rgb(&buf, bw as usize, bh as usize, k as usize)),
+        Ok(()) if k == 1 => {
+            std::mem::swap(&mut buf, out);
+            Ok(())
+        }
+        Ok(()) => {
+            downsample_into(&buf, bw as usize, bh as usize, k as usize, out);
+            Ok(())
+        }
     };
+    keep(&CANVAS, buf);
+    res
+}
+
+/// [`supersampled`] into a new buffer (for the caller to keep).
+fn in_memory<F>(w: u32, h: u32, k: u32, draw: F) -> Result<Vec<u8>, PlotError>
+where
+    F: FnOnce(&Area) -> DrawResult,
+{
+    let mut out = Vec::new();
+    supersampled(w, h, k, draw, &mut out)?;
+    Ok(out)
+}
+
+/// [`supersampled`] into the thread's image buffer, encoded as a PNG at `path` (atomically).
+fn to_png<F>(path: &Path, w: u32, h: u32, k: u32, draw: F) -> Result<(), PlotError>
+where
+    F: FnOnce(&Area) -> DrawResult,
+{
+    let mut rgb = IMAGE.with_borrow_mut(std::mem::take);
+    let res = supersampled(w, h, k, draw, &mut rgb).and_then(|()| write_png(path, w, h, &rgb));
+    keep(&IMAGE, rgb);
+    res
+}
+
+/// Keeps `buf` in `slot` for the thread's next figure, unless it is larger than any preset's.
+fn keep(slot: &'static std::thread::LocalKey<std::cell::RefCell<Vec<u8>>>, buf: Vec<u8>) {
     if buf.capacity() <= MAX_KEPT_CANVAS {
-        CANVAS.with_borrow_mut(|c| *c = buf);
+        slot.with_borrow_mut(|c| *c = buf);
     }
-    out
 }
 
 /// Largest canvas kept for the thread's next figure (bytes): the presets' largest is 35 MB.
@@ -127,14 +167,15 @@ const MAX_KEPT_CANVAS: usize = 64 << 20;
 thread_local! {
     /// The last supersampled canvas drawn on this thread, for the next figure to reuse.
     static CANVAS: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+    /// The last image averaged down from it, likewise.
+    static IMAGE: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-/// Encodes an RGB image as PNG at `path`, atomically.
+/// Encodes an RGB image as PNG at `path`, atomically: `image`'s encoder, as plotters' bitmap
+/// backend calls it (the same bytes), without copying the image into a backend first.
 fn write_png(path: &Path, w: u32, h: u32, rgb: &[u8]) -> Result<(), PlotError> {
     gyroemu_io::write_atomic_via(path, |tmp| {
-        let mut backend = BitMapBackend::new(tmp, (w, h));
-        backend.blit_bitmap((0, 0), (w, h), rgb)?;
-        backend.present()?;
+        image::save_buffer(tmp, rgb, w, h, image::ColorType::Rgb8)?;
         Ok(())
     })?;
     Ok(())
@@ -146,8 +187,11 @@ fn write_png(path: &Path, w: u32, h: u32, rgb: &[u8]) -> Result<(), PlotError> {
 /// skipped; empty or constant data get a sensible span.
 pub fn render_png(fig: &Figure, path: &Path) -> Result<(), PlotError> {
     check_target(path, fig.width_px, fig.height_px)?;
-    let rgb = render_rgb_antialiased(fig)?;
-    write_png(path, fig.width_px, fig.height_px, &rgb)
+    ensure_font()?;
+    let k = SUPERSAMPLE;
+    to_png(path, fig.width_px, fig.height_px, k, |a| {
+        draw_figure(a, fig, f64::from(k))
+    })
 }
 
 /// Renders `fig` into memory without anti-aliasing: `width_px * height_px * 3` bytes, RGB,
@@ -156,7 +200,7 @@ pub fn render_png(fig: &Figure, path: &Path) -> Result<(), PlotError> {
 pub fn render_rgb(fig: &Figure) -> Result<Vec<u8>, PlotError> {
     check_target(Path::new("memory.png"), fig.width_px, fig.height_px)?;
     ensure_font()?;
-    supersampled(fig.width_px, fig.height_px, 1, |a| draw_figure(a, fig, 1.0))
+    in_memory(fig.width_px, fig.height_px, 1, |a| draw_figure(a, fig, 1.0))
 }
 
 /// Renders `fig` into memory exactly as [`render_png`] encodes it: drawn at
@@ -165,7 +209,7 @@ pub fn render_rgb_antialiased(fig: &Figure) -> Result<Vec<u8>, PlotError> {
     check_target(Path::new("memory.png"), fig.width_px, fig.height_px)?;
     ensure_font()?;
     let k = SUPERSAMPLE;
-    supersampled(fig.width_px, fig.height_px, k, |a| {
+    in_memory(fig.width_px, fig.height_px, k, |a| {
         draw_figure(a, fig, f64::from(k))
     })
 }
@@ -203,7 +247,7 @@ pub fn render_panels_png(
     ensure_font()?;
     let k = SUPERSAMPLE;
     let ss = f64::from(k);
-    let rgb = supersampled(width_px, height_px, k, |root| {
+    to_png(path, width_px, height_px, k, |root| {
         let body = if title.is_empty() {
             root.clone()
         } else {
@@ -218,6 +262,5 @@ pub fn render_panels_png(
             draw_figure(cell, fig, ss)?;
         }
         Ok(())
-    })?;
-    write_png(path, width_px, height_px, &rgb)
+    })
 }
