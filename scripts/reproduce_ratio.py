@@ -1,0 +1,106 @@
+#!/usr/bin/env python3
+"""Issue 15, goal 3: how close a full `reproduce` comes to the time the bench predicts.
+
+    python3 scripts/reproduce_ratio.py [--runs N] [--repeats R] BINARY [BINARY ...]
+
+The prediction is the sum over the experiments of their point-samples (each experiment's
+`summary.json`, `point_samples_emulated`; the bandwidth sweep's are the closing line's total
+less theirs) divided by the bench's `whole chain` rate of the experiment's preset on all
+threads, in the lanes this CPU runs (the best of R runs; the bandwidth sweep at the rate-table
+chain's rate). The bench is run before and after the `reproduce` runs, and the prediction is
+their mean: a shared host's speed moves by 10 % or more within minutes. The binaries'
+`reproduce` runs alternate (N each), and each is reported as prediction / wall time, at the
+median and at the best run. The first binary is benched; give the same CPU's binaries only.
+"""
+
+import argparse
+import json
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+# The experiments of `reproduce`: each runs its preset's chain and writes `<preset>/`.
+PRESETS = ["m2tfg-rotating", "baw-rotating", "m2tfg-ratetable", "m2tfg-coriolis", "baw-coriolis"]
+
+
+def bench(binary: str, repeats: int) -> dict:
+    """The best `whole chain` rate on all threads of each preset, point-samples/s."""
+    rates = {}
+    for preset in PRESETS:
+        out = subprocess.run(
+            [binary, "bench", "--preset", preset, "--repeats", str(repeats)],
+            check=True, capture_output=True, text=True,
+        ).stdout
+        rows = [line.split() for line in out.splitlines()
+                if re.match(r"whole chain( \(f64x[48]\))? +\d", line)]
+        # The widest lanes' rows on the most threads: what a run uses.
+        rows = [r for r in rows if r[2] == "(f64x8)"] or rows
+        best = max(rows, key=lambda r: int(r[-3]))
+        rates[preset] = float(best[-2]) * 1e6
+    return rates
+
+
+def run_reproduce(binary: str, out: Path) -> tuple:
+    """Wall seconds and the closing line's point-samples of one full `reproduce`."""
+    shutil.rmtree(out, ignore_errors=True)
+    t = time.perf_counter()
+    done = subprocess.run([binary, "reproduce", "--out", str(out)],
+                          check=True, capture_output=True, text=True)
+    wall = time.perf_counter() - t
+    m = re.search(r"reproduce: (\d+) point-samples", done.stdout + done.stderr)
+    return wall, int(m.group(1))
+
+
+def point_samples(out: Path, total: int) -> dict:
+    """Each preset's point-samples, and the bandwidth sweep's (the total less theirs)."""
+    per = {}
+    for preset in PRESETS:
+        per[preset] = json.loads((out / preset / "summary.json").read_text())[
+            "point_samples_emulated"]
+    per["bandwidth"] = total - sum(per.values())
+    return per
+
+
+def predict(samples: dict, rates: dict) -> float:
+    t = sum(n / rates[p] for p, n in samples.items() if p != "bandwidth")
+    return t + samples["bandwidth"] / rates["m2tfg-ratetable"]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("binaries", nargs="+")
+    ap.add_argument("--runs", type=int, default=7)
+    ap.add_argument("--repeats", type=int, default=3)
+    a = ap.parse_args()
+    tmp = Path(tempfile.mkdtemp(prefix="reproduce_ratio_"))
+    _, total = run_reproduce(a.binaries[0], tmp / "first")
+    samples = point_samples(tmp / "first", total)
+    before = bench(a.binaries[0], a.repeats)
+    walls = {b: [] for b in a.binaries}
+    for _ in range(a.runs):
+        for b in a.binaries:
+            walls[b].append(run_reproduce(b, tmp / "run")[0])
+    after = bench(a.binaries[0], a.repeats)
+    shutil.rmtree(tmp, ignore_errors=True)
+    p = [predict(samples, r) for r in (before, after)]
+    pred = statistics.mean(p)
+    print("point-samples:", {k: f"{v:.4g}" for k, v in samples.items()})
+    for name, r in (("before", before), ("after", after)):
+        print(f"bench {name} (M point-samples/s):",
+              {k: round(v / 1e6, 1) for k, v in r.items()})
+    print(f"prediction {p[0]:.3f} s before, {p[1]:.3f} s after: {pred:.3f} s; "
+          f"80 % asks {pred / 0.8:.3f} s")
+    for b, w in walls.items():
+        w.sort()
+        med = statistics.median(w)
+        print(f"{b}: wall {w[0]:.2f} to {w[-1]:.2f} s, median {med:.2f} (n={len(w)}): "
+              f"{100 * pred / med:.0f} % at the median, {100 * pred / w[0]:.0f} % at the best")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
