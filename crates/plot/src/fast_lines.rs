@@ -1,9 +1,10 @@
 //! The bitmap backend with one faster path: an opaque axis-aligned line wider than one pixel
-//! (the grid, the axes, tick marks) is filled as the rectangle it covers. plotters draws every
-//! wide line as a polygon, swept one pixel row at a time with an allocation and a sort per
-//! row; the grid lines of a run's figures took about 40 % of their drawing time that way.
-//! The rectangle is exactly the pixels the polygon path sets (tested pixel for pixel against
-//! it), so the figures keep their bytes.
+//! (the figures' grid lines) is filled as the rectangle it covers. plotters draws every wide
+//! line as a polygon, swept one pixel row at a time with an allocation and a sort per row;
+//! the grid lines of a run's figures took about 40 % of their drawing time that way. The
+//! rectangle is exactly the pixels the polygon path sets (tested pixel for pixel against it),
+//! so the figures keep their bytes. (Axes and tick marks reach the backend as paths, which
+//! keep plotters' own route.)
 
 use plotters::prelude::BitMapBackend;
 use plotters_backend::{
@@ -47,13 +48,15 @@ pub(crate) fn wide_axis_line_rect(
         // A degenerate polygon: plotters draws a one-pixel line instead.
         return None;
     }
+    // The exclusive corner one past the last pixel: a line at the end of `i32`'s range
+    // keeps plotters' path rather than wrap.
     Some(if xr - xl <= yb - yt {
         // Rows yt ..= yb, the last only if the edges are at most one pixel apart.
-        let last = if xr - xl > 1 { yb } else { yb + 1 };
-        ((xl, yt), (xr + 1, last))
+        let last = if xr - xl > 1 { yb } else { yb.checked_add(1)? };
+        ((xl, yt), (xr.checked_add(1)?, last))
     } else {
-        let last = if yb - yt > 1 { xr } else { xr + 1 };
-        ((xl, yt), (last, yb + 1))
+        let last = if yb - yt > 1 { xr } else { xr.checked_add(1)? };
+        ((xl, yt), (last, yb.checked_add(1)?))
     })
 }
 
@@ -170,6 +173,19 @@ mod tests {
         }
         // The walk exercised the fast path, not only the fallback.
         assert!(fast_taken > 2000, "{fast_taken}");
+    }
+
+    #[test]
+    fn lines_at_the_end_of_the_coordinate_range_keep_plotters_path() {
+        // One past the last pixel would wrap at i32::MAX (the whole canvas height filled).
+        assert_eq!(wide_axis_line_rect((10, i32::MAX), (30, i32::MAX), 4), None);
+        assert_eq!(wide_axis_line_rect((i32::MAX, 5), (i32::MAX, 20), 4), None);
+        // Just inside the range the fast path holds (plotters itself overflows at the end, in
+        // a debug build, so the comparison stops short of it).
+        let black = RGBColor(0, 0, 0).to_rgba();
+        assert!(wide_axis_line_rect((10, i32::MAX - 3), (30, i32::MAX - 3), 4).is_some());
+        let (plain, fast) = both(&[((10, i32::MAX - 3), (30, i32::MAX - 3), 4, black)]);
+        assert!(plain == fast);
     }
 
     #[test]
