@@ -9,6 +9,7 @@ use crate::font::{bold, ensure_font};
 use crate::PlotError;
 use plotters::prelude::*;
 use std::path::Path;
+use std::sync::Mutex;
 
 /// Smallest accepted image (or panel) side: below this axes and labels cannot fit.
 pub const MIN_SIDE_PX: u32 = 64;
@@ -103,9 +104,9 @@ where
 {
     let (bw, bh) = (w * k, h * k);
     let len = bw as usize * bh as usize * 3;
-    // The canvas is kept per thread between figures: a fresh one of up to 35 MB per figure
-    // cost a page fault per 4 KiB (about a tenth of a run's figure time).
-    let mut buf = CANVAS.with_borrow_mut(std::mem::take);
+    // The canvas is kept between figures ([`take_buffer`]): a fresh one of up to 35 MB per
+    // figure cost a page fault per 4 KiB (about a tenth of a run's figure time).
+    let mut buf = take_buffer(len);
     buf.clear();
     buf.resize(len, 255);
     let drawn: DrawResult = (|| {
@@ -129,7 +130,7 @@ where
             Ok(())
         }
     };
-    keep(&CANVAS, buf);
+    give_back(buf);
     res
 }
 
@@ -143,32 +144,43 @@ where
     Ok(out)
 }
 
-/// [`supersampled`] into the thread's image buffer, encoded as a PNG at `path` (atomically).
+/// [`supersampled`] into a kept image buffer, encoded as a PNG at `path` (atomically).
 fn to_png<F>(path: &Path, w: u32, h: u32, k: u32, draw: F) -> Result<(), PlotError>
 where
     F: FnOnce(&Area) -> DrawResult,
 {
-    let mut rgb = IMAGE.with_borrow_mut(std::mem::take);
+    let mut rgb = take_buffer(w as usize * h as usize * 3);
     let res = supersampled(w, h, k, draw, &mut rgb).and_then(|()| write_png(path, w, h, &rgb));
-    keep(&IMAGE, rgb);
+    give_back(rgb);
     res
 }
 
-/// Keeps `buf` in `slot` for the thread's next figure, unless it is larger than any preset's.
-fn keep(slot: &'static std::thread::LocalKey<std::cell::RefCell<Vec<u8>>>, buf: Vec<u8>) {
-    if buf.capacity() <= MAX_KEPT_CANVAS {
-        slot.with_borrow_mut(|c| *c = buf);
-    }
+/// Buffers kept for the next figures (canvases and images): at most [`MAX_POOLED`] of at most
+/// [`MAX_KEPT_BUFFER`] bytes each, whatever the number of threads that draw, so two figures
+/// drawn at once reuse theirs and a process keeps at most 256 MB (88 MB with the presets').
+static POOL: Mutex<Vec<Vec<u8>>> = Mutex::new(Vec::new());
+/// Buffers in [`POOL`]: a canvas and an image for each of two figures drawn at once.
+const MAX_POOLED: usize = 4;
+/// Largest buffer kept (bytes): the presets' largest canvas is 35 MB.
+const MAX_KEPT_BUFFER: usize = 64 << 20;
+
+/// A kept buffer for `len` bytes (the smallest that holds them, else the largest, to grow),
+/// or a new one; its contents are for the caller to overwrite.
+fn take_buffer(len: usize) -> Vec<u8> {
+    let mut pool = POOL.lock().unwrap_or_else(|e| e.into_inner());
+    let fits = (0..pool.len())
+        .filter(|&i| pool[i].capacity() >= len)
+        .min_by_key(|&i| pool[i].capacity());
+    let pick = fits.or_else(|| (0..pool.len()).max_by_key(|&i| pool[i].capacity()));
+    pick.map(|i| pool.swap_remove(i)).unwrap_or_default()
 }
 
-/// Largest canvas kept for the thread's next figure (bytes): the presets' largest is 35 MB.
-const MAX_KEPT_CANVAS: usize = 64 << 20;
-
-thread_local! {
-    /// The last supersampled canvas drawn on this thread, for the next figure to reuse.
-    static CANVAS: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
-    /// The last image averaged down from it, likewise.
-    static IMAGE: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+/// Keeps `buf` for the next figure, if the pool has room and it is neither empty nor oversized.
+fn give_back(buf: Vec<u8>) {
+    let mut pool = POOL.lock().unwrap_or_else(|e| e.into_inner());
+    if pool.len() < MAX_POOLED && (1..=MAX_KEPT_BUFFER).contains(&buf.capacity()) {
+        pool.push(buf);
+    }
 }
 
 /// Encodes an RGB image as PNG at `path`, atomically: `image`'s encoder, as plotters' bitmap
@@ -263,4 +275,24 @@ pub fn render_panels_png(
         }
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pool_keeps_at_most_its_bound() {
+        for n in [0usize, 1, 1000, MAX_KEPT_BUFFER + 1] {
+            give_back(Vec::with_capacity(n));
+        }
+        for _ in 0..10 {
+            give_back(vec![0u8; 100]);
+        }
+        let pool = POOL.lock().unwrap_or_else(|e| e.into_inner());
+        assert!(pool.len() <= MAX_POOLED);
+        assert!(pool
+            .iter()
+            .all(|b| (1..=MAX_KEPT_BUFFER).contains(&b.capacity())));
+    }
 }

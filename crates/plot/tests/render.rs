@@ -309,3 +309,45 @@ fn failed_renders_leave_nothing_under_the_final_name() {
     assert_eq!(std::fs::read(&keep).unwrap(), b"old");
     assert_eq!(entries(dir.path()), vec!["blocked.png", "keep.png"]);
 }
+
+/// Figures drawn into buffers kept from earlier figures (larger, smaller, drawn at once on
+/// several threads) come out as when drawn first: no pixel of an earlier figure survives.
+#[test]
+fn kept_buffers_leave_nothing_of_earlier_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let small = {
+        let mut f = demo("small");
+        (f.width_px, f.height_px) = (300, 200);
+        f
+    };
+    let first_png = dir.path().join("first.png");
+    render_png(&small, &first_png).unwrap();
+    let first_rgb = gyroemu_plot::render_rgb_antialiased(&small).unwrap();
+    // Larger figures, some at once, leave their buffers behind.
+    std::thread::scope(|s| {
+        for t in 0..4 {
+            let dir = dir.path();
+            s.spawn(move || {
+                let mut big = demo(&format!("big {t}"));
+                (big.width_px, big.height_px) = (1400, 1000);
+                render_png(&big, &dir.join(format!("big{t}.png"))).unwrap();
+                render_panels_png(
+                    "panels",
+                    &[big.clone(), big],
+                    2,
+                    1600,
+                    900,
+                    &dir.join(format!("p{t}.png")),
+                )
+                .unwrap();
+            });
+        }
+    });
+    let again_png = dir.path().join("again.png");
+    render_png(&small, &again_png).unwrap();
+    assert_eq!(
+        std::fs::read(&first_png).unwrap(),
+        std::fs::read(&again_png).unwrap()
+    );
+    assert!(gyroemu_plot::render_rgb_antialiased(&small).unwrap() == first_rgb);
+}
