@@ -234,14 +234,7 @@ impl<S: Sample> Board<S> {
         streams: &[u64],
         starts: &[u64],
     ) -> Result<Self, ParamError> {
-        if starts.len() != rates_rad_s.len() {
-            return Err(ParamError::new(
-                crate::params::STAGE,
-                "starts",
-                starts.len(),
-                format!("must list one start per point ({})", rates_rad_s.len()),
-            ));
-        }
+        one_per_point("starts", starts.len(), rates_rad_s.len(), "start")?;
         Self::build(p, rates_rad_s, None, streams, starts)
     }
 
@@ -262,14 +255,7 @@ impl<S: Sample> Board<S> {
                 "a table frequency per lane needs a rate-table board",
             ));
         };
-        if table_hz.len() != rates_rad_s.len() {
-            return Err(ParamError::new(
-                crate::params::STAGE,
-                "table_hz",
-                table_hz.len(),
-                format!("must list one frequency per point ({})", rates_rad_s.len()),
-            ));
-        }
+        one_per_point("table_hz", table_hz.len(), rates_rad_s.len(), "frequency")?;
         for &f in table_hz {
             gyroemu_core::error::positive(crate::params::STAGE, "table_freq_hz", f)?;
         }
@@ -421,4 +407,22 @@ impl<S: Sample> Board<S> {
     pub fn tia_flicker_joined(&self) -> bool {
         self.flicker.as_ref().is_some_and(|f| f.tia_joined())
     }
+}
+
+/// Refuses a per-lane list `key` of `len` entries unless it has one `what` per point.
+fn one_per_point(
+    key: &'static str,
+    len: usize,
+    points: usize,
+    what: &str,
+) -> Result<(), ParamError> {
+    if len == points {
+        return Ok(());
+    }
+    Err(ParamError::new(
+        crate::params::STAGE,
+        key,
+        len,
+        format!("must list one {what} per point ({points})"),
+    ))
 }

@@ -34,6 +34,17 @@ fn width_for(n: usize) -> usize {
     }
 }
 
+/// `Board::$ctor(args)` in the lanes [`width_for`] picks for `$n` points, as a group.
+macro_rules! in_lanes_for {
+    ($n:expr, $ctor:ident($($arg:expr),* $(,)?)) => {
+        Ok(Self(match width_for($n) {
+            #[cfg(target_arch = "x86_64")]
+            8 => Lanes::Eight(Box::new(Board::$ctor($($arg),*)?)),
+            _ => Lanes::Four(Box::new(Board::$ctor($($arg),*)?)),
+        }))
+    };
+}
+
 /// The same call on whichever board the group holds.
 macro_rules! on_board {
     ($self:expr, $b:ident => $e:expr) => {
@@ -60,21 +71,10 @@ impl GroupBoard {
         streams: &[u64],
         starts: &[u64],
     ) -> Result<Self, ParamError> {
-        Ok(Self(match width_for(rates_rad_s.len()) {
-            #[cfg(target_arch = "x86_64")]
-            8 => Lanes::Eight(Box::new(Board::with_starts(
-                p,
-                rates_rad_s,
-                streams,
-                starts,
-            )?)),
-            _ => Lanes::Four(Box::new(Board::with_starts(
-                p,
-                rates_rad_s,
-                streams,
-                starts,
-            )?)),
-        }))
+        in_lanes_for!(
+            rates_rad_s.len(),
+            with_starts(p, rates_rad_s, streams, starts)
+        )
     }
 
     /// [`Board::with_table_hz`] (a rate table per lane) in the lanes [`GroupBoard::new`]
@@ -85,21 +85,10 @@ impl GroupBoard {
         table_hz: &[f64],
         streams: &[u64],
     ) -> Result<Self, ParamError> {
-        Ok(Self(match width_for(rates_rad_s.len()) {
-            #[cfg(target_arch = "x86_64")]
-            8 => Lanes::Eight(Box::new(Board::with_table_hz(
-                p,
-                rates_rad_s,
-                table_hz,
-                streams,
-            )?)),
-            _ => Lanes::Four(Box::new(Board::with_table_hz(
-                p,
-                rates_rad_s,
-                table_hz,
-                streams,
-            )?)),
-        }))
+        in_lanes_for!(
+            rates_rad_s.len(),
+            with_table_hz(p, rates_rad_s, table_hz, streams)
+        )
     }
 
     /// The board in lanes of `width` (4 or 8) whatever the points (benchmarks, and tests that
