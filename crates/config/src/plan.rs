@@ -101,7 +101,7 @@ impl Config {
     }
 
     /// Rate-table runs: the table harmonics `-N ..= N` the board demodulates, the fewest that
-    /// leave nothing above [`TABLE_HARMONIC_REL`] of the envelope at the largest amplitude
+    /// leave nothing above `TABLE_HARMONIC_REL` (1e-10) of the envelope at the largest amplitude
     /// (from the plant's exact periodic steady state), at most [`MAX_TABLE_HARMONIC`]; `None`
     /// when the swing needs more. 0 for the other shapes.
     pub fn table_harmonics_needed(&self) -> Option<usize> {

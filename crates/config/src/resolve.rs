@@ -411,7 +411,7 @@ pub fn pll_bounds_hz(cfg: &Config, damping: f64, mode: usize) -> (f64, f64) {
 
 impl Config {
     /// The carrier PLL's natural frequency, Hz (set, or the geometric mean of the bounds of
-    /// [`pll_bounds_hz`]); `None` without a `[pll]` section.
+    /// `pll_bounds_hz`); `None` without a `[pll]` section.
     pub fn pll_natural_hz(&self) -> Option<f64> {
         let p = self.pll.as_ref()?;
         Some(p.natural_hz.unwrap_or_else(|| {
