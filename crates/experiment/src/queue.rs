@@ -69,7 +69,7 @@ fn group_items<'s>(
 }
 
 /// The items of `sweep`'s lane groups, each costing its input samples times `per_sample`
-/// (the chain's relative cost per sample), followed by `then` ([`group_items`]). The group
+/// (the chain's relative cost per sample), followed by `then` (`group_items`). The group
 /// that records the dump writes it (and runs `on_dump_early`) as soon as its windows are
 /// recorded, on its own thread, then goes on: every thread has items to run, so nothing is
 /// gained by handing the writing to another, and the dump is written before the sweep's

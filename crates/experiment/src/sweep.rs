@@ -64,7 +64,7 @@ pub type OnGroup<'a> = &'a (dyn Fn(&[(usize, LaneResult)]) -> Result<(), String>
 /// returns the files it made from them.
 pub type OnDump<'a> = &'a (dyn Fn(&[PathBuf]) -> Result<Vec<PathBuf>, String> + Sync);
 
-/// What [`run_sweep_with`] runs and what it does with the points it finishes.
+/// What [`run_sweep_with`](crate::run_sweep_with) runs and what it does with the points it finishes.
 #[derive(Default)]
 pub struct SweepOptions<'a> {
     /// Points already computed (by index): not run again (a resumed sweep).
@@ -78,7 +78,7 @@ pub struct SweepOptions<'a> {
     /// Receives each finished group (e.g. to write its point files).
     pub on_group: Option<OnGroup<'a>>,
     /// The dump to record instead of the config's `[dump]` (if any); written into the
-    /// `dump_dir` given to [`run_sweep_with`].
+    /// `dump_dir` given to [`run_sweep_with`](crate::run_sweep_with).
     pub dump: Option<DumpPlan>,
     /// The threads the lane groups are sized for; `None`: the pool's. A caller whose pool
     /// runs other work beside this sweep (reproduce runs every experiment in one pool) gives
@@ -100,7 +100,7 @@ pub struct SweepOptions<'a> {
     pub split: bool,
 }
 
-/// The points a [`run_sweep_with`] call has, and whether it was cancelled.
+/// The points a [`run_sweep_with`](crate::run_sweep_with) call has, and whether it was cancelled.
 #[derive(Clone, Debug, Default)]
 pub struct SweepRun {
     /// Every point available: the given `done` plus those computed now, by index.

@@ -28,7 +28,7 @@ fn sig3(x: f64) -> String {
     format!("{x:.d$}")
 }
 
-/// "dBV" for volts, else "dB re 1 <unit>" (or "dB" when dimensionless).
+/// `"dBV"` for volts, else `"dB re 1 <unit>"` (or `"dB"` when dimensionless).
 pub fn db_unit(unit: &str) -> String {
     match unit {
         "V" => "dBV".into(),

@@ -80,7 +80,7 @@ const FLOOR_HALF_WIDTH: usize = 32;
 
 /// The strongest `max` tones of `psd`, strongest first: local maxima of the power spectrum (DC
 /// counts when bin 0 exceeds bin 1) at least `min_snr_db` above the median of the bins within
-/// [`FLOOR_HALF_WIDTH`] of them. The floor is local because a coloured spectrum has no one
+/// `FLOOR_HALF_WIDTH` (32) of them. The floor is local because a coloured spectrum has no one
 /// floor: on a low-passed node most bins lie in the stop band, and pass-band noise stood 20 dB
 /// above the whole spectrum's median and was listed as tones. A single sinusoid's leakage,
 /// sampled at the bins, falls monotonically away from its peak, so its sidelobes are not

@@ -494,7 +494,7 @@ fn sandwich(
 /// `theta` (two-sided density `sum theta_k S_k(nu)`), Gaussian, long next to each tau:
 /// `C_ij = (1 / M_ij) int_0^(1/2) |G_i|^2 |G_j|^2 S^2 dnu` with
 /// `|G_m|^2 = 4 sin^4(pi nu m) / (m^2 sin^2(pi nu))` and `M_ij` the larger `n_terms`. The
-/// integral runs on a geometric grid; past [`OSCILLATION_AVERAGED`] periods `sin^4` is
+/// integral runs on a geometric grid; past `OSCILLATION_AVERAGED` (8) periods `sin^4` is
 /// replaced by its mean.
 pub fn avar_covariance(pts: &[AllanPoint], tau0: f64, theta: &[f64; 4]) -> DMatrix<f64> {
     use core::f64::consts::PI;
