@@ -26,10 +26,12 @@ pub fn fit_line(x: &[f64], y: &[f64]) -> LineFit {
     }
     let slope = sxy / sxx;
     let intercept = my - slope * mx;
+    // At most 1 by Cauchy-Schwarz (sxy^2 <= sxx syy); its rounding can pass 1 by an ulp on
+    // a near-exact line, a value no results file should hold.
     let r2 = if syy == 0.0 {
         1.0
     } else {
-        sxy * sxy / (sxx * syy)
+        (sxy * sxy / (sxx * syy)).min(1.0)
     };
     let rss: f64 = x
         .iter()
@@ -81,6 +83,27 @@ mod tests {
             .map(|(i, v)| v + if i % 2 == 0 { 0.5 } else { -0.5 })
             .collect();
         assert!(fit_line(&x, &y2).r2 < 0.999);
+    }
+
+    #[test]
+    fn r2_never_passes_one_on_near_exact_lines() {
+        // Seeded lines with offsets and tiny scatter, the data a noiseless sweep fits: the
+        // rounded ratio passes 1 on some of them (this loop failed without the clamp).
+        let mut seed = 11u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..2000 {
+            let n = 2 + (next() * 9.0) as usize;
+            let (a, b) = (next() * 2.0 - 1.0, next() * 100.0 - 50.0);
+            let x: Vec<f64> = (0..n).map(|k| 25.0 * (k + 1) as f64).collect();
+            let y: Vec<f64> = x.iter().map(|v| a * v + b + 1e-13 * next()).collect();
+            let r2 = fit_line(&x, &y).r2;
+            assert!((0.0..=1.0).contains(&r2), "r2 {r2} for {x:?} {y:?}");
+        }
     }
 
     #[test]
