@@ -65,10 +65,15 @@ pub(crate) fn merge_lot(
             })
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let written = write_lot(dir, &cfg, &devices).map_err(RunError::from);
-    let ((mut files, summary), path) = split.finish(dir, n, written)?;
+    // Untrusted devices fail the merge after its files are written: the manifest says so too.
+    let written = write_lot(dir, &cfg, &devices)
+        .map_err(RunError::from)
+        .and_then(|(files, summary)| {
+            check_unreliable(&dir.display().to_string(), &summary, &devices)?;
+            Ok(files)
+        });
+    let (mut files, path) = split.finish(dir, n, written)?;
     files.push(path);
     reporter.note(&format!("merged {} shards ({n} devices)", split.count));
-    check_unreliable(&dir.display().to_string(), &summary, &devices)?;
     Ok(files)
 }

@@ -207,10 +207,12 @@ pub fn run_lot(
     let devices: Vec<DeviceResult> = done.values().cloned().collect();
     let (mut files, summary) =
         write_lot(out, cfg, &devices).map_err(|e| ledger.fail(e.into(), &done))?;
+    warn_devices(&devices, reporter);
+    // Untrusted devices fail the lot after its files are written: the manifest says so too.
+    check_unreliable(&out.display().to_string(), &summary, &devices)
+        .map_err(|e| ledger.fail(e, &done))?;
     ledger.complete(&done)?;
     files.push(ledger.path().to_path_buf());
-    warn_devices(&devices, reporter);
-    check_unreliable(&out.display().to_string(), &summary, &devices)?;
     Ok(LotOutcome::Complete { files, summary })
 }
 

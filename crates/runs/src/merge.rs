@@ -68,12 +68,16 @@ fn merge_run(dir: &Path, split: Split, reporter: &dyn Reporter) -> Result<Vec<Pa
     }
     let r = finish_sweep(&held, &lanes)?;
     let written = write_run(dir, &held, &r, &run_title(&cfg)).map_err(RunError::from);
-    let (mut files, path) = split.finish(dir, n, written)?;
-    files.push(path);
-    reporter.note(&format!("merged {} shards ({n} points)", split.count));
     for w in &r.warnings {
         reporter.warn(w);
     }
-    check_problems(&dir.display().to_string(), &r.problems)?;
+    // Refused phases fail the merge after its files are written: the manifest says so too.
+    let checked = written.and_then(|files| {
+        check_problems(&dir.display().to_string(), &r.problems)?;
+        Ok(files)
+    });
+    let (mut files, path) = split.finish(dir, n, checked)?;
+    files.push(path);
+    reporter.note(&format!("merged {} shards ({n} points)", split.count));
     Ok(files)
 }

@@ -266,13 +266,15 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         .map_err(RunError::from)
         .and_then(|r| Ok((write_run(out, &held, &r, &run_title(cfg))?, r)));
     let (mut files, r) = written.map_err(|e| ledger.fail(e, &swept.lanes))?;
-    ledger.complete(&swept.lanes)?;
-    files.push(ledger.path().to_path_buf());
-    files.extend(swept.dump_files.iter().cloned());
     for w in &r.warnings {
         reporter.warn(w);
     }
-    check_problems(&out.display().to_string(), &r.problems)?;
+    // Refused phases fail the run after its files are written: the manifest says so too.
+    check_problems(&out.display().to_string(), &r.problems)
+        .map_err(|e| ledger.fail(e.into(), &swept.lanes))?;
+    ledger.complete(&swept.lanes)?;
+    files.push(ledger.path().to_path_buf());
+    files.extend(swept.dump_files.iter().cloned());
     Ok(RunOutcome::Complete(files))
 }
 

@@ -321,3 +321,40 @@ fn device_files_of_another_version_are_computed_again_with_one_warning() {
     assert!(r.notes.contains("and 1 more device files"), "{}", r.notes);
     assert_eq!(std::fs::read(out.join("devices.csv")).unwrap(), csv);
 }
+
+#[test]
+fn untrusted_devices_leave_the_manifest_failed_in_a_lot_and_in_its_merge() {
+    // A 2-bit ADC over 0.1 V reads every device's signal as zeros: each device's phases are
+    // refused, the lot and the merge of its shards write their files, then fail, and their
+    // manifests must say so.
+    let mut cfg = lot();
+    cfg.board.adc_bits = Some(2);
+    cfg.board.adc_full_scale_v = 0.1;
+    cfg.validate().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let one = dir.path().join("one");
+    let r = run_into(&cfg, &one, 2, None, false, None);
+    let e = r.outcome.unwrap_err();
+    assert!(e.to_string().contains("cannot be trusted"), "{e}");
+    assert!(one.join("devices.csv").is_file());
+    let m = json(&one.join("manifest.json"));
+    assert_eq!(m["status"], "failed", "{m}");
+    assert!(
+        m["next"].as_str().unwrap().contains("cannot be trusted"),
+        "{m}"
+    );
+
+    let split = dir.path().join("split");
+    for s in ["0/2", "1/2"] {
+        let r = run_into(&cfg, &split, 2, Some(s), false, None);
+        assert!(
+            matches!(r.outcome, Ok(LotOutcome::ShardComplete { .. })),
+            "{s}"
+        );
+    }
+    let e = merge(&split, &Quiet).unwrap_err();
+    assert!(e.to_string().contains("cannot be trusted"), "{e}");
+    assert!(split.join("devices.csv").is_file());
+    let m = json(&split.join("manifest.json"));
+    assert_eq!(m["status"], "failed", "{m}");
+}

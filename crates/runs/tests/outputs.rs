@@ -1,7 +1,7 @@
-//! What a run leaves in its output folder: a failed write of the results leaves the manifest
-//! `failed` with the cause; `[dump]` does not change the config's identity (points reused, only
-//! the dumped point computed again to record it, and an earlier dump deleted when the
-//! `[dump]` changes); a folder of another config is refused naming the keys that differ, and
+//! What a run leaves in its output folder: a failed write of the results, or refused phases
+//! (also in a merge of shards), leave the manifest `failed` with the cause; `[dump]` does not
+//! change the config's identity (points reused, only the dumped point computed again to
+//! record it, and an earlier dump deleted when the `[dump]` changes); a folder of another config is refused naming the keys that differ, and
 //! `--force` deletes that config's dumps with its points.
 
 mod common;
@@ -87,6 +87,49 @@ fn a_failed_write_of_the_results_leaves_the_manifest_failed() {
     assert!(matches!(r, Ok(RunOutcome::Complete(_))));
     assert_eq!(computed, 0);
     assert_eq!(json(&out.join("manifest.json"))["status"], "complete");
+}
+
+#[test]
+fn refused_phases_leave_the_manifest_failed_with_the_files_written() {
+    // A 2-bit ADC over 0.1 V reads the 20 mV signal as zeros: every phase is refused (NaN),
+    // the run exits non-zero, and its manifest must not say `complete`.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path();
+    let text = CONFIG.replace(
+        "[board]\n",
+        "[board]\nadc_bits = 2\nadc_full_scale_v = 0.1\n",
+    );
+    let (r, computed, _) = run_into(&config(&text), out, false);
+    let e = r.unwrap_err();
+    assert!(matches!(e, RunError::Report(_)), "{e}");
+    assert!(e.to_string().contains("refused"), "{e}");
+    assert_eq!(computed, 4);
+    assert!(out.join("results.csv").is_file() && out.join("summary.json").is_file());
+    let m = json(&out.join("manifest.json"));
+    assert_eq!(m["status"], "failed", "{m}");
+    assert_eq!(m["points_done"], serde_json::json!([0, 1, 2, 3]));
+    let next = m["next"].as_str().unwrap();
+    assert!(next.contains("refused") && next.contains("adc"), "{next}");
+
+    // The same points run as two shards and merged: the merge fails alike.
+    let split = dir.path().join("split");
+    for s in ["0/2", "1/2"] {
+        prepare_out(&split).unwrap();
+        let req = RunRequest {
+            config: &config(&text),
+            out: &split,
+            shard: Some(gyroemu_runs::shard::parse_shard(s).unwrap()),
+            force: false,
+            cancel: Arc::new(AtomicBool::new(false)),
+            on_saved: None,
+        };
+        let r = run(&req, &Record::default());
+        assert!(matches!(r, Ok(RunOutcome::ShardComplete { .. })), "{s}");
+    }
+    let e = gyroemu_runs::merge(&split, &gyroemu_experiment::Quiet).unwrap_err();
+    assert!(e.to_string().contains("refused"), "{e}");
+    assert!(split.join("results.csv").is_file());
+    assert_eq!(json(&split.join("manifest.json"))["status"], "failed");
 }
 
 #[test]
