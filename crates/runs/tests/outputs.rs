@@ -1,8 +1,9 @@
 //! What a run leaves in its output folder: a failed write of the results, or refused phases
 //! (also in a merge of shards), leave the manifest `failed` with the cause; `[dump]` does not
 //! change the config's identity (points reused, only the dumped point computed again to
-//! record it, and an earlier dump deleted when the `[dump]` changes); a folder of another config is refused naming the keys that differ, and
-//! `--force` deletes that config's dumps with its points.
+//! record it, and an earlier dump deleted when the `[dump]` changes); a folder of another
+//! config is refused naming the keys that differ, and `--force` deletes that config's dumps
+//! with its points.
 
 mod common;
 
