@@ -182,11 +182,14 @@ fn live_holder(path: &Path, reporter: &dyn Reporter) -> Result<Option<LockInfo>,
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == ErrorKind::NotFound => return Ok(None),
+        // A folder or an unreadable file where the lock goes: the user's to fix (exit 2),
+        // like a lock that is not gyroemu's.
         Err(e) => {
-            return Err(RunError::Io {
-                context: format!("cannot read the lock `{}`", path.display()),
-                reason: e,
-            })
+            return Err(RunError::Locked(format!(
+                "`{}` cannot be read as a gyroemu lock ({e}), so its holder is unknown: if no \
+                 gyroemu writes into this folder, remove it",
+                path.display()
+            )))
         }
     };
     let Ok(info) = serde_json::from_str::<LockInfo>(&text) else {

@@ -145,3 +145,19 @@ fn shards_lock_side_by_side_but_not_beside_the_folder() {
     let whole = lock_out(out, "gyroemu merge o", LockScope::Folder, &Quiet).unwrap();
     drop(whole);
 }
+
+#[test]
+fn a_folder_where_the_lock_goes_is_refused_as_input_naming_it() {
+    // Refused as the user's to fix (`Locked`: exit 2), not as a failure while running.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path();
+    std::fs::create_dir(out.join(LOCK_FILE)).unwrap();
+    let m = locked(lock_out(
+        out,
+        "gyroemu run a.toml",
+        LockScope::Folder,
+        &Quiet,
+    ));
+    assert!(m.contains(LOCK_FILE) && m.contains("remove it"), "{m}");
+    assert!(out.join(LOCK_FILE).is_dir());
+}
