@@ -19,7 +19,7 @@ pub struct ChannelStats {
     pub unit: String,
     /// Root mean square over the recording.
     pub rms: f64,
-    /// Largest |sample|.
+    /// Largest |sample| (NaN if any sample is NaN).
     pub peak: f64,
     /// The strongest tones, strongest first, within [`SPECTRUM_RANGE_DB`] of the first (empty
     /// when the spectrum cannot be computed).
@@ -34,7 +34,12 @@ pub fn channel_stats(d: &gyroemu_io::Dump) -> Vec<ChannelStats> {
         .iter()
         .zip(&d.data)
         .map(|(c, x)| {
-            let peak = x.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+            // NaN when any sample is (`f64::max` skips NaN: an all-NaN channel read 0).
+            let peak = if x.iter().any(|v| v.is_nan()) {
+                f64::NAN
+            } else {
+                x.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
+            };
             let rms = rms(x, peak);
             let (mut tones, spectrum_error) = match welch(x, d.sample_rate_hz, None) {
                 Ok(p) => (find_tones(&p, TONES_LISTED, TONE_MIN_SNR_DB), None),

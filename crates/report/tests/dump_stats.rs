@@ -1,7 +1,7 @@
 //! `gyroemu inspect`'s RMS and peak of a channel: the RMS of a square wave is its amplitude
 //! (to the rounding of its sum), at any magnitude f64 holds (1e300 once read inf, 1e-170 read 0); ordinary
 //! samples keep the bits of the plain mean of squares; a spectrum beyond f64's range is said,
-//! with no tones listed.
+//! with no tones listed; a NaN sample makes the peak NaN (it read 0 on an all-NaN channel).
 
 use gyroemu_io::{Dump, SigmfChannel};
 use gyroemu_report::dump_stats::channel_stats;
@@ -61,4 +61,20 @@ fn a_spectrum_beyond_f64_lists_no_tones_and_says_why() {
         .collect();
     let s = &channel_stats(&dump(x))[0];
     assert!((s.tones[0].freq_hz - 500.0).abs() < 1e-6, "{:?}", s.tones);
+}
+
+#[test]
+fn a_nan_sample_makes_the_peak_and_rms_nan_not_a_clean_number() {
+    // All NaN, and one NaN among finite samples: neither may read as a peak of finite data.
+    let all = vec![f64::NAN; 64];
+    let mut one: Vec<f64> = (0..64).map(|i| (i as f64 * 0.3).sin()).collect();
+    one[17] = f64::NAN;
+    for x in [all, one] {
+        let s = &channel_stats(&dump(x))[0];
+        assert!(s.peak.is_nan() && s.rms.is_nan(), "{s:?}");
+        assert!(s.spectrum_error.as_deref().unwrap_or_default().contains("NaN"));
+    }
+    // An infinite sample is the peak.
+    let s = &channel_stats(&dump(vec![1.0, f64::NEG_INFINITY, 2.0, 0.5]))[0];
+    assert_eq!(s.peak, f64::INFINITY);
 }
