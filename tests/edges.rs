@@ -247,5 +247,27 @@ fn a_clipping_warning_names_the_points_that_clipped_and_only_those() {
         for clean in ["1000 deg/s", "2000 deg/s"] {
             assert!(!w.contains(clean), "{clean}: {w}");
         }
+        // The reference clipped, and every phase is read against it.
+        assert!(w.contains("phase of this run can be trusted"), "{w}");
     }
+    // Against the same board without rails: every phase moved by the reference's shift (the
+    // clipped tone's harmonics alias onto the carrier at fs = 16 f0), and the clipped points'
+    // by their own clipping besides.
+    c.board.tia_rail_v = None;
+    let free = run(&c);
+    let moved: Vec<f64> = r
+        .points
+        .iter()
+        .zip(&free.points)
+        .map(|(p, q)| p.phase_deg[0] - q.phase_deg[0])
+        .collect();
+    let reference_shift = moved[2];
+    assert!(reference_shift.abs() > 1e-2, "{moved:?}");
+    assert!((moved[3] - reference_shift).abs() < 1e-9, "{moved:?}");
+    assert!(
+        moved[..2]
+            .iter()
+            .all(|m| (m - reference_shift).abs() > 1e-2),
+        "{moved:?}"
+    );
 }

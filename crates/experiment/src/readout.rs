@@ -158,8 +158,14 @@ fn dead_channels(cfg: &Config, lr: &LaneResult) -> Vec<(usize, String)> {
     dead
 }
 
-/// The clipping a point's counts show, as warnings naming the stage and its setting.
-fn clipping_warnings(h: &Health, points: &[(f64, bool, Health)]) -> Vec<String> {
+/// The clipping a point's counts show, as warnings naming the stage and its setting, and
+/// which phases it spoils: the clipped points', or every point's where each is read against
+/// a zero-rate reference that clipped (`against_reference`: a Coriolis sweep).
+fn clipping_warnings(
+    h: &Health,
+    points: &[(f64, bool, Health)],
+    against_reference: bool,
+) -> Vec<String> {
     let pct = |n: u64| 100.0 * n as f64 / h.samples.max(1) as f64;
     let mut w = Vec::new();
     for (what, counts, setting, of) in [
@@ -197,8 +203,20 @@ fn clipping_warnings(h: &Health, points: &[(f64, bool, Health)]) -> Vec<String> 
                         }
                     })
                     .collect();
+                let reference_clipped = against_reference
+                    && points
+                        .iter()
+                        .any(|(rate, _, p)| *rate == 0.0 && of(p)[k] > 0);
+                let spoilt = if reference_clipped {
+                    format!(
+                        "no mode-{} phase of this run can be trusted: each is read against the zero-rate reference, which clipped",
+                        k + 1
+                    )
+                } else {
+                    "the phases at those points cannot be trusted".to_string()
+                };
                 w.push(format!(
-                    "{what} {n} of {} samples ({:.3} %) of mode {}, at {} (counted over each run, settling included): raise {setting} (clipping distorts the signal; the phase of its fundamental survives only for a pure tone)",
+                    "{what} {n} of {} samples ({:.3} %) of mode {}, at {} (counted over each run, settling included): raise {setting}; {spoilt} (sampled at fs, even a clipped pure tone's harmonics alias onto the carrier and move its phase, by degrees when deeply clipped)",
                     h.samples,
                     pct(n),
                     k + 1,
@@ -507,7 +525,7 @@ pub fn post_process_with(
         .zip(lanes)
         .map(|(&rate, l)| (rate, cfg.experiment.rates_dps.contains(&rate), l.health))
         .collect();
-    let warnings = clipping_warnings(&health, &per_point);
+    let warnings = clipping_warnings(&health, &per_point, matches!(shape, Shape::Coriolis));
     let xs: Vec<f64> = out.iter().map(|p| p.rate_dps).collect();
     let fit =
         [0, 1].map(|k| fit_line(&xs, &out.iter().map(|p| p.phase_deg[k]).collect::<Vec<_>>()));

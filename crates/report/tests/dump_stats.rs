@@ -72,7 +72,11 @@ fn a_nan_sample_makes_the_peak_and_rms_nan_not_a_clean_number() {
     for x in [all, one] {
         let s = &channel_stats(&dump(x))[0];
         assert!(s.peak.is_nan() && s.rms.is_nan(), "{s:?}");
-        assert!(s.spectrum_error.as_deref().unwrap_or_default().contains("NaN"));
+        assert!(s
+            .spectrum_error
+            .as_deref()
+            .unwrap_or_default()
+            .contains("NaN"));
     }
     // An infinite sample is the peak.
     let s = &channel_stats(&dump(vec![1.0, f64::NEG_INFINITY, 2.0, 0.5]))[0];
