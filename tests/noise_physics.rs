@@ -7,7 +7,7 @@ mod common;
 
 use gyroemu::board::{Board, Point, Probe, RunOptions};
 use gyroemu::config::presets::preset;
-use gyroemu::config::{Config, NoiseConfig};
+use gyroemu::config::{Config, NoiseConfig, WindowKind};
 use gyroemu::core::f64x4;
 use gyroemu::lpf::Window;
 use std::f64::consts::PI;
@@ -168,4 +168,53 @@ fn brownian_force_gives_the_snr_phase_noise() {
         (got / expected - 1.0).abs() < TOL,
         "phase noise {got:e} rad, closed form {expected:e}"
     );
+}
+
+/// The error against theory of each mode's phase over `seeds` noise seeds, deg.
+fn seeded_errors(cfg: &Config, seeds: u64) -> Vec<[f64; 2]> {
+    (0..seeds)
+        .map(|seed| {
+            let mut c = cfg.clone();
+            c.noise.as_mut().unwrap().seed = seed;
+            let p = &common::run(&c).points[0];
+            [0, 1].map(|k| p.phase_deg[k] - p.theory_deg[k])
+        })
+        .collect()
+}
+
+#[test]
+fn the_warned_reading_scatter_is_the_sweeps_own() {
+    // `Config::noise_phase_sigma_rad`, which the noise-dominance warning states, against the
+    // scatter of a Coriolis sweep's read-out over seeds (each reading a point against the
+    // zero-rate reference, both noisy): the TIA's input noise under a boxcar window, and the
+    // Brownian force under a Hann window (1.5 times the noise bandwidth).
+    let (mut cfg, _) = board_cfg();
+    cfg.experiment.rates_dps = vec![100.0];
+    // The Brownian part is the resonance's, correlated over tau = Q / (pi f0) = 42 ms: white
+    // to an average of 1 s (24 tau), not yet to one of 0.2 s.
+    for (n, window, average_s) in [
+        (noise(None, 3e-10, 0.0), WindowKind::Boxcar, 0.2),
+        (noise(None, 3e-10, 0.0), WindowKind::Hann, 0.3),
+        (noise(Some(1.2e-15), 0.0, 0.0), WindowKind::Boxcar, 1.0),
+        (noise(Some(1.2e-15), 0.0, 0.0), WindowKind::Hann, 1.0),
+    ] {
+        cfg.noise = Some(n);
+        cfg.experiment.window = window;
+        cfg.experiment.average_s = average_s;
+        cfg.validate().unwrap();
+        let sigma = cfg
+            .noise_phase_sigma_rad()
+            .unwrap()
+            .map(|s| s.0.to_degrees());
+        assert!((1.0..4.0).contains(&sigma[0]), "{sigma:?}");
+        let errors = seeded_errors(&cfg, 64);
+        // 128 draws of sigma (both modes alike): within 20 % at 3.2 standard errors (6.3 %),
+        // so a sqrt(2) off (the reference's noise left out) fails.
+        let all: Vec<f64> = errors.iter().flatten().copied().collect();
+        let got = std_dev(&all);
+        assert!(
+            (got / sigma[0] - 1.0).abs() < 0.2,
+            "{window:?}: scatter {got} deg, stated {sigma:?}"
+        );
+    }
 }

@@ -17,6 +17,7 @@ mod validate;
 mod validate_dac;
 mod validate_montecarlo;
 mod validate_noise;
+mod validate_noise_phase;
 mod validate_regime;
 mod validate_settling;
 mod validate_sweep;
@@ -34,5 +35,6 @@ pub use resolve::{
     SWEEP_SPAN_HALF_BANDWIDTHS,
 };
 pub use validate::MAX_RUN_SAMPLES;
+pub use validate_noise_phase::{reading_sigma_rad, NOISE_PHASE_WARN_FRACTION};
 pub use validate_regime::{MAX_HOLD_ERROR_MDEG, NODE_RANGE, WARN_HOLD_ERROR_MDEG};
 pub use validate_sweep::{MAX_SWEEP_POINTS, MIN_POINTS_NEAR_RESONANCE, MIN_SWEEP_POINTS};

@@ -85,6 +85,14 @@ impl Config {
             .fold(0.0, f64::max);
         self.validate_noise_range(p, largest);
         self.validate_converters(p, warnings);
+        if p.clean(&[
+            "noise.temperature_k",
+            "noise.effective_mass_kg",
+            "noise.tia_current_noise_a_per_rthz",
+            "noise.tia_voltage_noise_v_per_rthz",
+        ]) {
+            self.validate_noise_phase(warnings);
+        }
         self.validate_dac_rounding(warnings);
         self.validate_mixer_product(warnings);
         self.validate_table_harmonics(warnings);
@@ -205,7 +213,7 @@ impl Config {
     /// f_c +- f_m (its zeros are the modulation's, not a dead signal). Rate table: the extremes
     /// of the envelope over the table period (harmonic balance, 24 harmonics, on a fine grid).
     /// `None` when the chain cannot be built (other rules report it).
-    fn tia_output_span(&self) -> Option<[AmpSpan; 2]> {
+    pub(crate) fn tia_output_span(&self) -> Option<[AmpSpan; 2]> {
         let chain = ChainResponse::new(&self.board_params()).ok()?;
         let plant = self.resonator_params();
         let dev = self.driven_device();
@@ -596,11 +604,11 @@ fn rotating_sideband(
 /// The smallest and the largest amplitude of a signal over the run's points, with the rate
 /// (deg/s) of each.
 #[derive(Clone, Copy, Debug)]
-struct AmpSpan {
-    min: f64,
-    min_at: f64,
-    max: f64,
-    max_at: f64,
+pub(crate) struct AmpSpan {
+    pub(crate) min: f64,
+    pub(crate) min_at: f64,
+    pub(crate) max: f64,
+    pub(crate) max_at: f64,
 }
 
 impl Default for AmpSpan {
