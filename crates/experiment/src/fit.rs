@@ -27,11 +27,17 @@ pub fn fit_line(x: &[f64], y: &[f64]) -> LineFit {
     let slope = sxy / sxx;
     let intercept = my - slope * mx;
     // At most 1 by Cauchy-Schwarz (sxy^2 <= sxx syy); its rounding can pass 1 by an ulp on
-    // a near-exact line, a value no results file should hold.
+    // a near-exact line, a value no results file should hold. NaN (a refused phase, or one
+    // x) stays NaN: `f64::min` would make it a perfect fit.
     let r2 = if syy == 0.0 {
         1.0
     } else {
-        (sxy * sxy / (sxx * syy)).min(1.0)
+        let r2 = sxy * sxy / (sxx * syy);
+        if r2 > 1.0 {
+            1.0
+        } else {
+            r2
+        }
     };
     let rss: f64 = x
         .iter()
@@ -104,6 +110,11 @@ mod tests {
             let r2 = fit_line(&x, &y).r2;
             assert!((0.0..=1.0).contains(&r2), "r2 {r2} for {x:?} {y:?}");
         }
+        // A refused phase (NaN) or a single x gives no fit, not a perfect one.
+        assert!(fit_line(&[1.0, 2.0, 3.0], &[0.5, f64::NAN, 1.5])
+            .r2
+            .is_nan());
+        assert!(fit_line(&[2.0, 2.0], &[0.5, 1.5]).r2.is_nan());
     }
 
     #[test]
