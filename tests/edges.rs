@@ -271,3 +271,33 @@ fn a_clipping_warning_names_the_points_that_clipped_and_only_those() {
         "{moved:?}"
     );
 }
+
+#[test]
+fn a_clipped_drive_in_a_coriolis_run_spoils_every_phase_and_the_warning_says_so() {
+    // Only drive 1 clips (F2 = 0.4 F1): its fundamental shrinks, the drives' ratio moves, and
+    // with it every point's phase of both modes, though only drive 1's counts show it.
+    let mut c = config("coriolis", 15e3, 2000.0, 1.0, 0.4, &[25.0, 2000.0], 0.5);
+    let free = run(&c);
+    c.board.dac_bits = Some(16);
+    c.board.dac_full_scale = 0.6;
+    let r = run(&c);
+    let dac: Vec<&String> = r
+        .warnings
+        .iter()
+        .filter(|w| w.contains("DAC clipped"))
+        .collect();
+    assert_eq!(dac.len(), 1, "{:?}", r.warnings);
+    assert!(
+        dac[0].contains("of mode 1") && dac[0].contains("no phase of this run"),
+        "{}",
+        dac[0]
+    );
+    for (p, q) in r.points.iter().zip(&free.points) {
+        let moved = (p.phase_deg[1] - q.phase_deg[1]).abs();
+        assert!(
+            moved > 1e-2,
+            "{} deg/s: mode 2 moved {moved} deg",
+            p.rate_dps
+        );
+    }
+}

@@ -159,13 +159,11 @@ fn dead_channels(cfg: &Config, lr: &LaneResult) -> Vec<(usize, String)> {
 }
 
 /// The clipping a point's counts show, as warnings naming the stage and its setting, and
-/// which phases it spoils: the clipped points', or every point's where each is read against
-/// a zero-rate reference that clipped (`against_reference`: a Coriolis sweep).
-fn clipping_warnings(
-    h: &Health,
-    points: &[(f64, bool, Health)],
-    against_reference: bool,
-) -> Vec<String> {
+/// which phases it spoils. On the sense side (TIA rails, ADC): the clipped points', or every
+/// point's where each is read against a zero-rate reference that clipped (`coriolis`). A
+/// clipped drive (DAC): the points it clipped at, and in a Coriolis sweep every point, whose
+/// phases all depend on the two drives' ratio (the drive is the same at every rate).
+fn clipping_warnings(h: &Health, points: &[(f64, bool, Health)], coriolis: bool) -> Vec<String> {
     let pct = |n: u64| 100.0 * n as f64 / h.samples.max(1) as f64;
     let mut w = Vec::new();
     for (what, counts, setting, of) in [
@@ -203,20 +201,22 @@ fn clipping_warnings(
                         }
                     })
                     .collect();
-                let reference_clipped = against_reference
+                let reference_clipped = coriolis
                     && points
                         .iter()
                         .any(|(rate, _, p)| *rate == 0.0 && of(p)[k] > 0);
-                let spoilt = if reference_clipped {
-                    format!(
-                        "no mode-{} phase of this run can be trusted: each is read against the zero-rate reference, which clipped",
+                let drive = setting == "board.dac_full_scale";
+                let spoilt = match (drive, coriolis, reference_clipped) {
+                    (true, true, _) => "no phase of this run can be trusted unless both drives clip alike: a clipped drive's fundamental shrinks and its aliased harmonics move its phase, and every Coriolis phase depends on the two drives' ratio".to_string(),
+                    (true, false, _) => "the phases at those points cannot be trusted: a clipped drive's fundamental shrinks and its aliased harmonics move its phase".to_string(),
+                    (false, _, true) => format!(
+                        "no mode-{} phase of this run can be trusted: each is read against the zero-rate reference, which clipped (sampled at fs, even a clipped pure tone's harmonics alias onto the carrier and move its phase, by degrees when deeply clipped)",
                         k + 1
-                    )
-                } else {
-                    "the phases at those points cannot be trusted".to_string()
+                    ),
+                    (false, _, false) => "the phases at those points cannot be trusted (sampled at fs, even a clipped pure tone's harmonics alias onto the carrier and move its phase, by degrees when deeply clipped)".to_string(),
                 };
                 w.push(format!(
-                    "{what} {n} of {} samples ({:.3} %) of mode {}, at {} (counted over each run, settling included): raise {setting}; {spoilt} (sampled at fs, even a clipped pure tone's harmonics alias onto the carrier and move its phase, by degrees when deeply clipped)",
+                    "{what} {n} of {} samples ({:.3} %) of mode {}, at {} (counted over each run, settling included): raise {setting}; {spoilt}",
                     h.samples,
                     pct(n),
                     k + 1,
