@@ -7,6 +7,7 @@ use crate::abort::LiveManifest;
 use crate::error::RunError;
 use crate::manifest::{Manifest, RunKind, ShardId};
 use crate::shard::{manifest_path, Shard};
+use gyroemu_report::ReportError;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -98,10 +99,16 @@ impl<'a> Ledger<'a> {
         }
     }
 
-    /// The run failed with `e`: the manifest says `failed`, with the cause and what to do.
+    /// The run failed with `e`: the manifest says `failed`, with the cause and what to do
+    /// (for refused numbers, [`RunKind::refused_next`]: rerunning unchanged cannot help).
     pub(crate) fn fail<V>(&self, e: RunError, done: &BTreeMap<usize, V>) -> RunError {
         let mut m = self.manifest("failed", done);
-        m.next = format!("fix the cause ({e}) and rerun the same command");
+        m.next = match &e {
+            RunError::Report(ReportError::Unreliable(_)) => self
+                .kind
+                .refused_next("rerun with --force (or into another --out)"),
+            _ => format!("fix the cause ({e}) and rerun the same command"),
+        };
         self.finish(&m, e)
     }
 

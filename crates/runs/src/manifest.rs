@@ -24,6 +24,19 @@ pub enum RunKind {
 }
 
 impl RunKind {
+    /// The `next` of a manifest whose results were written but refuse some of their numbers
+    /// (`ReportError::Unreliable`): where they are listed, and that the same config refuses
+    /// them again while a changed one meets this folder's results (hence `--force`).
+    /// `rerun`: how to run it again (the run itself, or every shard and then the merge).
+    pub(crate) fn refused_next(self, rerun: &str) -> String {
+        let listed = match self {
+            RunKind::Run => "phases refused (NaN in results.csv, listed in summary.json's `problems`)",
+            RunKind::Montecarlo => {
+                "devices whose numbers cannot be trusted (listed in montecarlo.json's `devices_unreliable`)"
+            }
+        };
+        format!("{listed}: the same config refuses them again; change it and {rerun}")
+    }
     /// How the user names it.
     pub fn describe(self) -> &'static str {
         match self {

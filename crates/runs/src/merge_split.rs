@@ -10,6 +10,7 @@ use crate::manifest::{read_manifest, shard_manifest_paths, Manifest, RunKind, RU
 use crate::records::{scan_records, RecordFile};
 use crate::shard::absent_shards;
 use gyroemu_config::parse_config;
+use gyroemu_report::ReportError;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -290,10 +291,18 @@ impl Split {
             }
             Err(e) => {
                 m.status = "failed".into();
-                m.next = format!(
-                    "fix the cause ({e}) and rerun gyroemu merge {}",
-                    dir.display()
-                );
+                m.next = match &e {
+                    RunError::Report(ReportError::Unreliable(_)) => {
+                        self.kind.refused_next(&format!(
+                            "rerun every shard with --force (or into another --out), then gyroemu merge {}",
+                            dir.display()
+                        ))
+                    }
+                    _ => format!(
+                        "fix the cause ({e}) and rerun gyroemu merge {}",
+                        dir.display()
+                    ),
+                };
                 Err(match m.write(&path) {
                     Ok(()) => e,
                     Err(w) => RunError::Unrecorded {

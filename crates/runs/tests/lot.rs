@@ -339,9 +339,10 @@ fn untrusted_devices_leave_the_manifest_failed_in_a_lot_and_in_its_merge() {
     assert!(one.join("devices.csv").is_file());
     let m = json(&one.join("manifest.json"));
     assert_eq!(m["status"], "failed", "{m}");
+    let next = m["next"].as_str().unwrap();
     assert!(
-        m["next"].as_str().unwrap().contains("cannot be trusted"),
-        "{m}"
+        next.contains("devices_unreliable") && next.contains("--force"),
+        "{next}"
     );
 
     let split = dir.path().join("split");
@@ -357,4 +358,11 @@ fn untrusted_devices_leave_the_manifest_failed_in_a_lot_and_in_its_merge() {
     assert!(split.join("devices.csv").is_file());
     let m = json(&split.join("manifest.json"));
     assert_eq!(m["status"], "failed", "{m}");
+    assert!(
+        m["next"]
+            .as_str()
+            .unwrap()
+            .contains("every shard with --force"),
+        "{m}"
+    );
 }

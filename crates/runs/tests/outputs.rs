@@ -109,8 +109,16 @@ fn refused_phases_leave_the_manifest_failed_with_the_files_written() {
     let m = json(&out.join("manifest.json"));
     assert_eq!(m["status"], "failed", "{m}");
     assert_eq!(m["points_done"], serde_json::json!([0, 1, 2, 3]));
+    // Where they are listed, and how to rerun: the same config refuses them again, a changed
+    // one meets this folder's results.
     let next = m["next"].as_str().unwrap();
-    assert!(next.contains("refused") && next.contains("adc"), "{next}");
+    assert!(
+        next.contains("summary.json") && next.contains("change it") && next.contains("--force"),
+        "{next}"
+    );
+    let (r, _, _) = run_into(&config(CONFIG), out, true);
+    assert!(matches!(r, Ok(RunOutcome::Complete(_))), "{r:?}");
+    assert_eq!(json(&out.join("manifest.json"))["status"], "complete");
 
     // The same points run as two shards and merged: the merge fails alike.
     let split = dir.path().join("split");
@@ -130,7 +138,15 @@ fn refused_phases_leave_the_manifest_failed_with_the_files_written() {
     let e = gyroemu_runs::merge(&split, &gyroemu_experiment::Quiet).unwrap_err();
     assert!(e.to_string().contains("refused"), "{e}");
     assert!(split.join("results.csv").is_file());
-    assert_eq!(json(&split.join("manifest.json"))["status"], "failed");
+    let m = json(&split.join("manifest.json"));
+    assert_eq!(m["status"], "failed");
+    assert!(
+        m["next"]
+            .as_str()
+            .unwrap()
+            .contains("every shard with --force"),
+        "{m}"
+    );
 }
 
 #[test]
