@@ -184,28 +184,46 @@ fn seeded_errors(cfg: &Config, seeds: u64) -> Vec<[f64; 2]> {
 
 #[test]
 fn the_warned_reading_scatter_is_the_sweeps_own() {
-    // `Config::noise_phase_sigma_rad`, which the noise-dominance warning states, against the
-    // scatter of a Coriolis sweep's read-out over seeds (each reading a point against the
-    // zero-rate reference, both noisy): the TIA's input noise under a boxcar window, and the
-    // Brownian force under a Hann window (1.5 times the noise bandwidth).
-    let (mut cfg, _) = board_cfg();
-    cfg.experiment.rates_dps = vec![100.0];
-    // The Brownian part is the resonance's, correlated over tau = Q / (pi f0) = 42 ms: white
-    // to an average of 1 s (24 tau), not yet to one of 0.2 s.
-    for (n, window, average_s) in [
-        (noise(None, 3e-10, 0.0), WindowKind::Boxcar, 0.2),
-        (noise(None, 3e-10, 0.0), WindowKind::Hann, 0.3),
-        (noise(Some(1.2e-15), 0.0, 0.0), WindowKind::Boxcar, 1.0),
-        (noise(Some(1.2e-15), 0.0, 0.0), WindowKind::Hann, 1.0),
+    // `Config::noise_phase`, which the noise-dominance warning states, against the scatter of
+    // a sweep's read-out over seeds. Coriolis: each reading a point against the zero-rate
+    // reference, both noisy; the TIA's input noise under a boxcar and a Hann window (1.5
+    // times the noise bandwidth), and the Brownian force. The Brownian part is the
+    // resonance's, correlated over tau = Q / (pi f0) = 42 ms: white to an average of 1 s (24
+    // tau), not yet to one of 0.2 s. Rotating: psi from the two sidebands, at 1800 deg/s
+    // averaged over whole half periods (0.1 s of the 0.19 s asked: the span counts).
+    let (mut coriolis, _) = board_cfg();
+    coriolis.experiment.rates_dps = vec![100.0];
+    let mut rotating = preset("m2tfg-rotating").unwrap();
+    rotating.experiment.rates_dps = vec![1800.0];
+    rotating.experiment.settle_s = Some(0.8);
+    for (base, n, window, average_s) in [
+        (&coriolis, noise(None, 3e-10, 0.0), WindowKind::Boxcar, 0.2),
+        (&coriolis, noise(None, 3e-10, 0.0), WindowKind::Hann, 0.3),
+        (
+            &coriolis,
+            noise(Some(1.2e-15), 0.0, 0.0),
+            WindowKind::Boxcar,
+            1.0,
+        ),
+        (
+            &coriolis,
+            noise(Some(1.2e-15), 0.0, 0.0),
+            WindowKind::Hann,
+            1.0,
+        ),
+        (
+            &rotating,
+            noise(None, 1.5e-10, 0.0),
+            WindowKind::Boxcar,
+            0.19,
+        ),
     ] {
+        let mut cfg = base.clone();
         cfg.noise = Some(n);
         cfg.experiment.window = window;
         cfg.experiment.average_s = average_s;
         cfg.validate().unwrap();
-        let sigma = cfg
-            .noise_phase_sigma_rad()
-            .unwrap()
-            .map(|s| s.0.to_degrees());
+        let sigma = cfg.noise_phase().unwrap()[0].sigma_rad.map(f64::to_degrees);
         assert!((1.0..4.0).contains(&sigma[0]), "{sigma:?}");
         let errors = seeded_errors(&cfg, 64);
         // 128 draws of sigma (both modes alike): within 20 % at 3.2 standard errors (6.3 %),
@@ -214,7 +232,8 @@ fn the_warned_reading_scatter_is_the_sweeps_own() {
         let got = std_dev(&all);
         assert!(
             (got / sigma[0] - 1.0).abs() < 0.2,
-            "{window:?}: scatter {got} deg, stated {sigma:?}"
+            "{:?} {window:?}: scatter {got} deg, stated {sigma:?}",
+            cfg.shape()
         );
     }
 }

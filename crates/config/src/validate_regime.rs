@@ -213,7 +213,19 @@ impl Config {
     /// f_c +- f_m (its zeros are the modulation's, not a dead signal). Rate table: the extremes
     /// of the envelope over the table period (harmonic balance, 24 harmonics, on a fine grid).
     /// `None` when the chain cannot be built (other rules report it).
-    pub(crate) fn tia_output_span(&self) -> Option<[AmpSpan; 2]> {
+    fn tia_output_span(&self) -> Option<[AmpSpan; 2]> {
+        let mut span = [AmpSpan::default(); 2];
+        for (rate, amps) in self.tia_output_per_rate()? {
+            for (s, (lo, hi)) in span.iter_mut().zip(amps) {
+                s.include(lo, hi, rate);
+            }
+        }
+        Some(span)
+    }
+
+    /// [`Config::tia_output_span`]'s amplitudes at each emulated rate (deg/s): per mode the
+    /// smallest and the largest over the point's run.
+    pub(crate) fn tia_output_per_rate(&self) -> Option<Vec<(f64, [(f64, f64); 2])>> {
         let chain = ChainResponse::new(&self.board_params()).ok()?;
         let plant = self.resonator_params();
         let dev = self.driven_device();
@@ -223,7 +235,7 @@ impl Config {
         let [f1, f2] = dev.drive;
         let shift = (90.0 + dev.phase_shifter_error_deg) * DEG;
         let force = [Complex64::new(f1, 0.0), Complex64::from_polar(f2, -shift)];
-        let mut span = [AmpSpan::default(); 2];
+        let mut per_rate = Vec::new();
         for rate in self.emulated_rates_dps() {
             let omega = rate * DEG;
             let amps: [(f64, f64); 2] = match self.shape() {
@@ -266,11 +278,9 @@ impl Config {
                     })
                 }
             };
-            for (s, (lo, hi)) in span.iter_mut().zip(amps) {
-                s.include(lo, hi, rate);
-            }
+            per_rate.push((rate, amps));
         }
-        Some(span)
+        Some(per_rate)
     }
 
     fn validate_converters(&self, p: &mut Rules, warnings: &mut Vec<String>) {
@@ -604,11 +614,11 @@ fn rotating_sideband(
 /// The smallest and the largest amplitude of a signal over the run's points, with the rate
 /// (deg/s) of each.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct AmpSpan {
-    pub(crate) min: f64,
-    pub(crate) min_at: f64,
-    pub(crate) max: f64,
-    pub(crate) max_at: f64,
+struct AmpSpan {
+    min: f64,
+    min_at: f64,
+    max: f64,
+    max_at: f64,
 }
 
 impl Default for AmpSpan {
