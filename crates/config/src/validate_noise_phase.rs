@@ -159,7 +159,7 @@ impl Config {
         else {
             return;
         };
-        for k in 0..2 {
+        for (k, density) in density.iter().enumerate() {
             // The worst ratio; a NaN (a dead signal, which other rules name) says nothing.
             let worst = points
                 .iter()
@@ -188,7 +188,7 @@ impl Config {
             };
             warnings.push(format!(
                 "the noise at the carrier (about {:.3e} V/sqrt(Hz) at the ADC input, the white sources together), averaged over the point's span, against the TIA output of mode {} at {} deg/s (about {amplitude:.3e} V) {scatter}; average longer (experiment.average_s) or lower the noise",
-                density[k].sqrt(),
+                density.sqrt(),
                 k + 1,
                 p.rate_dps,
             ));

@@ -225,7 +225,7 @@ impl Config {
 
     /// [`Config::tia_output_span`]'s amplitudes at each emulated rate (deg/s): per mode the
     /// smallest and the largest over the point's run.
-    pub(crate) fn tia_output_per_rate(&self) -> Option<Vec<(f64, [(f64, f64); 2])>> {
+    pub(crate) fn tia_output_per_rate(&self) -> Option<Vec<(f64, [LoHi; 2])>> {
         let chain = ChainResponse::new(&self.board_params()).ok()?;
         let plant = self.resonator_params();
         let dev = self.driven_device();
@@ -610,6 +610,9 @@ fn rotating_sideband(
     let x = continuous_steady_state(&dev.plant, 0.0, fc + sign * fm, f);
     [x[2], x[3]]
 }
+
+/// A signal's smallest and largest amplitude over a point's run.
+pub(crate) type LoHi = (f64, f64);
 
 /// The smallest and the largest amplitude of a signal over the run's points, with the rate
 /// (deg/s) of each.
