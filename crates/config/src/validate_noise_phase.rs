@@ -4,6 +4,7 @@
 
 use crate::config::{Config, WindowKind};
 use crate::plan::DEG;
+use crate::validate_regime::LoHi;
 use gyroemu_board::{ChainResponse, Shape};
 
 /// The noise is said to dominate when a reading's standard deviation passes this fraction of
@@ -101,16 +102,22 @@ impl Config {
     /// warning). Flicker is left out.
     pub fn noise_phase(&self) -> Option<Vec<NoisePhase>> {
         let density = self.carrier_noise_density()?;
-        let per_rate = self.tia_output_per_rate()?;
+        // By rate: a sweep may list 1e5 rates, too many to search each time.
+        let per_rate: std::collections::HashMap<u64, [LoHi; 2]> = self
+            .tia_output_per_rate()?
+            .into_iter()
+            .map(|(r, a)| (r.to_bits(), a))
+            .collect();
+        let amps = |rate: f64| per_rate.get(&rate.to_bits());
         let enbw = match self.experiment.window {
             WindowKind::Boxcar => 1.0,
             WindowKind::Hann => 1.5,
         };
         let fs_out = self.fs_out_hz();
         let variance = |rate: f64, k: usize| {
-            let (_, amps) = per_rate.iter().find(|(r, _)| *r == rate)?;
+            let a = amps(rate)?;
             let span_s = self.plan_point(rate).span_samples() / fs_out;
-            Some(phase_variance_rad2(density[k], enbw, span_s, amps[k].0))
+            Some(phase_variance_rad2(density[k], enbw, span_s, a[k].0))
         };
         let dev = self.driven_device();
         let shape = self.shape();
@@ -133,12 +140,7 @@ impl Config {
                         _ => (2.0 * own).sqrt(),
                     }
                 });
-                let amplitude_v = [0, 1].map(|k| {
-                    per_rate
-                        .iter()
-                        .find(|(r, _)| *r == rate)
-                        .map_or(f64::NAN, |(_, a)| a[k].0)
-                });
+                let amplitude_v = [0, 1].map(|k| amps(rate).map_or(f64::NAN, |a| a[k].0));
                 NoisePhase {
                     rate_dps: rate,
                     sigma_rad,
