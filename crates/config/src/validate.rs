@@ -334,7 +334,7 @@ impl Config {
                 },
                 e.settle_s.filter(|&s| s > e.average_s).unwrap_or(e.average_s),
                 format!(
-                    "settling plus averaging must span at most 2^53 = {MAX_RUN_SAMPLES:e} input samples per point (here {run_samples:e} at fs_hz = {})",
+                    "settling plus averaging must span at most 2^53 = {MAX_RUN_SAMPLES:e} input samples per point (here {run_samples:e} at fs_hz = {:?})",
                     fs_hz
                 ),
             );

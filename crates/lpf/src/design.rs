@@ -54,7 +54,7 @@ pub(crate) fn sections(
                 param,
                 value,
                 format!(
-                    "{why} at fs_hz = {fs_hz} (too close to 0 or to fs/2 for double precision)"
+                    "{why} at fs_hz = {fs_hz:?} (too close to 0 or to fs/2 for double precision)"
                 ),
             )
         })?;
