@@ -476,6 +476,16 @@ impl Config {
             }
         }
         if p.clean(&["board.fs_hz"]) {
+            // Far below a sample the window holds nothing: the dump was one row at its start.
+            p.check(
+                duration_s * self.fs_hz() >= 1.0,
+                "dump.duration_s",
+                duration_s,
+                format!(
+                    "the window must hold at least one full-rate sample (1 / fs_hz = {:e} s)",
+                    1.0 / self.fs_hz()
+                ),
+            );
             p.check(
                 duration_s * self.fs_hz() <= 5e7,
                 "dump.duration_s",
@@ -497,6 +507,14 @@ impl Config {
                 format!("\"{n}\""),
                 format!("must be one of {DUMP_NODES:?}"),
             );
+            if let Some(j) = nodes[..i].iter().position(|m| m == n) {
+                p.check(
+                    false,
+                    &format!("dump.nodes[{i}]"),
+                    format!("\"{n}\""),
+                    format!("is already listed as dump.nodes[{j}]: list each node once"),
+                );
+            }
         }
         if p.clean(&["board.fs_hz", "board.decimation"]) {
             let (fs, m) = (self.fs_hz(), self.decimation());

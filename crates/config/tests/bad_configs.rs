@@ -1155,6 +1155,20 @@ fn cases() -> Vec<Case> {
             &["dump.nodes[1]", "\"foo\"", "must be one of", "\"stage2\""],
         ),
         invalid(
+            "dump node listed twice",
+            set(&dumped, "dump", "nodes", "[\"tia\", \"lowpass\", \"tia\"]"),
+            &[
+                "dump.nodes[2]",
+                "\"tia\"",
+                "already listed as dump.nodes[0]",
+            ],
+        ),
+        invalid(
+            "dump shorter than a sample",
+            set(&dumped, "dump", "duration_s", "1e-9"),
+            &["dump.duration_s", "at least one full-rate sample"],
+        ),
+        invalid(
             "dump nodes empty",
             set(&dumped, "dump", "nodes", "[]"),
             &["dump.nodes", "[]", "at least one node"],
