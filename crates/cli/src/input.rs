@@ -97,6 +97,19 @@ pub fn list_written(out: &Path, files: &[std::path::PathBuf]) {
     list_written_with(out, files, None);
 }
 
+/// `r`, having listed the files a run wrote before refusing numbers in them
+/// ([`gyroemu_runs::RunError::Refused`]): its list, as a run that completes ends with.
+pub fn listing_refused<T>(
+    r: Result<T, gyroemu_runs::RunError>,
+    out: &Path,
+    items: Option<ItemFiles>,
+) -> Result<T, gyroemu_runs::RunError> {
+    if let Err(gyroemu_runs::RunError::Refused { files, .. }) = &r {
+        list_written_with(out, files, items);
+    }
+    r
+}
+
 /// [`list_written`], then the per-item files `items` as one line: `points/ (3 point files)`.
 pub fn list_written_with(out: &Path, files: &[std::path::PathBuf], items: Option<ItemFiles>) {
     let items = items.filter(|i| i.count > 0);

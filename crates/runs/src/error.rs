@@ -22,10 +22,17 @@ pub enum RunError {
     /// `{:#}` would print it twice).
     #[error("emulation failed: {0}")]
     Sweep(SweepError),
-    /// Writing the outputs failed, or they hold numbers that cannot be trusted
-    /// ([`ReportError::Unreliable`]: written as null, the run exits non-zero).
+    /// Writing the outputs failed.
     #[error(transparent)]
     Report(#[from] ReportError),
+    /// The outputs were written, but they hold numbers that cannot be trusted (refused phases,
+    /// untrusted devices: [`ReportError::Unreliable`], written as NaN / null): the run exits
+    /// non-zero and lists `files`, what it wrote.
+    #[error("{error}")]
+    Refused {
+        error: ReportError,
+        files: Vec<std::path::PathBuf>,
+    },
     /// A failure (`cause`) after which the manifest could not be updated either: it still
     /// says `running`.
     #[error("{cause}; the manifest `{}` could not be updated either ({why}): it still says `running`", manifest.display())]

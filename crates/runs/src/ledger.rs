@@ -7,7 +7,6 @@ use crate::abort::LiveManifest;
 use crate::error::RunError;
 use crate::manifest::{Manifest, RunKind, ShardId};
 use crate::shard::{manifest_path, Shard};
-use gyroemu_report::ReportError;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -104,7 +103,7 @@ impl<'a> Ledger<'a> {
     pub(crate) fn fail<V>(&self, e: RunError, done: &BTreeMap<usize, V>) -> RunError {
         let mut m = self.manifest("failed", done);
         m.next = match &e {
-            RunError::Report(ReportError::Unreliable(_)) => self
+            RunError::Refused { .. } => self
                 .kind
                 .refused_next("rerun with --force (or into another --out)"),
             _ => format!("fix the cause ({e}) and rerun the same command"),

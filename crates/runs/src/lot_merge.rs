@@ -69,8 +69,10 @@ pub(crate) fn merge_lot(
     let written = write_lot(dir, &cfg, &devices)
         .map_err(RunError::from)
         .and_then(|(files, summary)| {
-            check_unreliable(&dir.display().to_string(), &summary, &devices)?;
-            Ok(files)
+            match check_unreliable(&dir.display().to_string(), &summary, &devices) {
+                Ok(()) => Ok(files),
+                Err(error) => Err(RunError::Refused { error, files }),
+            }
         });
     let (mut files, path) = split.finish(dir, n, written)?;
     files.push(path);

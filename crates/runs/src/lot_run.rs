@@ -208,11 +208,12 @@ pub fn run_lot(
     let (mut files, summary) =
         write_lot(out, cfg, &devices).map_err(|e| ledger.fail(e.into(), &done))?;
     warn_devices(&devices, reporter);
-    // Untrusted devices fail the lot after its files are written: the manifest says so too.
-    check_unreliable(&out.display().to_string(), &summary, &devices)
-        .map_err(|e| ledger.fail(e, &done))?;
-    ledger.complete(&done)?;
     files.push(ledger.path().to_path_buf());
+    // Untrusted devices fail the lot after its files are written: the manifest says so too.
+    if let Err(error) = check_unreliable(&out.display().to_string(), &summary, &devices) {
+        return Err(ledger.fail(RunError::Refused { error, files }, &done));
+    }
+    ledger.complete(&done)?;
     Ok(LotOutcome::Complete { files, summary })
 }
 
@@ -246,7 +247,7 @@ pub(crate) fn check_unreliable(
     what: &str,
     summary: &LotSummary,
     devices: &[DeviceResult],
-) -> Result<(), RunError> {
+) -> Result<(), ReportError> {
     if summary.unreliable.is_empty() {
         return Ok(());
     }
@@ -263,11 +264,11 @@ pub(crate) fn check_unreliable(
             format!("device {}: {why}", d.index)
         })
         .collect();
-    Err(RunError::Report(ReportError::Unreliable(format!(
+    Err(ReportError::Unreliable(format!(
         "{what}: {} of the {} devices have numbers that cannot be trusted (NaN in devices.csv, \
          left out of the percentiles, counted as failing the spec):\n  {}",
         summary.unreliable.len(),
         summary.devices,
         first.join("\n  ")
-    ))))
+    )))
 }

@@ -25,7 +25,7 @@ pub enum RunKind {
 
 impl RunKind {
     /// The `next` of a manifest whose results were written but refuse some of their numbers
-    /// (`ReportError::Unreliable`): where they are listed, and that the same config refuses
+    /// (`RunError::Refused`): where they are listed, and that the same config refuses
     /// them again while a changed one meets this folder's results (hence `--force`).
     /// `rerun`: how to run it again (the run itself, or every shard and then the merge).
     pub(crate) fn refused_next(self, rerun: &str) -> String {

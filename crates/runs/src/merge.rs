@@ -72,10 +72,13 @@ fn merge_run(dir: &Path, split: Split, reporter: &dyn Reporter) -> Result<Vec<Pa
         reporter.warn(w);
     }
     // Refused phases fail the merge after its files are written: the manifest says so too.
-    let checked = written.and_then(|files| {
-        check_problems(&dir.display().to_string(), &r.problems)?;
-        Ok(files)
-    });
+    let checked =
+        written.and_then(
+            |files| match check_problems(&dir.display().to_string(), &r.problems) {
+                Ok(()) => Ok(files),
+                Err(error) => Err(RunError::Refused { error, files }),
+            },
+        );
     let (mut files, path) = split.finish(dir, n, checked)?;
     files.push(path);
     reporter.note(&format!("merged {} shards ({n} points)", split.count));

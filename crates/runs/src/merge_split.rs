@@ -10,7 +10,6 @@ use crate::manifest::{read_manifest, shard_manifest_paths, Manifest, RunKind, RU
 use crate::records::{scan_records, RecordFile};
 use crate::shard::absent_shards;
 use gyroemu_config::parse_config;
-use gyroemu_report::ReportError;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -289,10 +288,13 @@ impl Split {
                 m.write(&path)?;
                 Ok((t, path))
             }
-            Err(e) => {
+            Err(mut e) => {
+                if let RunError::Refused { files, .. } = &mut e {
+                    files.push(path.clone());
+                }
                 m.status = "failed".into();
                 m.next = match &e {
-                    RunError::Report(ReportError::Unreliable(_)) => {
+                    RunError::Refused { .. } => {
                         self.kind.refused_next(&format!(
                             "rerun every shard with --force (or into another --out), then gyroemu merge {}",
                             dir.display()

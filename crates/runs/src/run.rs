@@ -269,12 +269,13 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     for w in &r.warnings {
         reporter.warn(w);
     }
-    // Refused phases fail the run after its files are written: the manifest says so too.
-    check_problems(&out.display().to_string(), &r.problems)
-        .map_err(|e| ledger.fail(e.into(), &swept.lanes))?;
-    ledger.complete(&swept.lanes)?;
     files.push(ledger.path().to_path_buf());
     files.extend(swept.dump_files.iter().cloned());
+    // Refused phases fail the run after its files are written: the manifest says so too.
+    if let Err(error) = check_problems(&out.display().to_string(), &r.problems) {
+        return Err(ledger.fail(RunError::Refused { error, files }, &swept.lanes));
+    }
+    ledger.complete(&swept.lanes)?;
     Ok(RunOutcome::Complete(files))
 }
 

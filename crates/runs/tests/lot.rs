@@ -336,7 +336,10 @@ fn untrusted_devices_leave_the_manifest_failed_in_a_lot_and_in_its_merge() {
     let r = run_into(&cfg, &one, 2, None, false, None);
     let e = r.outcome.unwrap_err();
     assert!(e.to_string().contains("cannot be trusted"), "{e}");
-    assert!(one.join("devices.csv").is_file());
+    let RunError::Refused { files, .. } = &e else {
+        panic!("{e:?}")
+    };
+    assert!(files.contains(&one.join("devices.csv")) && files.contains(&one.join("manifest.json")));
     let m = json(&one.join("manifest.json"));
     assert_eq!(m["status"], "failed", "{m}");
     let next = m["next"].as_str().unwrap();

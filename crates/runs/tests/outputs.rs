@@ -102,8 +102,14 @@ fn refused_phases_leave_the_manifest_failed_with_the_files_written() {
     );
     let (r, computed, _) = run_into(&config(&text), out, false);
     let e = r.unwrap_err();
-    assert!(matches!(e, RunError::Report(_)), "{e}");
     assert!(e.to_string().contains("refused"), "{e}");
+    // The error lists what was written, for the command to show as a completed run does.
+    let RunError::Refused { files, .. } = &e else {
+        panic!("{e:?}")
+    };
+    for f in ["results.csv", "summary.json", "manifest.json"] {
+        assert!(files.contains(&out.join(f)), "{f}: {files:?}");
+    }
     assert_eq!(computed, 4);
     assert!(out.join("results.csv").is_file() && out.join("summary.json").is_file());
     let m = json(&out.join("manifest.json"));
@@ -137,6 +143,12 @@ fn refused_phases_leave_the_manifest_failed_with_the_files_written() {
     }
     let e = gyroemu_runs::merge(&split, &gyroemu_experiment::Quiet).unwrap_err();
     assert!(e.to_string().contains("refused"), "{e}");
+    let RunError::Refused { files, .. } = &e else {
+        panic!("{e:?}")
+    };
+    assert!(
+        files.contains(&split.join("results.csv")) && files.contains(&split.join("manifest.json"))
+    );
     assert!(split.join("results.csv").is_file());
     let m = json(&split.join("manifest.json"));
     assert_eq!(m["status"], "failed");

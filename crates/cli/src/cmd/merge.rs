@@ -1,6 +1,6 @@
 //! `gyroemu merge DIR`.
 
-use crate::input::{command_line, list_written};
+use crate::input::{command_line, list_written, listing_refused};
 use crate::progress::Terminal;
 use crate::signals;
 use anyhow::Result;
@@ -21,7 +21,7 @@ pub fn merge_command(dir: &Path) -> Result<()> {
     } else {
         None
     };
-    let files = gyroemu_runs::merge(dir, &Terminal)?;
+    let files = listing_refused(gyroemu_runs::merge(dir, &Terminal), dir, None)?;
     list_written(dir, &files);
     Ok(())
 }

@@ -3,7 +3,8 @@
 
 use crate::cmd::out_args::OutArgs;
 use crate::input::{
-    list_written_with, print_out, read_config, refused, BadInput, ItemFiles, SavedCount,
+    list_written_with, listing_refused, print_out, read_config, refused, BadInput, ItemFiles,
+    SavedCount,
 };
 use crate::progress::Terminal;
 use anyhow::Result;
@@ -75,12 +76,12 @@ pub fn montecarlo_command(a: &MonteCarloArgs) -> Result<()> {
         cancel,
         on_saved: Some(&on_saved),
     };
-    let outcome = run_lot(&req, n, &Terminal)?;
-    let devices = ItemFiles {
+    let devices = || ItemFiles {
         dir: DEVICES_DIR,
         item: "device",
         count: saved.get(),
     };
+    let outcome = listing_refused(run_lot(&req, n, &Terminal), &a.out.out, Some(devices()))?;
     let files = match outcome {
         LotOutcome::Complete { files, summary } => {
             print_out(&summary_text(&summary))?;
@@ -91,7 +92,7 @@ pub fn montecarlo_command(a: &MonteCarloArgs) -> Result<()> {
             files
         }
     };
-    list_written_with(&a.out.out, &files, Some(devices));
+    list_written_with(&a.out.out, &files, Some(devices()));
     Ok(())
 }
 

@@ -1,7 +1,7 @@
 //! `gyroemu run CONFIG --out DIR [--shard I/N] [--force]`.
 
 use crate::cmd::out_args::OutArgs;
-use crate::input::{list_written_with, load_config, ItemFiles, SavedCount};
+use crate::input::{list_written_with, listing_refused, load_config, ItemFiles, SavedCount};
 use crate::progress::Terminal;
 use anyhow::Result;
 use gyroemu_runs::points::POINTS_DIR;
@@ -26,12 +26,12 @@ pub fn run_command(config: &Path, a: &OutArgs) -> Result<()> {
         cancel,
         on_saved: Some(&on_saved),
     };
-    let outcome = run(&req, &Terminal)?;
-    let points = ItemFiles {
+    let points = || ItemFiles {
         dir: POINTS_DIR,
         item: "point",
         count: saved.get(),
     };
+    let outcome = listing_refused(run(&req, &Terminal), &a.out, Some(points()))?;
     let files = match outcome {
         RunOutcome::Complete(files) => files,
         RunOutcome::ShardComplete { next, files } => {
@@ -39,6 +39,6 @@ pub fn run_command(config: &Path, a: &OutArgs) -> Result<()> {
             files
         }
     };
-    list_written_with(&a.out, &files, Some(points));
+    list_written_with(&a.out, &files, Some(points()));
     Ok(())
 }
