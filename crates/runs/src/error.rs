@@ -30,7 +30,8 @@ pub enum RunError {
     /// non-zero and lists `files`, what it wrote.
     #[error("{error}")]
     Refused {
-        error: ReportError,
+        /// Boxed: the error type stays small on every other path.
+        error: Box<ReportError>,
         files: Vec<std::path::PathBuf>,
     },
     /// A failure (`cause`) after which the manifest could not be updated either: it still

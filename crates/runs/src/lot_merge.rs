@@ -71,7 +71,10 @@ pub(crate) fn merge_lot(
         .and_then(|(files, summary)| {
             match check_unreliable(&dir.display().to_string(), &summary, &devices) {
                 Ok(()) => Ok(files),
-                Err(error) => Err(RunError::Refused { error, files }),
+                Err(error) => Err(RunError::Refused {
+                    error: Box::new(error),
+                    files,
+                }),
             }
         });
     let (mut files, path) = split.finish(dir, n, written)?;

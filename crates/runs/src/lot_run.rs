@@ -211,6 +211,7 @@ pub fn run_lot(
     files.push(ledger.path().to_path_buf());
     // Untrusted devices fail the lot after its files are written: the manifest says so too.
     if let Err(error) = check_unreliable(&out.display().to_string(), &summary, &devices) {
+        let error = Box::new(error);
         return Err(ledger.fail(RunError::Refused { error, files }, &done));
     }
     ledger.complete(&done)?;

@@ -76,7 +76,10 @@ fn merge_run(dir: &Path, split: Split, reporter: &dyn Reporter) -> Result<Vec<Pa
         written.and_then(
             |files| match check_problems(&dir.display().to_string(), &r.problems) {
                 Ok(()) => Ok(files),
-                Err(error) => Err(RunError::Refused { error, files }),
+                Err(error) => Err(RunError::Refused {
+                    error: Box::new(error),
+                    files,
+                }),
             },
         );
     let (mut files, path) = split.finish(dir, n, checked)?;

@@ -273,6 +273,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     files.extend(swept.dump_files.iter().cloned());
     // Refused phases fail the run after its files are written: the manifest says so too.
     if let Err(error) = check_problems(&out.display().to_string(), &r.problems) {
+        let error = Box::new(error);
         return Err(ledger.fail(RunError::Refused { error, files }, &swept.lanes));
     }
     ledger.complete(&swept.lanes)?;
