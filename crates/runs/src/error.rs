@@ -60,6 +60,21 @@ impl From<SweepError> for RunError {
 }
 
 impl RunError {
+    /// `files` when `check` passed; else a [`RunError::Refused`] carrying them (the outputs
+    /// are written, the numbers `check` names are not to be trusted).
+    pub(crate) fn refused_unless(
+        check: Result<(), ReportError>,
+        files: Vec<std::path::PathBuf>,
+    ) -> Result<Vec<std::path::PathBuf>, Self> {
+        match check {
+            Ok(()) => Ok(files),
+            Err(error) => Err(RunError::Refused {
+                error: Box::new(error),
+                files,
+            }),
+        }
+    }
+
     /// A file-system failure while doing `context`.
     pub(crate) fn io(context: impl Into<String>) -> impl FnOnce(std::io::Error) -> Self {
         let context = context.into();

@@ -69,13 +69,8 @@ pub(crate) fn merge_lot(
     let written = write_lot(dir, &cfg, &devices)
         .map_err(RunError::from)
         .and_then(|(files, summary)| {
-            match check_unreliable(&dir.display().to_string(), &summary, &devices) {
-                Ok(()) => Ok(files),
-                Err(error) => Err(RunError::Refused {
-                    error: Box::new(error),
-                    files,
-                }),
-            }
+            let check = check_unreliable(&dir.display().to_string(), &summary, &devices);
+            RunError::refused_unless(check, files)
         });
     let (mut files, path) = split.finish(dir, n, written)?;
     files.push(path);

@@ -210,10 +210,8 @@ pub fn run_lot(
     warn_devices(&devices, reporter);
     files.push(ledger.path().to_path_buf());
     // Untrusted devices fail the lot after its files are written: the manifest says so too.
-    if let Err(error) = check_unreliable(&out.display().to_string(), &summary, &devices) {
-        let error = Box::new(error);
-        return Err(ledger.fail(RunError::Refused { error, files }, &done));
-    }
+    let check = check_unreliable(&out.display().to_string(), &summary, &devices);
+    let files = RunError::refused_unless(check, files).map_err(|e| ledger.fail(e, &done))?;
     ledger.complete(&done)?;
     Ok(LotOutcome::Complete { files, summary })
 }

@@ -72,16 +72,12 @@ fn merge_run(dir: &Path, split: Split, reporter: &dyn Reporter) -> Result<Vec<Pa
         reporter.warn(w);
     }
     // Refused phases fail the merge after its files are written: the manifest says so too.
-    let checked =
-        written.and_then(
-            |files| match check_problems(&dir.display().to_string(), &r.problems) {
-                Ok(()) => Ok(files),
-                Err(error) => Err(RunError::Refused {
-                    error: Box::new(error),
-                    files,
-                }),
-            },
-        );
+    let checked = written.and_then(|files| {
+        RunError::refused_unless(
+            check_problems(&dir.display().to_string(), &r.problems),
+            files,
+        )
+    });
     let (mut files, path) = split.finish(dir, n, checked)?;
     files.push(path);
     reporter.note(&format!("merged {} shards ({n} points)", split.count));

@@ -272,10 +272,8 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     files.push(ledger.path().to_path_buf());
     files.extend(swept.dump_files.iter().cloned());
     // Refused phases fail the run after its files are written: the manifest says so too.
-    if let Err(error) = check_problems(&out.display().to_string(), &r.problems) {
-        let error = Box::new(error);
-        return Err(ledger.fail(RunError::Refused { error, files }, &swept.lanes));
-    }
+    let check = check_problems(&out.display().to_string(), &r.problems);
+    let files = RunError::refused_unless(check, files).map_err(|e| ledger.fail(e, &swept.lanes))?;
     ledger.complete(&swept.lanes)?;
     Ok(RunOutcome::Complete(files))
 }

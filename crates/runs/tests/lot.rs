@@ -340,13 +340,7 @@ fn untrusted_devices_leave_the_manifest_failed_in_a_lot_and_in_its_merge() {
         panic!("{e:?}")
     };
     assert!(files.contains(&one.join("devices.csv")) && files.contains(&one.join("manifest.json")));
-    let m = json(&one.join("manifest.json"));
-    assert_eq!(m["status"], "failed", "{m}");
-    let next = m["next"].as_str().unwrap();
-    assert!(
-        next.contains("devices_unreliable") && next.contains("--force"),
-        "{next}"
-    );
+    assert_failed(&one, &["devices_unreliable", "--force"]);
 
     let split = dir.path().join("split");
     for s in ["0/2", "1/2"] {
@@ -359,13 +353,5 @@ fn untrusted_devices_leave_the_manifest_failed_in_a_lot_and_in_its_merge() {
     let e = merge(&split, &Quiet).unwrap_err();
     assert!(e.to_string().contains("cannot be trusted"), "{e}");
     assert!(split.join("devices.csv").is_file());
-    let m = json(&split.join("manifest.json"));
-    assert_eq!(m["status"], "failed", "{m}");
-    assert!(
-        m["next"]
-            .as_str()
-            .unwrap()
-            .contains("every shard with --force"),
-        "{m}"
-    );
+    assert_failed(&split, &["every shard with --force"]);
 }

@@ -27,6 +27,17 @@ pub fn json(p: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
+/// The manifest in `out` says `failed`, its `next` holding each of `next_has`; returns it.
+pub fn assert_failed(out: &Path, next_has: &[&str]) -> Value {
+    let m = json(&out.join("manifest.json"));
+    assert_eq!(m["status"], "failed", "{m}");
+    let next = m["next"].as_str().unwrap();
+    for s in next_has {
+        assert!(next.contains(s), "{s}: {next}");
+    }
+    m
+}
+
 /// The names of the files in `out/dir`, sorted (none when it does not exist).
 pub fn files_in(out: &Path, dir: &str) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(out.join(dir))
