@@ -37,6 +37,25 @@ pub struct NoisePhase {
 }
 
 impl Config {
+    /// The TIA's white input noise: its density (A/sqrt(Hz), the current noise and
+    /// e_n / tia_gain_ohm in power) and the band it reaches the ADC in (Hz: a one-pole TIA
+    /// passes pi/2 of its pole frequency of white noise, the sampling at most fs/2). `None`
+    /// without `[noise]`.
+    pub(crate) fn tia_white_noise(&self) -> Option<(f64, f64)> {
+        let n = self.noise.as_ref()?;
+        let b = &self.board;
+        let density = gyroemu_tia::input_referred_noise_a_per_rthz(
+            n.tia_current_noise_a_per_rthz,
+            n.tia_voltage_noise_v_per_rthz,
+            b.tia_gain_ohm,
+        );
+        let band = b
+            .tia_pole_hz
+            .map_or(f64::INFINITY, |fp| core::f64::consts::FRAC_PI_2 * fp)
+            .min(0.5 * self.fs_hz());
+        Some((density, band))
+    }
+
     /// Per mode, the one-sided density at the ADC input near the carrier (V^2/Hz) of the
     /// white sources: the TIA's input noise (current and e_n / tia_gain_ohm), the Brownian
     /// force through the mode's velocity response and transduction (uncoupled modes), both
@@ -49,17 +68,8 @@ impl Config {
         let chain = ChainResponse::new(&self.board_params()).ok()?;
         let fc = self.carrier_hz();
         let tia = chain.tia(fc).norm_sqr();
-        let i_n = gyroemu_tia::input_referred_noise_a_per_rthz(
-            n.tia_current_noise_a_per_rthz,
-            n.tia_voltage_noise_v_per_rthz,
-            b.tia_gain_ohm,
-        );
-        // The TIA noise's RMS at the ADC input: a one-pole TIA passes pi/2 of its pole
-        // frequency of white noise, the sampling at most fs/2.
-        let band = b
-            .tia_pole_hz
-            .map_or(f64::INFINITY, |fp| core::f64::consts::FRAC_PI_2 * fp)
-            .min(0.5 * self.fs_hz());
+        // The TIA noise's RMS at the ADC input, its gain taken at the carrier.
+        let (i_n, band) = self.tia_white_noise()?;
         let tia_rms2 = i_n * i_n * tia * band;
         let plant = self.resonator_params();
         let w = core::f64::consts::TAU * fc;

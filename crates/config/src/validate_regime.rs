@@ -505,19 +505,8 @@ impl Config {
     /// bias under the TIA's white noise (a lower bound on the noise there, so an upper bound
     /// on the bias) against the carrier's amplitude.
     fn adc_phase_bound_mdeg(&self, step: f64, amplitude: f64) -> f64 {
-        let b = &self.board;
-        let sigma = self.noise.as_ref().map_or(0.0, |n| {
-            let density = gyroemu_tia::input_referred_noise_a_per_rthz(
-                n.tia_current_noise_a_per_rthz,
-                n.tia_voltage_noise_v_per_rthz,
-                b.tia_gain_ohm,
-            );
-            // A one-pole TIA passes pi/2 of its pole frequency of white noise.
-            let band = b
-                .tia_pole_hz
-                .map_or(f64::INFINITY, |fp| core::f64::consts::FRAC_PI_2 * fp)
-                .min(0.5 * self.fs_hz());
-            b.tia_gain_ohm * density * band.sqrt()
+        let sigma = self.tia_white_noise().map_or(0.0, |(density, band)| {
+            self.board.tia_gain_ohm * density * band.sqrt()
         });
         let bias = gyroemu_theory::quantiser_bias_bound(step, sigma);
         gyroemu_theory::quantiser_phase_bound_rad(bias, amplitude).to_degrees() * 1e3
