@@ -129,6 +129,8 @@ impl Config {
             let span_s = self.plan_point(rate).span_samples() / fs_out;
             Some(phase_variance_rad2(density[k], enbw, span_s, a[k].0))
         };
+        // The zero-rate reference a Coriolis reading is taken against, once for every rate.
+        let reference = [0, 1].map(|k| variance(0.0, k).unwrap_or(f64::NAN));
         let dev = self.driven_device();
         let shape = self.shape();
         let points = self
@@ -146,7 +148,7 @@ impl Config {
                 let sigma_rad = [0, 1].map(|k| {
                     let own = variance(rate, k).unwrap_or(f64::NAN);
                     match shape {
-                        Shape::Coriolis => (own + variance(0.0, k).unwrap_or(f64::NAN)).sqrt(),
+                        Shape::Coriolis => (own + reference[k]).sqrt(),
                         _ => (2.0 * own).sqrt(),
                     }
                 });
