@@ -49,6 +49,10 @@ impl Work {
     /// lane group alone on one thread (a point's samples run in sequence, so more threads do
     /// not shorten it).
     pub fn summary(&self, point_samples_per_s: Option<f64>) -> String {
+        if self.points == 0 {
+            // A shard with no point: no longest point, no time to estimate.
+            return "no operating point to run".into();
+        }
         let time = point_samples_per_s.map_or(String::new(), |r| {
             let lanes = gyroemu_board::max_lanes();
             let even = self.point_samples as f64 / r;

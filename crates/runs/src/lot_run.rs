@@ -105,7 +105,9 @@ pub fn run_lot(
     let what = Shard::describe(req.shard.as_ref(), n, "device");
     let devices_dir = out.join(DEVICES_DIR);
     let reused = mine.len() - todo.len();
-    reporter.note(&if todo.is_empty() {
+    reporter.note(&if mine.is_empty() {
+        what
+    } else if todo.is_empty() {
         format!(
             "{what}: all already computed for this lot (sha256 {}) in `{}`: reusing them",
             &hash[..12],

@@ -182,7 +182,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     let reused = mine.len() - todo.len();
     let what = Shard::describe(req.shard.as_ref(), n, "point");
     let points_dir = out.join(POINTS_DIR);
-    reporter.note(&if reused == mine.len() {
+    reporter.note(&if reused > 0 && reused == mine.len() {
         format!(
             "{what}: all already computed for this config (sha256 {}) in `{}`: reusing them",
             &hash[..12],

@@ -55,13 +55,22 @@ impl Shard {
     /// `shard 0/4 (--shard 0/4): 3 of the 10 points`, or `10 points` without a shard.
     pub(crate) fn describe(shard: Option<&Shard>, n: usize, item: &str) -> String {
         match shard {
-            Some(s) => format!(
-                "shard {}/{} ({}): {} of the {n} {item}s",
-                s.index,
-                s.count,
-                s.source,
-                s.points(n).len()
-            ),
+            Some(s) => {
+                let mine = s.points(n).len();
+                // More shards than items leaves some shards none: say so, not "all computed".
+                let none = if mine == 0 {
+                    format!(
+                        ": none falls to this shard ({} shards of {n}), nothing to run",
+                        s.count
+                    )
+                } else {
+                    String::new()
+                };
+                format!(
+                    "shard {}/{} ({}): {mine} of the {n} {item}s{none}",
+                    s.index, s.count, s.source
+                )
+            }
             None => format!("{n} {item}s"),
         }
     }
@@ -167,8 +176,13 @@ pub fn resolve_shard(
         let step = env("SLURM_ARRAY_TASK_STEP")
             .map(|m| int("SLURM_ARRAY_TASK_STEP", &m))
             .transpose()?
-            .unwrap_or(1)
-            .max(1);
+            .unwrap_or(1);
+        if step == 0 {
+            // Slurm never sets 0; reading it as 1 would guess the array's grid.
+            return Err(RunError::BadInput(
+                "SLURM_ARRAY_TASK_STEP = 0: a job array's step is at least 1".into(),
+            ));
+        }
         // The array's own size, when Slurm says it, and how it said it.
         let size = match (env("SLURM_ARRAY_TASK_COUNT"), env("SLURM_ARRAY_TASK_MAX")) {
             (Some(c), _) => {
@@ -481,6 +495,17 @@ mod tests {
         ]);
         let s = resolve_shard(None, None, &slurm).unwrap().unwrap();
         assert_eq!((s.index, s.count), (2, 4));
+        // A step of 0 is no grid: refused, not read as 1.
+        let slurm = env_of(&[
+            ("SLURM_ARRAY_TASK_ID", "14"),
+            ("SLURM_ARRAY_TASK_MIN", "10"),
+            ("SLURM_ARRAY_TASK_MAX", "16"),
+            ("SLURM_ARRAY_TASK_STEP", "0"),
+        ]);
+        match resolve_shard(None, None, &slurm) {
+            Err(RunError::BadInput(m)) => assert!(m.contains("SLURM_ARRAY_TASK_STEP = 0"), "{m}"),
+            other => panic!("step 0 not refused: {other:?}"),
+        }
         let k8s = env_of(&[("JOB_COMPLETION_INDEX", "5")]);
         assert!(resolve_shard(None, None, &k8s).is_err());
         let s = resolve_shard(None, Some(8), &k8s).unwrap().unwrap();

@@ -193,6 +193,22 @@ fn a_lot_checks_its_split_against_the_folder_too() {
     };
     assert!(m.contains("2000 shards of 4 devices"), "{m}");
     assert!(tree(&out) == before, "a refused lot wrote into the folder");
+    // A shard with no device says so, not that its devices were computed.
+    let sparse = dir.path().join("sparse");
+    prepare_out(&sparse).unwrap();
+    let req = RunRequest {
+        config: &cfg,
+        out: &sparse,
+        shard: Some(parse_shard("5/8").unwrap()),
+        force: false,
+        cancel: Arc::new(AtomicBool::new(false)),
+        on_saved: None,
+    };
+    let rec = Record::default();
+    run_lot(&req, 4, &rec).unwrap();
+    let notes = rec.0.into_inner().unwrap().join("\n");
+    assert!(notes.contains("none falls to this shard"), "{notes}");
+    assert!(!notes.contains("already computed"), "{notes}");
 }
 
 #[test]
@@ -208,13 +224,16 @@ fn a_shard_count_far_past_the_points_is_refused_before_anything() {
     // A uniform array larger than the sweep: its empty shards merge.
     let sparse = dir.path().join("sparse");
     for i in 0..12 {
-        run_shard(
+        let (r, notes) = run_shard(
             &cfg,
             &sparse,
             Some(parse_shard(&format!("{i}/12")).unwrap()),
-        )
-        .0
-        .unwrap();
+        );
+        r.unwrap();
+        // Shards 10 and 11 hold no point: they say so, not that their points were computed.
+        let empty = notes.contains("none falls to this shard");
+        assert_eq!(empty, i >= 10, "shard {i}: {notes}");
+        assert!(!notes.contains("already computed"), "shard {i}: {notes}");
     }
     merge(&sparse, &Quiet).unwrap();
 }
