@@ -25,6 +25,9 @@ pub struct Dump {
     pub data: Vec<Vec<f64>>,
     /// The numeric `gyroemu:<key>` entries of the metadata (operating point), if any.
     pub extra: BTreeMap<String, f64>,
+    /// What the reader could not check (a SigMF recording without `core:sha512`), for the
+    /// user: each a sentence.
+    pub notes: Vec<String>,
 }
 
 impl Dump {
@@ -319,6 +322,7 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
             ),
         ));
     }
+    let mut notes = Vec::new();
     if let Some(want) = g.get("core:sha512").and_then(Value::as_str) {
         let got: String = Sha512::digest(&bytes)
             .iter()
@@ -330,6 +334,12 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
                 "its SHA-512 differs from core:sha512 in the metadata (changed or truncated)",
             ));
         }
+    } else {
+        // gyroemu always writes the hash: without it a changed or truncated file reads clean.
+        notes.push(format!(
+            "no core:sha512 in the metadata: `{}` was read unchecked",
+            data_path.display()
+        ));
     }
     let frames = bytes.len() / (8 * n_ch);
     if frames == 0 {
@@ -341,6 +351,15 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
             "captures[0].core:global_index = {global_index}: its {frames} frames would run \
              past sample index {}",
             u64::MAX
+        )));
+    }
+    // Every frame's time must be a number: a rate of 1e-308 Hz put them at infinity.
+    let time = |n: u64| t0_s + n as f64 / fs;
+    let last = global_index + (frames as u64 - 1);
+    if !(time(global_index).is_finite() && time(last).is_finite()) {
+        return Err(bad(format!(
+            "core:sample_rate = {fs:?} Hz with gyroemu:t0_s = {t0_s:?} s: the time of sample \
+             index {last}, t0_s + index / rate, is not a finite number of seconds"
         )));
     }
     let mut data = vec![Vec::with_capacity(frames); n_ch];
@@ -356,6 +375,7 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
         channels,
         data,
         extra,
+        notes,
     })
 }
 
@@ -548,5 +568,6 @@ pub fn read_csv_dump(path: &Path) -> Result<Dump, IoError> {
         channels,
         data,
         extra: BTreeMap::new(),
+        notes: Vec::new(),
     })
 }

@@ -395,6 +395,42 @@ fn sigmf_captures_gyroemu_does_not_write_are_refused() {
 }
 
 #[test]
+fn frame_times_past_f64_are_refused_and_an_unhashed_recording_is_said_unchecked() {
+    let dir = tempfile::tempdir().unwrap();
+    recorder().write(dir.path(), "x").unwrap();
+    let meta = dir.path().join("x.sigmf-meta");
+    assert!(
+        read_dump(&meta).unwrap().notes.is_empty(),
+        "a hashed recording is checked"
+    );
+    // Index 1299 at 1e-308 Hz is 1.3e311 s: `inspect` printed t = inf .. inf.
+    edit_meta(&meta, |m| m["global"]["core:sample_rate"] = 1e-308.into());
+    refused(&meta, "core:sample_rate = 1e-308 Hz");
+    // The last frame alone past f64 (1000 frames fit below 1.8e308 s, 1299 do not).
+    edit_meta(&meta, |m| {
+        m["global"]["core:sample_rate"] = (1.1e3 / f64::MAX).into()
+    });
+    refused(&meta, "the time of sample index 1299");
+    // A time origin far out plus the span sums to inf too.
+    edit_meta(&meta, |m| {
+        m["global"]["core:sample_rate"] = 1e-290.into();
+        m["global"]["gyroemu:t0_s"] = f64::MAX.into();
+    });
+    refused(&meta, "is not a finite number of seconds");
+    edit_meta(&meta, |m| {
+        m["global"]["core:sample_rate"] = 2_400.0.into();
+        m["global"]["gyroemu:t0_s"] = 0.0.into();
+    });
+    // Without the hash nothing is checked, and the reader says so.
+    edit_meta(&meta, |m| {
+        m["global"].as_object_mut().unwrap().remove("core:sha512");
+    });
+    let d = read_dump(&meta).unwrap();
+    assert_eq!(d.notes.len(), 1, "{:?}", d.notes);
+    assert!(d.notes[0].contains("no core:sha512") && d.notes[0].contains("x.sigmf-data"));
+}
+
+#[test]
 fn recordings_without_samples_are_refused() {
     // Once printed as rms -0 and peak 0 at read, as if a silent signal had been recorded.
     let dir = tempfile::tempdir().unwrap();

@@ -85,6 +85,9 @@ pub fn inspect_text(set: &DumpSet) -> String {
             d.time_s(0),
             d.time_s(n.saturating_sub(1)),
         ));
+        for note in &d.notes {
+            out.push_str(&format!("  note: {note}\n"));
+        }
         out.push_str(&format!(
             "  {:<10} {:<5} {:>11} {:>11}  strongest tones (Hz: level)\n",
             "channel", "unit", "rms", "peak"

@@ -19,6 +19,7 @@ fn dump(x: Vec<f64>) -> Dump {
         }],
         data: vec![x],
         extra: BTreeMap::new(),
+        notes: Vec::new(),
     }
 }
 
@@ -81,4 +82,23 @@ fn a_nan_sample_makes_the_peak_and_rms_nan_not_a_clean_number() {
     // An infinite sample is the peak.
     let s = &channel_stats(&dump(vec![1.0, f64::NEG_INFINITY, 2.0, 0.5]))[0];
     assert_eq!(s.peak, f64::INFINITY);
+}
+
+#[test]
+fn what_the_reader_could_not_check_is_printed_with_the_recording() {
+    let mut d = dump(vec![1.0, -1.0, 1.0, -1.0]);
+    let set = |d: Dump| gyroemu_report::DumpSet {
+        name: "x".into(),
+        dir: ".".into(),
+        full: Some(d),
+        decimated: None,
+    };
+    let text = gyroemu_report::inspect_text(&set(d.clone()));
+    assert!(!text.contains("note:"), "{text}");
+    d.notes.push("no core:sha512 in the metadata".into());
+    let text = gyroemu_report::inspect_text(&set(d));
+    assert!(
+        text.contains("  note: no core:sha512 in the metadata\n"),
+        "{text}"
+    );
 }
