@@ -62,6 +62,23 @@ impl Config {
         self.drive.carrier_hz.unwrap_or(self.device.f0_hz)
     }
 
+    /// With a `[pll]`, the config its sweep is expected to run: the carrier on the locked
+    /// mode's resonance (where the loop steers it) and the `[pll]` spent; `None` without one.
+    /// The rules that weigh the signal at the ADC (its size, the noise against it) judge this
+    /// config: the nominal carrier is only where the lock starts, and can sit far down the
+    /// resonance's skirt.
+    pub fn expected_lock(&self) -> Option<Config> {
+        let p = self.pll.as_ref()?;
+        let mut held = self.clone();
+        held.drive.carrier_hz = Some(if p.mode == 2 {
+            self.f0_mode2_hz()
+        } else {
+            self.device.f0_hz
+        });
+        held.pll = None;
+        Some(held)
+    }
+
     /// Mode-2 drive amplitude F2 (set, or F1).
     pub fn f2(&self) -> f64 {
         self.drive.f2.unwrap_or(self.drive.f1)

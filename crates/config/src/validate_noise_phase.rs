@@ -63,6 +63,9 @@ impl Config {
     /// noise dithers it (its RMS at the ADC input at least an LSB; an undithered ADC's error
     /// is systematic, and the ADC-LSB rule states it). `None` without `[noise]`.
     pub(crate) fn carrier_noise_density(&self) -> Option<[f64; 2]> {
+        if let Some(held) = self.expected_lock() {
+            return held.carrier_noise_density();
+        }
         let n = self.noise.as_ref()?;
         let b = &self.board;
         let chain = ChainResponse::new(&self.board_params()).ok()?;
@@ -111,6 +114,10 @@ impl Config {
     /// shorter than a few of those sees less of it than stated (the warning errs towards
     /// warning). Flicker is left out.
     pub fn noise_phase(&self) -> Option<Vec<NoisePhase>> {
+        // With a [pll], the reading's noise and phase at the carrier the lock holds.
+        if let Some(held) = self.expected_lock() {
+            return held.noise_phase();
+        }
         let density = self.carrier_noise_density()?;
         // By rate: a sweep may list 1e5 rates, too many to search each time.
         let per_rate: std::collections::HashMap<u64, [LoHi; 2]> = self

@@ -226,6 +226,9 @@ impl Config {
     /// [`Config::tia_output_span`]'s amplitudes at each emulated rate (deg/s): per mode the
     /// smallest and the largest over the point's run.
     pub(crate) fn tia_output_per_rate(&self) -> Option<Vec<(f64, [LoHi; 2])>> {
+        if let Some(held) = self.expected_lock() {
+            return held.tia_output_per_rate();
+        }
         let chain = ChainResponse::new(&self.board_params()).ok()?;
         let plant = self.resonator_params();
         let dev = self.driven_device();
