@@ -21,6 +21,7 @@ mod validate_noise_phase;
 mod validate_regime;
 mod validate_settling;
 mod validate_sweep;
+mod validate_sweep_dac;
 
 pub use config::{
     BoardConfig, Config, DeviceConfig, Distribution, DriveConfig, DumpConfig, ExperimentConfig,
@@ -38,3 +39,4 @@ pub use validate::MAX_RUN_SAMPLES;
 pub use validate_noise_phase::{phase_variance_rad2, NoisePhase, WARN_NOISE_PHASE_FRACTION};
 pub use validate_regime::{MAX_HOLD_ERROR_MDEG, NODE_RANGE, WARN_HOLD_ERROR_MDEG};
 pub use validate_sweep::{MAX_SWEEP_POINTS, MIN_POINTS_NEAR_RESONANCE, MIN_SWEEP_POINTS};
+pub use validate_sweep_dac::WARN_SWEEP_DAC_REL;

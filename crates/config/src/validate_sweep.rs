@@ -200,6 +200,9 @@ impl Config {
         ];
         if rates_ok && p.clean(&swept) && p.section_clean("board") {
             self.validate_sweep_mixer_products(warnings);
+            if p.section_clean("drive") {
+                self.validate_sweep_dac(warnings);
+            }
         }
     }
 }
