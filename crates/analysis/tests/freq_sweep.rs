@@ -408,9 +408,9 @@ fn a_fit_the_coupling_pulls_off_the_devices_modes_says_so() {
     let c = config(40.0, 2000.0, 2.0 * w0 * 2.0 * PI * 5.0, 41, "");
     let r = coupled(&c);
     let eig = stiffness_modes_hz(&c);
-    for k in 0..2 {
-        let off = (r.modes[k].fit.unwrap().f0_hz - eig[k]).abs() / 3.75;
-        assert!(off < 1e-2, "mode {k}: {off} half-bandwidths");
+    for (m, e) in r.modes.iter().zip(eig) {
+        let off = (m.fit.unwrap().f0_hz - e).abs() / 3.75;
+        assert!(off < 1e-2, "mode {}: {off} half-bandwidths", m.mode);
     }
     assert_eq!(said(&r), 0, "{:?}", r.measured.warnings);
 }
