@@ -113,16 +113,20 @@ impl Probe {
         let fs_out = fs_hz / decimation as f64;
         let start = (start_s * fs_hz).round() as u64;
         let len = (duration_s * fs_hz).round().max(1.0) as u64;
-        let start_out = (start_s * fs_out).round() as u64;
+        // Decimated sample k is formed at input sample kM + M - 1, at (M - 1) / fs after
+        // k / fs_out: the output nearest the window's start is counted from that origin (from
+        // t = 0 it came an output late, and a window of under an output period at the run's
+        // end recorded nothing).
+        let origin_s = (decimation - 1) as f64 / fs_hz;
+        let start_out = ((start_s - origin_s) * fs_out).round().max(0.0) as u64;
         let len_out = (duration_s * fs_out).round().max(1.0) as u64;
         Self {
             lane,
             nodes: on,
             full: SignalRecorder::new(full_names, fs_hz, start, len).with_units(&full_units),
-            // Decimated sample k is formed at input sample kM + M - 1.
             decimated: SignalRecorder::new(dec_names, fs_out, start_out, len_out)
                 .with_units(&dec_units)
-                .with_time_origin((decimation - 1) as f64 / fs_hz),
+                .with_time_origin(origin_s),
             check_lanes: 0,
             fault: None,
         }
@@ -346,6 +350,21 @@ impl Probe {
         ["fullrate", "decimated"]
             .iter()
             .flat_map(|r| SignalRecorder::file_names(&format!("{stem}_{r}")))
+            .collect()
+    }
+
+    /// Why a recording of this probe gets no WAV though its rate fits one (a sample outside
+    /// float32's normal range: [`SignalRecorder::wav_range_problem`]), one sentence each.
+    pub fn wav_notes(&self) -> Vec<String> {
+        [("full-rate", &self.full), ("decimated", &self.decimated)]
+            .into_iter()
+            .filter(|(_, r)| !r.names().is_empty())
+            .filter_map(|(what, r)| {
+                let why = r.wav_range_problem()?;
+                Some(format!(
+                    "the {what} dump has no .wav: {why}; its CSV and SigMF keep the f64 samples"
+                ))
+            })
             .collect()
     }
 

@@ -127,3 +127,47 @@ fn a_finite_check_is_never_handed_on() {
     assert_eq!(calls.load(Ordering::SeqCst), 0);
     assert!(check.fault().is_none());
 }
+
+/// Decimated output k is formed at input sample kM + M - 1, so at (kM + M - 1) / fs: a window
+/// records from the output nearest its start (it took one an output later, 0.9 s late at fs
+/// = 300 Hz, M = 200), and a window shorter than an output period at the run's end holds
+/// the output formed there (it wrote an empty recording).
+#[test]
+fn the_decimated_window_starts_at_the_output_nearest_its_start() {
+    let n_settle = 12;
+    let points = [point(100.0, 30)];
+    let p = m2tfg(Shape::Rotating);
+    let (fs, m) = (p.fs_hz(), p.decimation);
+    let fs_out = fs / m as f64;
+    let formed = |k: u64| (k * m as u64 + m as u64 - 1) as f64 / fs;
+    // The run's outputs are 0 ..= 42; the last is formed at 4299 / fs = 17.9125 ms.
+    let last = formed((n_settle + 30) as u64);
+    for start in [0.0003, 0.0101, 0.0125, 0.01538, last - 4e-5, last - 1e-6] {
+        let mut probe = Probe::new(&["lowpass".to_string()], fs, m, start, 1.0 / fs, 1);
+        run(
+            &p,
+            &[points[0].rate_rad_s],
+            n_settle,
+            &points,
+            RunOptions {
+                probe: Some(&mut probe),
+                ..Default::default()
+            },
+            &|_| {},
+        );
+        let dir = tempfile::tempdir().unwrap();
+        probe.write(dir.path(), "dump").unwrap();
+        let d = gyroemu_io::read_dump(&dir.path().join("dump_decimated.sigmf-meta"))
+            .unwrap_or_else(|e| panic!("start {start}: {e}"));
+        assert_eq!(d.frames(), 1, "start {start}");
+        let t = d.time_s(0);
+        assert!(
+            (t - formed(d.global_index)).abs() < 1e-15,
+            "start {start}: {t}"
+        );
+        assert!(
+            (t - start).abs() <= 0.5 / fs_out + 1e-12,
+            "start {start}: the first output is formed at {t}"
+        );
+    }
+}

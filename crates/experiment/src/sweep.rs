@@ -117,6 +117,8 @@ pub struct SweepRun {
     pub dump_bytes: u64,
     /// The files `on_dump_early` made from them.
     pub dump_made: Vec<PathBuf>,
+    /// What the dump could not write (a WAV copy that would lose samples), for the user.
+    pub dump_notes: Vec<String>,
     /// Wall time spent writing them, s (after the emulation, not part of its time, unless
     /// written early).
     pub dump_write_s: f64,
@@ -129,6 +131,7 @@ impl SweepRun {
         self.dump_write_s += w.seconds;
         self.dump_files.extend(w.files);
         self.dump_made.extend(w.made);
+        self.dump_notes.extend(w.notes);
     }
 
     /// The dump written, for a progress line.
@@ -177,6 +180,7 @@ pub fn add_group_progress(
 pub(crate) struct DumpWritten {
     files: Vec<PathBuf>,
     made: Vec<PathBuf>,
+    notes: Vec<String>,
     bytes: u64,
     seconds: f64,
 }
@@ -204,6 +208,7 @@ pub(crate) fn write_dump(
     Ok(DumpWritten {
         files,
         made,
+        notes: p.wav_notes(),
         bytes,
         seconds,
     })

@@ -28,5 +28,5 @@ pub use sigmf::{
 };
 pub use wav::{
     check_wav_f32_size, wav_f32_rate_problem, write_wav_f32, WAV_F32_HEADER_BYTES,
-    WAV_F32_MAX_DATA_BYTES,
+    WAV_F32_MAX_DATA_BYTES, WAV_RATE_REL_TOL,
 };

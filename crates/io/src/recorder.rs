@@ -171,8 +171,9 @@ impl SignalRecorder {
     /// Writes, each atomically:
     /// - `<dir>/<stem>.csv` (columns `sample`, `time_s`, then one per name; exact float text);
     /// - `<dir>/<stem>.wav` (one 32-bit float channel per name at round(fs_hz) Hz), when a WAV
-    ///   header can hold the rate ([`wav_f32_rate_problem`]; an output rate below 0.5 Hz, or
-    ///   a byte rate past 2^32, has only the CSV and SigMF). WAV values are the raw signals,
+    ///   header can hold the rate ([`wav_f32_rate_problem`]; an output rate below 0.5 Hz or
+    ///   not within 1e-4 of a whole Hz, or a byte rate past 2^32, has only the CSV and SigMF)
+    ///   and float32 every sample ([`wav_range_problem`](Self::wav_range_problem)). WAV values are the raw signals,
     ///   not normalised, so they may exceed +-1: read them with `soundfile.read(path)` or
     ///   `scipy.io.wavfile.read(path)`, not an audio player;
     /// - `<dir>/<stem>.sigmf-data` + `<dir>/<stem>.sigmf-meta` (SigMF 1.2.0, `rf64_le`, full
@@ -189,7 +190,9 @@ impl SignalRecorder {
         let ch = self.names.len();
         let frames = self.len();
         // No channels at all is refused by the size check (nothing to write).
-        let wav = ch == 0 || wav_f32_rate_problem(self.fs_hz, ch as u64).is_none();
+        let wav = ch == 0
+            || (wav_f32_rate_problem(self.fs_hz, ch as u64).is_none()
+                && self.wav_range_problem().is_none());
         if wav {
             check_wav_f32_size(
                 &wav_path,
@@ -211,6 +214,25 @@ impl SignalRecorder {
         let sigmf = write_sigmf_frames(dir, stem, &meta, ch, frames, |i, k| self.data[i * ch + k])?;
         files.extend([sigmf.data_path, sigmf.meta_path]);
         Ok(files)
+    }
+
+    /// Why the float32 WAV copy would lose a sample, if it would: a finite value beyond
+    /// float32's range (it would read inf) or a nonzero one below its normal range (0 or a
+    /// subnormal of few digits). [`write`](Self::write) then writes no WAV; the CSV and SigMF
+    /// keep f64.
+    pub fn wav_range_problem(&self) -> Option<String> {
+        let ch = self.names.len().max(1);
+        let (i, &x) = self.data.iter().enumerate().find(|&(_, &x)| {
+            let y = x as f32;
+            x.is_finite() && (y.is_infinite() || (x != 0.0 && y.abs() < f32::MIN_POSITIVE))
+        })?;
+        Some(format!(
+            "`{}` holds {x:e}, outside float32's normal range ({:e} .. {:e}): its WAV copy would read {}",
+            self.names.get(i % ch).map_or("", String::as_str),
+            f32::MIN_POSITIVE,
+            f32::MAX,
+            (x as f32)
+        ))
     }
 
     /// Writes only the CSV (columns `sample`, `time_s`, then one per name), atomically. The

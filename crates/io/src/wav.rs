@@ -11,14 +11,26 @@ pub const WAV_F32_HEADER_BYTES: u64 = 68;
 /// Largest sample payload a RIFF file can describe: its 32-bit size field counts the file minus 8 bytes.
 pub const WAV_F32_MAX_DATA_BYTES: u64 = u32::MAX as u64 - (WAV_F32_HEADER_BYTES - 8);
 
+/// The largest relative error of a WAV's whole-Hz rate against the recording's (0.5 Hz at
+/// 5 kHz); a rate further off gets no WAV.
+pub const WAV_RATE_REL_TOL: f64 = 1e-4;
+
 /// Why a float WAV of `channels` channels cannot describe a rate of `fs_hz` (a WAV rate is a
-/// whole number of Hz in 1..=2^32-1, and its byte-rate field, rate x channels x 4, is 32-bit
-/// too), or `None` when it can. The CSV and SigMF beside it carry any rate.
+/// whole number of Hz in 1..=2^32-1, within [`WAV_RATE_REL_TOL`] of the rate, and its
+/// byte-rate field, rate x channels x 4, is 32-bit too), or `None` when it can. The CSV and SigMF beside it carry any rate.
 pub fn wav_f32_rate_problem(fs_hz: f64, channels: u64) -> Option<String> {
     let rate = fs_hz.round();
     if !(rate >= 1.0 && rate <= f64::from(u32::MAX)) {
         return Some(format!(
             "fs_hz = {fs_hz} does not round to a WAV sample rate in 1..=2^32-1 Hz"
+        ));
+    }
+    // A whole-Hz rate far from the true one scales every frequency and time read from the
+    // file (1.5 Hz was written as 2 Hz, 33 % off); at or above 5 kHz the rounding is within it.
+    let off = (rate - fs_hz).abs() / fs_hz;
+    if off > WAV_RATE_REL_TOL {
+        return Some(format!(
+            "fs_hz = {fs_hz} rounds to the WAV sample rate {rate} Hz, {off:.1e} off (more than {WAV_RATE_REL_TOL:e}): a whole-Hz rate cannot describe it"
         ));
     }
     if rate * channels as f64 * 4.0 > f64::from(u32::MAX) {

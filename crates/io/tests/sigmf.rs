@@ -232,9 +232,11 @@ fn recorder_writes_sigmf_beside_csv_and_wav() {
         }
     }
     r.write(dir.path(), "dump").unwrap();
+    // Values float32 cannot hold (f64::MAX, subnormals) leave out the WAV copy only.
+    assert!(r.wav_range_problem().is_some());
     assert_eq!(
         entries(dir.path()),
-        ["dump.csv", "dump.sigmf-data", "dump.sigmf-meta", "dump.wav"]
+        ["dump.csv", "dump.sigmf-data", "dump.sigmf-meta"]
     );
     let words = read_f64_le(&dir.path().join("dump.sigmf-data"));
     assert_eq!(words.len(), 3 * 50);
@@ -307,8 +309,9 @@ fn recorder_with_no_channels_fails_before_writing() {
 #[test]
 fn a_rate_no_wav_can_hold_writes_the_csv_and_sigmf_only() {
     use gyroemu_io::wav_f32_rate_problem;
-    // 0.4 Hz rounds to 0; 1e8 Hz x 12 channels x 4 bytes is 4.8e9 > 2^32 - 1.
-    for (fs_hz, ch) in [(0.4, 2usize), (1e8, 12)] {
+    // 0.4 Hz rounds to 0; 1.5 Hz to 2 (a third off: every frequency read from the file
+    // would be); 1e8 Hz x 12 channels x 4 bytes is 4.8e9 > 2^32 - 1.
+    for (fs_hz, ch) in [(0.4, 2usize), (1.5, 1), (1e8, 12)] {
         let why = wav_f32_rate_problem(fs_hz, ch as u64).expect("no WAV rate");
         assert!(why.contains("WAV"), "{why}");
         let dir = tempfile::tempdir().unwrap();
@@ -329,8 +332,42 @@ fn a_rate_no_wav_can_hold_writes_the_csv_and_sigmf_only() {
                 .unwrap();
         assert_eq!(meta["global"]["core:sample_rate"].as_f64(), Some(fs_hz));
     }
-    // The edges: 0.5 Hz rounds to 1 Hz; 4 channels of 4 bytes fit up to (2^32 - 1)/16 Hz.
-    assert_eq!(wav_f32_rate_problem(0.5, 1), None);
+    // The edges: a whole-Hz rate within 1e-4 (0.5 Hz at 5 kHz), so 5000.5 Hz but not 4999.5;
+    // 240 kHz / 76 (3.3e-5 off); 4 channels of 4 bytes fit up to (2^32 - 1)/16 Hz.
+    assert_eq!(wav_f32_rate_problem(5000.5, 1), None);
+    assert!(wav_f32_rate_problem(4999.5, 1).is_some());
+    assert_eq!(wav_f32_rate_problem(240_000.0 / 76.0, 4), None);
     assert_eq!(wav_f32_rate_problem(268_435_455.0, 4), None);
     assert!(wav_f32_rate_problem(268_435_456.0, 4).is_some());
+}
+
+/// float32 holds 1.2e-38 .. 3.4e38 at full precision: a sample outside it would read inf, 0
+/// or a subnormal of few digits in the WAV copy (a drive of 1e-60 was a silent WAV of zeros,
+/// one of 1e45 a WAV of inf), so that recording gets no WAV and says why; 0 and ordinary
+/// values keep it.
+#[test]
+fn a_sample_float32_cannot_hold_writes_no_wav_and_says_why() {
+    let write = |x: f64| {
+        let dir = tempfile::tempdir().unwrap();
+        let mut r = SignalRecorder::new(vec!["a_v".into(), "b_v".into()], 1000.0, 0, 4);
+        for n in 0..4u64 {
+            r.record(n, &[0.0, if n == 2 { x } else { 1.0 }]);
+        }
+        r.write(dir.path(), "d").unwrap();
+        (r.wav_range_problem(), entries(dir.path()))
+    };
+    for x in [1e-60, -1e45, 1e-39, f64::MAX] {
+        let (why, files) = write(x);
+        let why = why.unwrap_or_else(|| panic!("{x:e} passed"));
+        assert!(
+            why.contains("`b_v`") && why.contains(&format!("{x:e}")),
+            "{why}"
+        );
+        assert_eq!(files, ["d.csv", "d.sigmf-data", "d.sigmf-meta"], "{x:e}");
+    }
+    for x in [0.0, -0.0, 1e-30, 3e38, f64::NAN, f64::INFINITY] {
+        let (why, files) = write(x);
+        assert_eq!(why, None, "{x:e}");
+        assert_eq!(files.len(), 4, "{x:e}: {files:?}");
+    }
 }

@@ -252,6 +252,9 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         }
     };
     task.finish_writing(Some(swept.point_samples), swept.written());
+    for note in &swept.dump_notes {
+        reporter.warn(note);
+    }
     let missing = mine.iter().any(|i| !swept.lanes.contains_key(i));
     if swept.cancelled || missing {
         return Err(ledger.interrupted(&swept.lanes, "point", &points_dir));

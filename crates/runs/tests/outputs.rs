@@ -222,3 +222,31 @@ fn another_config_is_refused_naming_the_keys_and_force_deletes_its_dumps() {
         "--force left the dumps of the other config"
     );
 }
+
+/// A drive of 1e-40 puts the TIA output near 1e-46 V, below float32's range: the dump's WAV
+/// copy would be zeros, so it is not written and the run says why; CSV and SigMF are.
+#[test]
+fn a_dump_float32_cannot_hold_has_no_wav_and_the_run_says_why() {
+    let cfg = config(&format!(
+        "{}{DUMP}",
+        CONFIG.replace("f1 = 1.0", "f1 = 1e-40")
+    ));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tiny");
+    let (r, _, notes) = run_into(&cfg, &out, false);
+    r.unwrap();
+    let files: Vec<String> = dump_files(&out)
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        files.contains(&"dump_fullrate.sigmf-data".to_string())
+            && !files.iter().any(|f| f.ends_with(".wav")),
+        "{files:?}"
+    );
+    assert!(
+        notes.contains("warning: the full-rate dump has no .wav")
+            && notes.contains("warning: the decimated dump has no .wav"),
+        "{notes}"
+    );
+}
