@@ -141,7 +141,7 @@ fn the_decimated_window_starts_at_the_output_nearest_its_start() {
     let fs_out = fs / m as f64;
     let formed = |k: u64| (k * m as u64 + m as u64 - 1) as f64 / fs;
     // The run's outputs are 0 ..= 42; the last is formed at 4299 / fs = 17.9125 ms.
-    let last = formed((n_settle + 30) as u64);
+    let last = formed(n_settle + 30);
     for start in [0.0003, 0.0101, 0.0125, 0.01538, last - 4e-5, last - 1e-6] {
         let mut probe = Probe::new(&["lowpass".to_string()], fs, m, start, 1.0 / fs, 1);
         run(
