@@ -3,7 +3,7 @@
 
 use crate::dump_figures::{db_unit, SPECTRUM_RANGE_DB};
 use crate::dump_set::{channel_unit, DumpSet};
-use gyroemu_spectrum::{find_tones, power_of_two_scale, welch, Tone};
+use gyroemu_spectrum::{find_tones, power_of_two_scale, unresolved, welch, Tone};
 
 /// Tones listed per channel.
 pub const TONES_LISTED: usize = 4;
@@ -24,6 +24,8 @@ pub struct ChannelStats {
     /// The strongest tones, strongest first, within [`SPECTRUM_RANGE_DB`] of the first (empty
     /// when the spectrum cannot be computed).
     pub tones: Vec<Tone>,
+    /// For each of `tones`, why it is not read (near DC or fs/2: [`unresolved`]), if so.
+    pub unresolved: Vec<Option<String>>,
     /// Why there are no tones, when the spectrum was refused (e.g. non-finite samples).
     pub spectrum_error: Option<String>,
 }
@@ -41,20 +43,25 @@ pub fn channel_stats(d: &gyroemu_io::Dump) -> Vec<ChannelStats> {
                 x.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
             };
             let rms = rms(x, peak);
-            let (mut tones, spectrum_error) = match welch(x, d.sample_rate_hz, None) {
-                Ok(p) => (find_tones(&p, TONES_LISTED, TONE_MIN_SNR_DB), None),
-                Err(e) => (Vec::new(), Some(e.to_string())),
+            let (mut tones, spectrum_error, psd) = match welch(x, d.sample_rate_hz, None) {
+                Ok(p) => (find_tones(&p, TONES_LISTED, TONE_MIN_SNR_DB), None, Some(p)),
+                Err(e) => (Vec::new(), Some(e.to_string()), None),
             };
             // Below that range lies f64 arithmetic's own floor, not the signal.
             if let Some(top) = tones.first().map(Tone::level_db) {
                 tones.retain(|t| t.level_db() >= top - SPECTRUM_RANGE_DB);
             }
+            let unresolved = tones
+                .iter()
+                .map(|t| psd.as_ref().and_then(|p| unresolved(p, t)))
+                .collect();
             ChannelStats {
                 name: c.name.clone(),
                 unit: channel_unit(&c.name, &c.unit).to_string(),
                 rms,
                 peak,
                 tones,
+                unresolved,
                 spectrum_error,
             }
         })
@@ -101,7 +108,14 @@ pub fn inspect_text(set: &DumpSet) -> String {
                 (None, false) => s
                     .tones
                     .iter()
-                    .map(|t| format!("{:.1}: {:.1} {}", t.freq_hz, t.level_db(), db_unit(&s.unit)))
+                    .zip(&s.unresolved)
+                    .map(|(t, why)| match why {
+                        // The bin's frequency, with no level: neither is the tone's.
+                        Some(why) => format!("near {:.1}: unresolved ({why})", t.freq_hz),
+                        None => {
+                            format!("{:.1}: {:.1} {}", t.freq_hz, t.level_db(), db_unit(&s.unit))
+                        }
+                    })
                     .collect::<Vec<_>>()
                     .join(", "),
             };

@@ -75,6 +75,40 @@ fn refine(psd: &Psd, k: usize) -> Tone {
     }
 }
 
+/// Bins from DC and from fs/2 within which a tone's mirror image (a real signal's -f, or
+/// fs - f) falls in the Hann window's main lobe beside it: [`refine`] reads neither its level
+/// nor its frequency there.
+pub const EDGE_BINS: usize = 3;
+
+/// Bin 1 over bin 0 of a constant through the Hann window is exactly 1/4, doubled in the
+/// one-sided spectrum (bin 1 holds both signs). A tone within 0.1 bin of DC (up to 2 x
+/// 0.2594) is, over a segment, a slowly moving level, and is read as one; 0.4 bin gives
+/// 2 x 0.414.
+const DC_LEAK_MAX: f64 = 0.52;
+
+/// Why `t` (a peak of `psd`) is not one tone read exactly, if it is not: a peak within
+/// [`EDGE_BINS`] of DC that is not a DC level (its bin 1 more than a constant's leakage), or
+/// within [`EDGE_BINS`] of fs/2 (a tone at fs/2 shows only A cos(phase)). There the tone and
+/// its mirror image share bins: a 10 Hz tone in 24.7 Hz bins read as a DC of -4.1 dB for
+/// -3.0, and one 0.43 bin below fs/2 was read 50 Hz and 1.4 dB off.
+pub fn unresolved(psd: &Psd, t: &Tone) -> Option<String> {
+    let p = &psd.power;
+    let (k, last, bin) = (t.bin, p.len() - 1, psd.bin_hz());
+    let dc = k == 0 && p.len() > 1 && p[1] <= DC_LEAK_MAX * p[0];
+    if k < EDGE_BINS && !dc {
+        Some(format!(
+            "a tone within {EDGE_BINS} bins of DC ({bin} Hz bins) overlaps its mirror image: its frequency and level are not read; record a longer window"
+        ))
+    } else if k + EDGE_BINS > last {
+        Some(format!(
+            "a tone within {EDGE_BINS} bins of fs/2 ({} Hz, {bin} Hz bins) overlaps its mirror image: its frequency and level are not read",
+            psd.fs_hz / 2.0
+        ))
+    } else {
+        None
+    }
+}
+
 /// Bins on each side of a peak whose median is the noise floor it must clear.
 const FLOOR_HALF_WIDTH: usize = 32;
 
