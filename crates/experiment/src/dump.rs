@@ -56,6 +56,8 @@ impl DumpPlan {
 pub fn dump_extra(cfg: &Config, rate_dps: f64) -> BTreeMap<String, f64> {
     let mut m = BTreeMap::from([
         ("f0_hz".to_string(), cfg.device.f0_hz),
+        // The drive's carrier (a PLL's locked one): where the driven tones sit.
+        ("carrier_hz".to_string(), cfg.carrier_hz()),
         ("f0_mode2_hz".to_string(), cfg.f0_mode2_hz()),
         ("rate_dps".to_string(), rate_dps),
         ("lpf_cutoff_hz".to_string(), cfg.lpf_cutoff_hz()),

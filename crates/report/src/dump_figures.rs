@@ -1,7 +1,7 @@
 //! The two figures of a signal dump, from the files alone (so `gyroemu inspect` and
 //! `reproduce` draw the same): `signals.png`, every node against time, and `spectrum.png`,
 //! Welch spectra of the full-rate nodes and of the low-pass output, with the carrier, the
-//! rotating excitation's sidebands, the 2 f0 mixer product and the low-pass residual marked
+//! rotating excitation's sidebands, the 2 fc mixer product and the low-pass residual marked
 //! and their levels read by the tone finder.
 
 use crate::dump_set::{groups, DumpSet, Group};
@@ -93,9 +93,8 @@ pub fn signal_panels(set: &DumpSet) -> (String, Vec<Figure>) {
         let shown = if decimated {
             n
         } else {
-            let per = set
-                .extra("f0_hz")
-                .map(|f0| (SHOWN_CARRIER_PERIODS * d.sample_rate_hz / f0).ceil() as usize);
+            let per = carrier_hz(set)
+                .map(|fc| (SHOWN_CARRIER_PERIODS * d.sample_rate_hz / fc).ceil() as usize);
             n.min(per.unwrap_or(SHOWN_SAMPLES_UNKNOWN_F0)).max(2.min(n))
         };
         let x_label = if shown < n {
@@ -139,31 +138,42 @@ struct Mark {
     freq_hz: f64,
 }
 
-/// The markers of a full-rate panel: the carrier(s), the rotating excitation's sidebands when
-/// the spectrum resolves them, 2 f0 on the mixer's output (and DC there).
+/// The drive's carrier, where the driven tones sit: `gyroemu:carrier_hz` (a detuned or
+/// PLL-locked carrier differs from f0), else, in a dump written before it was recorded,
+/// `gyroemu:f0_hz`.
+fn carrier_hz(set: &DumpSet) -> Option<f64> {
+    set.extra("carrier_hz").or_else(|| set.extra("f0_hz"))
+}
+
+/// The markers of a full-rate panel: the carrier fc, mode 2's resonance when the bins tell it
+/// from fc, the rotating excitation's sidebands when the spectrum resolves them, 2 fc on the
+/// mixer's output (and DC there).
 fn full_rate_marks(set: &DumpSet, psd: &Psd, stage1: bool) -> (Vec<Mark>, Option<String>) {
     let mut marks = Vec::new();
     let mut note = None;
-    let Some(f0) = set.extra("f0_hz") else {
-        return (marks, Some("carrier unknown (no gyroemu:f0_hz)".into()));
+    let Some(fc) = carrier_hz(set) else {
+        return (
+            marks,
+            Some("carrier unknown (no gyroemu:carrier_hz)".into()),
+        );
     };
-    let f0b = set.extra("f0_mode2_hz").unwrap_or(f0);
+    let f0b = set.extra("f0_mode2_hz").unwrap_or(fc);
     if stage1 {
         marks.push(Mark {
             what: "DC".into(),
             freq_hz: 0.0,
         });
         marks.push(Mark {
-            what: "2 f0".into(),
-            freq_hz: 2.0 * f0,
+            what: "2 fc".into(),
+            freq_hz: 2.0 * fc,
         });
         return (marks, None);
     }
     marks.push(Mark {
-        what: "f0".into(),
-        freq_hz: f0,
+        what: "fc".into(),
+        freq_hz: fc,
     });
-    if (f0b - f0).abs() > 2.0 * psd.bin_hz() {
+    if (f0b - fc).abs() > 2.0 * psd.bin_hz() {
         marks.push(Mark {
             what: "f0 mode 2".into(),
             freq_hz: f0b,
@@ -172,16 +182,16 @@ fn full_rate_marks(set: &DumpSet, psd: &Psd, stage1: bool) -> (Vec<Mark>, Option
     if let Some(om) = set.extra("omega_hz").filter(|&o| o > 0.0) {
         if om > 2.0 * psd.bin_hz() {
             marks.push(Mark {
-                what: "f0 − Ω".into(),
-                freq_hz: f0 - om,
+                what: "fc − Ω".into(),
+                freq_hz: fc - om,
             });
             marks.push(Mark {
-                what: "f0 + Ω".into(),
-                freq_hz: f0 + om,
+                what: "fc + Ω".into(),
+                freq_hz: fc + om,
             });
         } else {
             note = Some(format!(
-                "f0 ± Ω unresolved (Ω = {} Hz, bins {} Hz)",
+                "fc ± Ω unresolved (Ω = {} Hz, bins {} Hz)",
                 sig3(om),
                 sig3(psd.bin_hz())
             ));
@@ -191,7 +201,7 @@ fn full_rate_marks(set: &DumpSet, psd: &Psd, stage1: bool) -> (Vec<Mark>, Option
 }
 
 /// The markers of the low-pass panel: DC, the modulation (rotating: Ω; rate table: its
-/// frequency) and where the 2 f0 residual lands after decimation.
+/// frequency) and where the 2 fc residual lands after decimation.
 fn lowpass_marks(set: &DumpSet, psd: &Psd) -> (Vec<Mark>, Option<String>) {
     let mut marks = vec![Mark {
         what: "DC".into(),
@@ -212,18 +222,18 @@ fn lowpass_marks(set: &DumpSet, psd: &Psd) -> (Vec<Mark>, Option<String>) {
             None => {}
         }
     }
-    let Some(f0) = set.extra("f0_hz") else {
+    let Some(fc) = carrier_hz(set) else {
         return (marks, notes.pop());
     };
     let fs = psd.fs_hz;
-    let alias = (2.0 * f0 - fs * (2.0 * f0 / fs).round()).abs();
+    let alias = (2.0 * fc - fs * (2.0 * fc / fs).round()).abs();
     if alias > 2.0 * psd.bin_hz() {
         marks.push(Mark {
-            what: "2 f0 residual (aliased)".into(),
+            what: "2 fc residual (aliased)".into(),
             freq_hz: alias,
         });
     } else {
-        notes.push("the 2 f0 residual aliases onto DC".into());
+        notes.push("the 2 fc residual aliases onto DC".into());
     }
     (marks, (!notes.is_empty()).then(|| notes.join("; ")))
 }

@@ -1,6 +1,7 @@
 //! The figures and statistics of a dump, on a synthetic recording of known tones: the tone
-//! finder's levels are the closed forms 20 log10(A / sqrt 2), the marks sit at f0, f0 +- Omega
-//! and 2 f0, and every way of naming the dump reads the same pair.
+//! finder's levels are the closed forms 20 log10(A / sqrt 2), the marks sit at the carrier
+//! fc, fc +- Omega and 2 fc (f0 stands in for fc in a dump without `carrier_hz`), and every way
+//! of naming the dump reads the same pair.
 
 use gyroemu_io::SignalRecorder;
 use gyroemu_report::dump_figures::{signal_panels, spectrum_panels};
@@ -106,8 +107,8 @@ fn spectrum_marks_the_carrier_sidebands_and_mixer_product_with_their_levels() {
     assert!(mix
         .markers
         .iter()
-        .any(|m| m.x == 2.0 * F0 && m.label.starts_with("2 f0")));
-    // The low-pass panel: DC and the 2 f0 residual where decimation folds it (6020 Hz at
+        .any(|m| m.x == 2.0 * F0 && m.label.starts_with("2 fc")));
+    // The low-pass panel: DC and the 2 fc residual where decimation folds it (6020 Hz at
     // 1 kHz: 20 Hz).
     let lp = panels
         .iter()
@@ -191,4 +192,27 @@ fn a_channel_left_out_of_the_spectrum_is_named_in_the_title() {
         tia.title
     );
     assert_eq!(tia.series.len(), 1);
+}
+
+/// A drive detuned 40 Hz from the resonance (4.7 bins of 8.5 Hz here): the tones sit at the
+/// carrier, so the marks do, and read the carrier's level; at f0 the spectrum holds only the
+/// tone's skirt, 40 dB down, which the f0 mark had printed as the drive's level.
+#[test]
+fn the_marks_sit_at_the_carrier_not_at_the_resonance() {
+    let dir = tempfile::tempdir().unwrap();
+    let fc = F0 + 40.0;
+    let extra = BTreeMap::from([("f0_hz".to_string(), F0), ("carrier_hz".into(), fc)]);
+    let mut full =
+        SignalRecorder::new(vec!["tia1_v".into()], FS, 0, 8192).with_extra(extra.clone());
+    for n in 0..8192u64 {
+        let t = n as f64 / FS;
+        full.record(n, &[1e-3 * (2.0 * PI * fc * t).sin()]);
+    }
+    full.write(dir.path(), "dump_fullrate").unwrap();
+    let set = read_dump_set(&dir.path().join("dump_fullrate.sigmf-meta")).unwrap();
+    let (_, panels) = spectrum_panels(&set);
+    let tia = panels.iter().find(|f| f.title.starts_with("TIA")).unwrap();
+    assert_eq!(tia.markers[0].x, fc);
+    let label = &tia.markers[0].label;
+    assert!(label.contains(&format!("{:.1} dBV", db(1e-3))), "{label}");
 }
