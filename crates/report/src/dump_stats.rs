@@ -85,11 +85,16 @@ pub fn inspect_text(set: &DumpSet) -> String {
         let fs = format!("{:.12e}", d.sample_rate_hz)
             .parse::<f64>()
             .unwrap_or(d.sample_rate_hz);
+        // Decimals enough to tell one sample period from the next (a GHz dump read
+        // `t = 0.000002 .. 0.000003 s` at six).
+        let decimals = (-(1.0 / d.sample_rate_hz).log10()).ceil().clamp(6.0, 17.0) as usize + 1;
         out.push_str(&format!(
-            "{}: {} channel(s), {n} samples at {fs} Hz, t = {:.6} .. {:.6} s\n",
+            "{}: {} channel(s), {n} samples at {fs} Hz, t = {:.*} .. {:.*} s\n",
             d.path.display(),
             d.channels.len(),
+            decimals,
             d.time_s(0),
+            decimals,
             d.time_s(n.saturating_sub(1)),
         ));
         for note in &d.notes {

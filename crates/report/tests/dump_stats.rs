@@ -102,3 +102,31 @@ fn what_the_reader_could_not_check_is_printed_with_the_recording() {
         "{text}"
     );
 }
+
+#[test]
+fn the_window_is_printed_to_a_sample_period_at_any_rate() {
+    // Four samples at 4.8 GHz from t = 2 us: six decimals printed both ends as 0.000002.
+    let mut d = dump(vec![1.0, -1.0, 1.0, -1.0]);
+    d.sample_rate_hz = 4.8e9;
+    d.t0_s = 2e-6;
+    let set = gyroemu_report::DumpSet {
+        name: "x".into(),
+        dir: ".".into(),
+        full: Some(d),
+        decimated: None,
+    };
+    let text = gyroemu_report::inspect_text(&set);
+    let window = text
+        .split("t = ")
+        .nth(1)
+        .unwrap()
+        .split(" s")
+        .next()
+        .unwrap();
+    let ends: Vec<f64> = window.split(" .. ").map(|t| t.parse().unwrap()).collect();
+    let period = 1.0 / 4.8e9;
+    assert!(
+        (ends[1] - ends[0] - 3.0 * period).abs() < 0.1 * period,
+        "{window}"
+    );
+}
