@@ -114,11 +114,12 @@ impl Probe {
         let start = (start_s * fs_hz).round() as u64;
         let len = (duration_s * fs_hz).round().max(1.0) as u64;
         // Decimated sample k is formed at input sample kM + M - 1, at (M - 1) / fs after
-        // k / fs_out: the output nearest the window's start is counted from that origin (from
-        // t = 0 it came an output late, and a window of under an output period at the run's
-        // end recorded nothing).
+        // k / fs_out: the window records from the first output formed at or after its start
+        // (to a millionth of an output period), counted from that origin (from t = 0 it came
+        // up to an output late, and a window of under an output period at the run's end
+        // recorded nothing).
         let origin_s = (decimation - 1) as f64 / fs_hz;
-        let start_out = ((start_s - origin_s) * fs_out).round().max(0.0) as u64;
+        let start_out = ((start_s - origin_s) * fs_out - 1e-6).ceil().max(0.0) as u64;
         let len_out = (duration_s * fs_out).round().max(1.0) as u64;
         Self {
             lane,
@@ -359,6 +360,10 @@ impl Probe {
         [("full-rate", &self.full), ("decimated", &self.decimated)]
             .into_iter()
             .filter(|(_, r)| !r.names().is_empty())
+            // A rate no WAV holds was said before the run.
+            .filter(|(_, r)| {
+                gyroemu_io::wav_f32_rate_problem(r.fs_hz(), r.names().len() as u64).is_none()
+            })
             .filter_map(|(what, r)| {
                 let why = r.wav_range_problem()?;
                 Some(format!(

@@ -9,6 +9,12 @@ use crate::validate_regime::{half_turn_mdeg, WARN_HOLD_ERROR_MDEG};
 use gyroemu_board::{ChainResponse, Shape};
 use gyroemu_core::Complex64;
 
+/// The DAC's code of `u` (step `lsb`, `half` = 2^(bits - 1) codes a side): mid-tread, ties
+/// away from zero, clipped to [-half, half - 1], as `gyroemu_am::Quantizer::quantize` rounds.
+pub(crate) fn dac_code(u: f64, lsb: f64, half: f64) -> f64 {
+    (u / lsb).round().clamp(-half, half - 1.0)
+}
+
 impl Config {
     /// The DAC rounds the cos and the sin drive sequences differently whenever the drives
     /// differ or the carrier's period is not a multiple of 4 samples (only then is the sin
@@ -178,7 +184,7 @@ impl Config {
         };
         let half = (1u64 << (bits - 1)) as f64;
         let lsb = self.board.dac_full_scale / half;
-        let code = |u: f64| (u / lsb).round().clamp(-half, half - 1.0);
+        let code = |u: f64| dac_code(u, lsb, half);
         let plant = self.resonator_params();
         let fc = self.carrier_hz();
         let fs_out = self.fs_out_hz();
@@ -424,7 +430,7 @@ impl Config {
                 phase_span,
             });
         };
-        let quantise = |x: f64| (x / lsb).round().clamp(-half, half - 1.0) * lsb;
+        let quantise = |x: f64| dac_code(x, lsb, half) * lsb;
         let mut carrier = gyroemu_nco::RotatingNco::<f64>::new(&[nco]);
         let zero = Complex64::new(0.0, 0.0);
         let (mut exact, mut rounded) = ([zero; 2], [zero; 2]);
@@ -508,7 +514,7 @@ fn drift_gains(
 ) {
     use core::f64::consts::{PI, TAU};
     let w = TAU / q as f64;
-    let code = |u: f64| (u / lsb).round().clamp(-half, half - 1.0);
+    let code = |u: f64| dac_code(u, lsb, half);
     let mut cuts: Vec<(f64, usize, u64)> = Vec::new();
     for (k, &(a, beta)) in drives.iter().enumerate() {
         for m in 0..q {

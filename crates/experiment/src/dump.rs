@@ -50,9 +50,10 @@ impl DumpPlan {
 }
 
 /// The operating point of a dump at `rate_dps`, as the numbers its SigMF metadata carries
-/// (`gyroemu:<key>`): the carrier `f0_hz` (mode 1) and `f0_mode2_hz`, `rate_dps`, the
-/// rotating excitation's `omega_hz` (sidebands at f0 +- omega_hz) or the rate table's
-/// `table_freq_hz`, and the read-out's `lpf_cutoff_hz`, `lpf_order` and `decimation`.
+/// (`gyroemu:<key>`): the resonances `f0_hz` (mode 1) and `f0_mode2_hz`, the drive's
+/// `carrier_hz`, `rate_dps`, the rotating excitation's `omega_hz` (sidebands at carrier_hz +-
+/// omega_hz) or the rate table's `table_freq_hz`, and the read-out's `lpf_cutoff_hz`,
+/// `lpf_order` and `decimation`.
 pub fn dump_extra(cfg: &Config, rate_dps: f64) -> BTreeMap<String, f64> {
     let mut m = BTreeMap::from([
         ("f0_hz".to_string(), cfg.device.f0_hz),

@@ -353,21 +353,12 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
             u64::MAX
         )));
     }
-    // Every frame's time must be a number: a rate of 1e-308 Hz put them at infinity.
-    let time = |n: u64| t0_s + n as f64 / fs;
-    let last = global_index + (frames as u64 - 1);
-    if !(time(global_index).is_finite() && time(last).is_finite()) {
-        return Err(bad(format!(
-            "core:sample_rate = {fs:?} Hz with gyroemu:t0_s = {t0_s:?} s: the time of sample \
-             index {last}, t0_s + index / rate, is not a finite number of seconds"
-        )));
-    }
     let mut data = vec![Vec::with_capacity(frames); n_ch];
     for (i, w) in bytes.chunks_exact(8).enumerate() {
         let v = f64::from_le_bytes(w.try_into().expect("chunks of 8"));
         data[i % n_ch].push(v);
     }
-    Ok(Dump {
+    let dump = Dump {
         path: data_path,
         sample_rate_hz: fs,
         global_index,
@@ -376,7 +367,16 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
         data,
         extra,
         notes,
-    })
+    };
+    // Every frame's time must be a number: a rate of 1e-308 Hz put them at infinity.
+    if !(dump.time_s(0).is_finite() && dump.time_s(frames - 1).is_finite()) {
+        return Err(bad(format!(
+            "core:sample_rate = {fs:?} Hz with gyroemu:t0_s = {t0_s:?} s: the time of sample \
+             index {}, t0_s + index / rate, is not a finite number of seconds",
+            global_index + (frames as u64 - 1)
+        )));
+    }
+    Ok(dump)
 }
 
 /// The line a CSV record starts on, from the position the csv crate gives it: that is where

@@ -172,8 +172,9 @@ impl SignalRecorder {
     /// - `<dir>/<stem>.csv` (columns `sample`, `time_s`, then one per name; exact float text);
     /// - `<dir>/<stem>.wav` (one 32-bit float channel per name at round(fs_hz) Hz), when a WAV
     ///   header can hold the rate ([`wav_f32_rate_problem`]; an output rate below 0.5 Hz or
-    ///   not within 1e-4 of a whole Hz, or a byte rate past 2^32, has only the CSV and SigMF)
-    ///   and float32 every sample ([`wav_range_problem`](Self::wav_range_problem)). WAV values are the raw signals,
+    ///   more than 1e-4 of itself off its nearest whole Hz, or a byte rate past 2^32, has only
+    ///   the CSV and SigMF) and float32 every sample
+    ///   ([`wav_range_problem`](Self::wav_range_problem)). WAV values are the raw signals,
     ///   not normalised, so they may exceed +-1: read them with `soundfile.read(path)` or
     ///   `scipy.io.wavfile.read(path)`, not an audio player;
     /// - `<dir>/<stem>.sigmf-data` + `<dir>/<stem>.sigmf-meta` (SigMF 1.2.0, `rf64_le`, full

@@ -17,7 +17,8 @@ pub const WAV_RATE_REL_TOL: f64 = 1e-4;
 
 /// Why a float WAV of `channels` channels cannot describe a rate of `fs_hz` (a WAV rate is a
 /// whole number of Hz in 1..=2^32-1, within [`WAV_RATE_REL_TOL`] of the rate, and its
-/// byte-rate field, rate x channels x 4, is 32-bit too), or `None` when it can. The CSV and SigMF beside it carry any rate.
+/// byte-rate field, rate x channels x 4, is 32-bit too), or `None` when it can. The CSV and
+/// SigMF beside it carry any rate.
 pub fn wav_f32_rate_problem(fs_hz: f64, channels: u64) -> Option<String> {
     let rate = fs_hz.round();
     if !(rate >= 1.0 && rate <= f64::from(u32::MAX)) {

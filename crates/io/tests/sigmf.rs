@@ -218,7 +218,7 @@ fn missing_directory_is_an_error_not_a_panic() {
 }
 
 #[test]
-fn recorder_writes_sigmf_beside_csv_and_wav() {
+fn recorder_writes_sigmf_beside_csv_and_leaves_out_a_wav_float32_cannot_hold() {
     let dir = tempfile::tempdir().unwrap();
     let names = vec!["tia1_v".to_string(), "q1_m".into(), "mix1_i1".into()];
     let fs_hz = 12_345.678;

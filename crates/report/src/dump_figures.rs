@@ -8,7 +8,7 @@ use crate::dump_set::{groups, DumpSet, Group};
 use crate::error::ReportError;
 use gyroemu_io::Dump;
 use gyroemu_plot::{render_panels_png, Figure, Series, SeriesStyle};
-use gyroemu_spectrum::{tone_near, welch, Psd, SpectrumError};
+use gyroemu_spectrum::{tone_near, unresolved, welch, Psd, SpectrumError};
 use std::path::{Path, PathBuf};
 
 /// Carrier periods of the full-rate nodes shown in `signals.png` (the waveforms stay legible).
@@ -293,8 +293,11 @@ fn spectrum_panel(
     for m in marks {
         let levels: Vec<String> = psds
             .iter()
-            .map(|(_, p)| {
-                tone_near(p, m.freq_hz, 2).map_or("-".into(), |t| format!("{:.1}", t.level_db()))
+            .map(|(_, p)| match tone_near(p, m.freq_hz, 2) {
+                None => "-".into(),
+                // As `inspect` says it: a tone sharing its bins with its mirror image.
+                Some(t) if unresolved(p, &t).is_some() => "unresolved".into(),
+                Some(t) => format!("{:.1}", t.level_db()),
             })
             .collect();
         f = f.with_marker(

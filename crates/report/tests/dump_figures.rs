@@ -216,3 +216,44 @@ fn the_marks_sit_at_the_carrier_not_at_the_resonance() {
     let label = &tia.markers[0].label;
     assert!(label.contains(&format!("{:.1} dBV", db(1e-3))), "{label}");
 }
+
+/// A mark on a tone within 3 bins of fs/2 reads `unresolved`, as `inspect` prints it: the
+/// 2 fc residual of the m2tfg presets lands exactly on the decimated fs/2 (2 x 15 kHz at
+/// 2.4 kHz), and a level there is the tone's and its mirror image's at once.
+#[test]
+fn a_mark_at_fs_over_2_reads_unresolved() {
+    let dir = tempfile::tempdir().unwrap();
+    let (fs, fc) = (240_000.0, 15_000.0);
+    let extra = BTreeMap::from([("carrier_hz".to_string(), fc), ("decimation".into(), 100.0)]);
+    let fs_out = fs / 100.0;
+    let mut dec = SignalRecorder::new(vec!["lp_i1".into()], fs_out, 0, 1024).with_extra(extra);
+    for k in 0..1024u64 {
+        let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+        dec.record(k, &[1e-3 + 1e-9 * sign]);
+    }
+    dec.write(dir.path(), "dump_decimated").unwrap();
+    let set = read_dump_set(&dir.path().join("dump_decimated.sigmf-meta")).unwrap();
+    let (_, panels) = spectrum_panels(&set);
+    let lp = panels
+        .iter()
+        .find(|f| f.title.starts_with("Low-pass"))
+        .unwrap();
+    let residual = lp
+        .markers
+        .iter()
+        .find(|m| m.label.contains("residual"))
+        .unwrap();
+    assert_eq!(residual.x, fs_out / 2.0);
+    assert!(residual.label.contains("unresolved"), "{}", residual.label);
+    // The DC level beside it is read.
+    let dc = lp
+        .markers
+        .iter()
+        .find(|m| m.label.starts_with("DC"))
+        .unwrap();
+    assert!(
+        dc.label.contains(&format!("{:.1}", 20.0 * 1e-3f64.log10())),
+        "{}",
+        dc.label
+    );
+}

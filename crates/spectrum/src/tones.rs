@@ -81,9 +81,9 @@ fn refine(psd: &Psd, k: usize) -> Tone {
 pub const EDGE_BINS: usize = 3;
 
 /// Bin 1 over bin 0 of a constant through the Hann window is exactly 1/4, doubled in the
-/// one-sided spectrum (bin 1 holds both signs). A tone within 0.1 bin of DC (up to 2 x
-/// 0.2594) is, over a segment, a slowly moving level, and is read as one; 0.4 bin gives
-/// 2 x 0.414.
+/// one-sided spectrum (bin 1 holds both signs). A tone within 0.1 bin of DC (up to about
+/// 0.52, with the record's phases) is, over a segment, a slowly moving level, and is read as
+/// one; 0.4 bin gives about 0.84.
 const DC_LEAK_MAX: f64 = 0.52;
 
 /// Why `t` (a peak of `psd`) is not one tone read exactly, if it is not: a peak within
