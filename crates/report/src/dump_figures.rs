@@ -154,7 +154,7 @@ fn full_rate_marks(set: &DumpSet, psd: &Psd, stage1: bool) -> (Vec<Mark>, Option
     let Some(fc) = carrier_hz(set) else {
         return (
             marks,
-            Some("carrier unknown (no gyroemu:carrier_hz)".into()),
+            Some("carrier unknown (no gyroemu:carrier_hz nor gyroemu:f0_hz)".into()),
         );
     };
     let f0b = set.extra("f0_mode2_hz").unwrap_or(fc);
