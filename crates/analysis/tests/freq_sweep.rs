@@ -134,6 +134,15 @@ fn stiffness_modes_hz(c: &Config) -> [f64; 2] {
     ]
 }
 
+/// How many of `r`'s warnings contain `needle`.
+fn warned(r: &FrequencyResponse, needle: &str) -> usize {
+    r.measured
+        .warnings
+        .iter()
+        .filter(|w| w.contains(needle))
+        .count()
+}
+
 fn coupled(c: &Config) -> FrequencyResponse {
     frequency_response_from(c, measure(c))
 }
@@ -367,13 +376,7 @@ fn a_fit_the_dac_hold_biases_says_so() {
     let c = parse_config(&text).unwrap();
     c.validate_sweep().unwrap();
     let r = frequency_response_from(&c, run_stepped_sine(&c, &|_, _| {}).unwrap());
-    let said = |r: &FrequencyResponse| {
-        r.measured
-            .warnings
-            .iter()
-            .filter(|w| w.contains("zero-order hold biases its fit"))
-            .count()
-    };
+    let said = |r: &FrequencyResponse| warned(r, "zero-order hold biases its fit");
     assert_eq!(said(&r), 2, "{:?}", r.measured.warnings);
     let c = config(2.0, 1950.0, 0.0, 21, "");
     let r = frequency_response_from(&c, measure(&c));
@@ -387,13 +390,7 @@ fn a_fit_the_dac_hold_biases_says_so() {
 /// half-bandwidth.
 #[test]
 fn a_fit_the_coupling_pulls_off_the_devices_modes_says_so() {
-    let said = |r: &FrequencyResponse| {
-        r.measured
-            .warnings
-            .iter()
-            .filter(|w| w.contains("quadrature coupling mixes both modes"))
-            .count()
-    };
+    let said = |r: &FrequencyResponse| warned(r, "quadrature coupling mixes both modes");
     let c = config(0.0, 2000.0, 5e5, 41, "");
     let r = coupled(&c);
     let eig = stiffness_modes_hz(&c);

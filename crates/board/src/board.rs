@@ -110,8 +110,8 @@ pub(crate) fn table_harmonics(p: &BoardParams) -> usize {
 }
 
 /// The phase shifter of the drive's quadrature copy (the nominal one is exactly -j: cos ->
-/// sin with no rounding).
-pub(crate) fn shifter(p: &BoardParams) -> Result<PhaseShifter, ParamError> {
+/// sin with no rounding); the config's rules that rebuild the drives call it too.
+pub fn drive_shifter(p: &BoardParams) -> Result<PhaseShifter, ParamError> {
     match p.phase_shifter_error_deg {
         0.0 => Ok(PhaseShifter::quadrature()),
         e => PhaseShifter::new((90.0 + e).to_radians()),
@@ -326,7 +326,7 @@ impl<S: Sample> Board<S> {
             shape: p.shape,
             lanes,
             carrier: RotatingNco::new(&[carrier]),
-            shifter: shifter(p)?,
+            shifter: drive_shifter(p)?,
             modulation: RotatingNco::new(&modulation),
             table_f_hz,
             table_nco: RotatingNco::new(&table[..1]),

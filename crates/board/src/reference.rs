@@ -5,7 +5,7 @@
 //! exact, so the fused board must give every lane these bits.
 
 use crate::board::{
-    modulation_hz, noise_sigmas, pattern, plant_rate, shifter, table_harmonics, table_nco,
+    drive_shifter, modulation_hz, noise_sigmas, pattern, plant_rate, table_harmonics, table_nco,
 };
 use crate::flicker::FlickerSources;
 use crate::health::Health;
@@ -33,7 +33,7 @@ pub fn run_reference(
     let fs = p.fs_hz();
     let m = p.decimation;
     let mut carrier = RotatingNco::<f64>::new(&[Nco::new(p.carrier_hz, fs, 0.0)?]);
-    let mut shift = shifter(p)?;
+    let mut shift = drive_shifter(p)?;
     let mut modulation =
         RotatingNco::<f64>::new(&[Nco::new(modulation_hz(p.shape, rate_rad_s), fs, 0.0)?]);
     let table = table_nco(p)?;

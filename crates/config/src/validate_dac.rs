@@ -310,12 +310,7 @@ impl Config {
         let nco = gyroemu_nco::Nco::new(self.carrier_hz(), self.fs_hz(), 0.0).ok()?;
         let step_word = nco.step_word();
         let near_whole = |n: u64| (step_word.wrapping_mul(n) as i64).unsigned_abs() < 1 << 24;
-        let e = self.board.phase_shifter_error_deg;
-        let shifter = if e == 0.0 {
-            gyroemu_nco::PhaseShifter::quadrature()
-        } else {
-            gyroemu_nco::PhaseShifter::new((90.0 + e).to_radians()).ok()?
-        };
+        let shifter = gyroemu_board::drive_shifter(&self.board_params()).ok()?;
         let half = (1u64 << (bits - 1)) as f64;
         let lsb = self.board.dac_full_scale / half;
         let gains = [self.drive.f1, self.f2()];

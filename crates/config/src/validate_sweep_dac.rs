@@ -52,14 +52,8 @@ impl Config {
         let span = (BUDGET / freqs.len().max(1) as u64)
             .max(MIN_SPAN)
             .min(point.window.samples() * m);
-        let e = self.board.phase_shifter_error_deg;
-        let shifter = if e == 0.0 {
-            gyroemu_nco::PhaseShifter::quadrature()
-        } else {
-            match gyroemu_nco::PhaseShifter::new((90.0 + e).to_radians()) {
-                Ok(s) => s,
-                Err(_) => return,
-            }
+        let Ok(shifter) = gyroemu_board::drive_shifter(&self.board_params()) else {
+            return;
         };
         for (k, a) in [self.drive.f1, self.f2()].into_iter().enumerate() {
             if !(a > 0.0 && a.is_finite()) {
