@@ -56,12 +56,13 @@ pub fn sweep_command(config: &Path, out: &Path, force: bool) -> Result<()> {
         }
     };
     say!(
-        "sweep: {}; {}; split {:.6} +- {:.1e} Hz (configured {})",
+        "sweep: {}; {}; split {:.6} +- {:.1e} Hz (configured {}, the coupled plant's {:.6})",
         part(0),
         part(1),
         split,
         split_sigma,
-        r.modes[1].configured_f0_hz - r.modes[0].configured_f0_hz
+        r.modes[1].configured_f0_hz - r.modes[0].configured_f0_hz,
+        r.modes[1].coupled_f0_hz - r.modes[0].coupled_f0_hz
     );
     list_written(out, &files);
     check_problems("sweep", &r.measured.problems)?;
