@@ -174,6 +174,9 @@ impl<S: Sample> Board<S> {
                 _ => self.block::<K, NOISY, DECOUPLED>(n0, None, &mut counts),
             };
             if NOISY {
+                if let Some(p) = opts.probe.as_deref_mut() {
+                    p.count_block(n0, m, k, &counts);
+                }
                 if k >= recount_at {
                     (active, recount_at) = counting(k);
                 }

@@ -37,4 +37,4 @@ pub use lanes::{
 pub use lock::{lock_carrier, LockRun, LockSample};
 pub use params::{BoardParams, Converter, NoiseParams, Shape};
 pub use point::{LaneResult, Point, RunOptions, RunOutput};
-pub use probe::{Probe, DUMP_NODES};
+pub use probe::{Probe, DUMP_NODES, EVENTS_COUNTED_KEY, EVENT_KEYS};

@@ -2,6 +2,7 @@
 //! happens inside the sample loop only for samples inside the window; memory is bounded by
 //! the window.
 
+use crate::health::{Counters, ADC_CLIP, DAC_CLIP, TIA_RAIL};
 use gyroemu_core::{Sample, Stage};
 use gyroemu_io::{IoError, SignalRecorder};
 use gyroemu_mixer::{Iq, Stage2Mixer};
@@ -20,7 +21,35 @@ pub struct Probe {
     /// and the first fault kept as (stage, input sample, lane); nothing is recorded.
     check_lanes: usize,
     fault: Option<(&'static str, u64, usize)>,
+    /// The converter events the board counted in the decimation blocks each recording's
+    /// window spans (in [`EVENT_KEYS`] order) and those blocks' input samples; `None` where
+    /// the board counts none (it has no converter, rail or noise, so nothing can clip).
+    events: [Option<([u64; 6], u64)>; 2],
 }
+
+/// The metadata keys of a recording's converter events (`gyroemu:<key>`), in the order of
+/// [`Probe`]'s counts, and the key of the input samples they were counted over.
+pub const EVENT_KEYS: [&str; 6] = [
+    "dac_clipped_samples_mode1",
+    "dac_clipped_samples_mode2",
+    "tia_railed_samples_mode1",
+    "tia_railed_samples_mode2",
+    "adc_clipped_samples_mode1",
+    "adc_clipped_samples_mode2",
+];
+
+/// See [`EVENT_KEYS`].
+pub const EVENTS_COUNTED_KEY: &str = "events_counted_samples";
+
+/// The [`Counters`] slots of [`EVENT_KEYS`].
+const EVENT_SLOTS: [usize; 6] = [
+    DAC_CLIP,
+    DAC_CLIP + 1,
+    TIA_RAIL,
+    TIA_RAIL + 1,
+    ADC_CLIP,
+    ADC_CLIP + 1,
+];
 
 /// The node names a dump accepts: full-rate `drive`, `displacement`, `velocity`, `tia`,
 /// `stage1`; decimated `lowpass`, `stage2`.
@@ -130,6 +159,7 @@ impl Probe {
                 .with_time_origin(origin_s),
             check_lanes: 0,
             fault: None,
+            events: [None; 2],
         }
     }
 
@@ -166,6 +196,7 @@ impl Probe {
             decimated: SignalRecorder::new(Vec::new(), 1.0, 0, 0),
             check_lanes: lanes,
             fault: None,
+            events: [None; 2],
         }
     }
 
@@ -270,6 +301,46 @@ impl Probe {
             ]);
         }
         self.full.record(n, &frame[..k]);
+    }
+
+    /// Adds this probe's lane of decimation block `k`'s converter events (input samples
+    /// `n0 .. n0 + m`) to each recording whose window the block touches: the full-rate one
+    /// where the block overlaps its samples, the decimated one where the block forms its
+    /// output `k`. Per block, not per sample: a window's edges inside a block count that
+    /// block's events whole.
+    pub(crate) fn count_block<S: Sample>(&mut self, n0: u64, m: u64, k: u64, c: &Counters<S>) {
+        if self.check_lanes > 0 {
+            return;
+        }
+        let touches = [
+            !self.full.names().is_empty() && n0 < self.full.end() && n0 + m > self.full.start(),
+            !self.decimated.names().is_empty() && self.decimated.wants(k),
+        ];
+        for (on, acc) in touches.into_iter().zip(&mut self.events) {
+            if on {
+                let (ev, samples) = acc.get_or_insert(([0; 6], 0));
+                for (e, slot) in ev.iter_mut().zip(EVENT_SLOTS) {
+                    *e += c.0[slot].lane(self.lane) as u64;
+                }
+                *samples += m;
+            }
+        }
+    }
+
+    /// The converter events counted for the full-rate (`0`) or decimated (`1`) recording,
+    /// as `gyroemu:<key>` entries ([`EVENT_KEYS`], [`EVENTS_COUNTED_KEY`]); empty where the
+    /// board counted none.
+    pub fn event_extra(&self, recording: usize) -> BTreeMap<String, f64> {
+        self.events[recording]
+            .iter()
+            .flat_map(|(ev, samples)| {
+                EVENT_KEYS
+                    .iter()
+                    .zip(ev)
+                    .map(|(k, &v)| (k.to_string(), v as f64))
+                    .chain([(EVENTS_COUNTED_KEY.to_string(), *samples as f64)])
+            })
+            .collect()
     }
 
     /// Records the decimated nodes of output sample `k`.
@@ -378,10 +449,18 @@ impl Probe {
     pub fn write(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, IoError> {
         let mut files = Vec::new();
         if !self.full.names().is_empty() {
-            files.extend(self.full.write(dir, &format!("{stem}_fullrate"))?);
+            let more = self.event_extra(0);
+            files.extend(
+                self.full
+                    .write_with(dir, &format!("{stem}_fullrate"), &more)?,
+            );
         }
         if !self.decimated.names().is_empty() {
-            files.extend(self.decimated.write(dir, &format!("{stem}_decimated"))?);
+            let more = self.event_extra(1);
+            files.extend(
+                self.decimated
+                    .write_with(dir, &format!("{stem}_decimated"), &more)?,
+            );
         }
         Ok(files)
     }

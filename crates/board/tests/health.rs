@@ -83,3 +83,79 @@ fn every_count_equals_the_reference_boards() {
         }
     }
 }
+
+/// A dump's recordings carry the converter events of the decimation blocks their windows
+/// span, so `inspect` can tell a clipped window later. On the 4-bit DAC above, each drive
+/// clips where its carrier, cos or sin of 2 pi n / 16, rounds beyond the codes -8..=7 at step
+/// 0.1: counted here sample by sample over those blocks. A board without converters, rails
+/// or noise counts nothing and says nothing.
+#[test]
+fn a_dumps_windows_carry_the_converter_events_of_their_blocks() {
+    use gyroemu_board::{Probe, DUMP_NODES, EVENTS_COUNTED_KEY, EVENT_KEYS};
+    let mut p = m2tfg(Shape::Coriolis);
+    p.dac = Some(Converter {
+        bits: 4,
+        full_scale: 0.8,
+    });
+    let clips = |x: f64| !(-8.0..=7.0).contains(&(x / 0.1).round());
+    // Input samples n0 .. n1 where each drive clips: the closed form of the carrier.
+    let want = |n0: u64, n1: u64| {
+        let ph = |n: u64| std::f64::consts::TAU * (n % 16) as f64 / 16.0;
+        [
+            (n0..n1).filter(|&n| clips(ph(n).cos())).count() as f64,
+            (n0..n1).filter(|&n| clips(ph(n).sin())).count() as f64,
+        ]
+    };
+    let nodes: Vec<String> = DUMP_NODES.map(String::from).to_vec();
+    // (start, full-rate length, decimated length) in input samples: block-aligned; from
+    // inside a block to inside the next; the decimated window longer than the full-rate one.
+    for (start, full, dec) in [(1000u64, 400u64, 400u64), (1050, 100, 300), (2730, 7, 2000)] {
+        let fs = 240_000.0;
+        let mut probe = Probe::new(&nodes, fs, 100, start as f64 / fs, full as f64 / fs, 0)
+            .with_decimated_duration(dec as f64 / fs);
+        let q = point(0.0, 49);
+        Board::<f64x4>::new(&p, &[0.0], &[0])
+            .unwrap()
+            .run(
+                30,
+                &[q],
+                RunOptions {
+                    probe: Some(&mut probe),
+                    ..Default::default()
+                },
+                &|_| {},
+            )
+            .unwrap();
+        // The full-rate window's blocks; the decimated window's outputs k, each formed by
+        // block k, from the first output formed at or after the start.
+        let full_blocks = (start / 100 * 100, (start + full).div_ceil(100) * 100);
+        let k0 = (start + 1).saturating_sub(100).div_ceil(100);
+        let dec_blocks = (k0 * 100, (k0 + dec / 100) * 100);
+        for (rec, (n0, n1)) in [full_blocks, dec_blocks].into_iter().enumerate() {
+            let got = probe.event_extra(rec);
+            let w = want(n0, n1);
+            assert!(w[0] > 0.0 && w[1] > 0.0);
+            assert_eq!(got[EVENT_KEYS[0]], w[0], "{start} {rec}: {got:?}");
+            assert_eq!(got[EVENT_KEYS[1]], w[1], "{start} {rec}: {got:?}");
+            assert_eq!(got[EVENTS_COUNTED_KEY], (n1 - n0) as f64, "{got:?}");
+            for key in &EVENT_KEYS[2..] {
+                assert_eq!(got[*key], 0.0, "{key}: {got:?}");
+            }
+        }
+    }
+    // Clean: no counts, so no keys (rather than zeros no counter stood behind).
+    let mut probe = Probe::new(&nodes, 240_000.0, 100, 0.004, 0.001, 0);
+    Board::<f64x4>::new(&m2tfg(Shape::Coriolis), &[0.0], &[0])
+        .unwrap()
+        .run(
+            30,
+            &[point(0.0, 49)],
+            RunOptions {
+                probe: Some(&mut probe),
+                ..Default::default()
+            },
+            &|_| {},
+        )
+        .unwrap();
+    assert!(probe.event_extra(0).is_empty() && probe.event_extra(1).is_empty());
+}

@@ -186,6 +186,17 @@ impl SignalRecorder {
     /// The WAV size and the SigMF request are checked before any file is written. Returns the
     /// paths written (CSV, WAV when written, SigMF data, SigMF meta).
     pub fn write(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, IoError> {
+        self.write_with(dir, stem, &BTreeMap::new())
+    }
+
+    /// [`SignalRecorder::write`] with `more` added to the metadata's `gyroemu:<key>` entries
+    /// (what is known only once the window is recorded).
+    pub fn write_with(
+        &self,
+        dir: &Path,
+        stem: &str,
+        more: &BTreeMap<String, f64>,
+    ) -> Result<Vec<PathBuf>, IoError> {
         let csv_path = dir.join(format!("{stem}.csv"));
         let wav_path = dir.join(format!("{stem}.wav"));
         let ch = self.names.len();
@@ -202,7 +213,8 @@ impl SignalRecorder {
                 frames as u64,
             )?;
         }
-        let meta = self.sigmf_meta(stem);
+        let mut meta = self.sigmf_meta(stem);
+        meta.extra.extend(more.iter().map(|(k, v)| (k.clone(), *v)));
         check_request(&dir.join(format!("{stem}.sigmf-data")), &meta, ch)?;
 
         self.write_csv(&csv_path)?;

@@ -14,7 +14,9 @@
 //!   `t0_s + (core:global_index + k) / core:sample_rate`;
 //! - `gyroemu:doc`: this description in one sentence, so the file documents itself;
 //! - (1.1.0) numeric keys describing the operating point, from [`SigmfMeta::extra`]: e.g.
-//!   `gyroemu:f0_hz`, `gyroemu:rate_dps`, `gyroemu:omega_hz`, `gyroemu:decimation`.
+//!   `gyroemu:f0_hz`, `gyroemu:rate_dps`, `gyroemu:omega_hz`, `gyroemu:decimation`;
+//! - (1.2.0) where the board counts its converters, their events around the window:
+//!   `gyroemu:adc_clipped_samples_mode1` and the like, over `gyroemu:events_counted_samples`.
 
 use crate::atomic::atomic_stream;
 use crate::json::write_json;
@@ -31,14 +33,16 @@ pub const SIGMF_VERSION: &str = "1.2.0";
 pub const SIGMF_DATATYPE_REAL_F64: &str = "rf64_le";
 
 /// Version of the `gyroemu` metadata extension declared in `core:extensions`.
-pub const GYROEMU_EXTENSION_VERSION: &str = "1.1.0";
+pub const GYROEMU_EXTENSION_VERSION: &str = "1.2.0";
 
 /// One-sentence description of the `gyroemu` extension, stored as `gyroemu:doc`.
 const GYROEMU_EXTENSION_DOC: &str = "gyroemu:channels lists each channel's name and unit in \
 interleave order (unit \"\" = dimensionless or unknown); gyroemu:t0_s is the time in seconds of \
 global sample index 0, so file sample k is at t0_s + (core:global_index + k) / core:sample_rate; \
 any other numeric gyroemu:<name>_<unit> key describes the recorded operating point (e.g. \
-gyroemu:f0_hz the carrier, gyroemu:omega_hz the rotating excitation's frequency).";
+gyroemu:carrier_hz the drive's carrier, gyroemu:omega_hz the rotating excitation's frequency); \
+the *_clipped_samples_* and *_railed_samples_* keys count the converter events of the \
+decimation blocks the window spans, over gyroemu:events_counted_samples input samples.";
 
 /// Name and physical unit of one recorded channel (stored in `gyroemu:channels`).
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -76,6 +76,33 @@ fn rms(x: &[f64], peak: f64) -> f64 {
     (x.iter().map(|v| (v * down) * (v * down)).sum::<f64>() / n).sqrt() * up
 }
 
+/// What the recording's metadata says the board clipped around its window (the DAC, the TIA's
+/// rails, the ADC: `gyroemu_board::EVENT_KEYS`), as one sentence, if anything: the tones of a
+/// clipped signal are its harmonics and intermodulation, not the device's response, and the
+/// run's warning is not beside the dump when it is read later.
+pub fn clipping_warning(d: &gyroemu_io::Dump) -> Option<String> {
+    let what = ["DAC (drive)", "TIA rail", "ADC"];
+    let parts: Vec<String> = gyroemu_board::EVENT_KEYS
+        .iter()
+        .enumerate()
+        .filter_map(|(i, key)| {
+            let n = *d.extra.get(*key)?;
+            (n > 0.0).then(|| format!("{} mode {}: {n}", what[i / 2], i % 2 + 1))
+        })
+        .collect();
+    if parts.is_empty() {
+        return None;
+    }
+    let over = d
+        .extra
+        .get(gyroemu_board::EVENTS_COUNTED_KEY)
+        .map_or(String::new(), |n| format!(" of {n}"));
+    Some(format!(
+        "the board clipped in the decimation blocks this window spans ({} samples{over}): every channel downstream of a clipped converter or rail holds a clipped signal, whose tones are not the device's response",
+        parts.join(", ")
+    ))
+}
+
 /// The table `gyroemu inspect` prints: one block per recording, one line per channel.
 pub fn inspect_text(set: &DumpSet) -> String {
     let mut out = String::new();
@@ -99,6 +126,9 @@ pub fn inspect_text(set: &DumpSet) -> String {
         ));
         for note in &d.notes {
             out.push_str(&format!("  note: {note}\n"));
+        }
+        if let Some(w) = clipping_warning(d) {
+            out.push_str(&format!("  warning: {w}\n"));
         }
         out.push_str(&format!(
             "  {:<10} {:<5} {:>11} {:>11}  strongest tones (Hz: level)\n",
