@@ -12,6 +12,9 @@ use gyroemu_board::DUMP_NODES;
 /// is exact as an f64.
 pub const MAX_RUN_SAMPLES: f64 = 9_007_199_254_740_992.0;
 
+/// How [`Config::validate_sweep`] begins a warning of the `[experiment]`'s rules.
+pub const EXPERIMENT_WARNING: &str = "weighed for `run` of [experiment] (its rates, drives and windows), which this sweep does not run: ";
+
 /// The same f64, bit for bit (a derived value equals its derivation exactly).
 fn same(a: f64, b: f64) -> bool {
     a.to_bits() == b.to_bits()
@@ -21,16 +24,19 @@ impl Config {
     /// Checks every rule that does not need the stages built (the `[sweep]` rules when the
     /// section is present); returns the warnings, or every broken rule in one error.
     pub fn validate(&self) -> Result<Vec<String>, ConfigError> {
-        self.validate_with(self.sweep.is_some())
+        self.validate_with(self.sweep.is_some(), false)
     }
 
     /// [`Config::validate`] plus the rules of the `[sweep]` that `gyroemu sweep` runs, its
     /// defaults included when the section is absent.
+    /// The warnings of the rules that weigh the `[experiment]`'s operating points (its rates,
+    /// settling, modulation or table) start with [`EXPERIMENT_WARNING`]: `sweep` does not
+    /// run them, and "at 5 deg/s" read as if it did.
     pub fn validate_sweep(&self) -> Result<Vec<String>, ConfigError> {
-        self.validate_with(true)
+        self.validate_with(true, true)
     }
 
-    fn validate_with(&self, sweep: bool) -> Result<Vec<String>, ConfigError> {
+    fn validate_with(&self, sweep: bool, for_sweep: bool) -> Result<Vec<String>, ConfigError> {
         let mut p = Rules::default();
         let mut warnings = Vec::new();
         self.link_derived(&mut p);
@@ -40,6 +46,7 @@ impl Config {
         self.validate_noise_adc_selfcal(&mut p, &mut warnings);
         self.validate_montecarlo(&mut p);
         // The regime rules weigh the whole chain: only once its keys are each valid.
+        let experiment_from = warnings.len();
         if ["device", "drive", "board"]
             .iter()
             .all(|s| p.section_clean(s))
@@ -48,6 +55,11 @@ impl Config {
             self.validate_regime(&mut p, &mut warnings);
             self.validate_table_alias(&mut p);
             self.validate_settling(&mut p, &mut warnings);
+        }
+        if for_sweep {
+            for w in &mut warnings[experiment_from..] {
+                w.insert_str(0, EXPERIMENT_WARNING);
+            }
         }
         self.validate_dump(&mut p, &mut warnings);
         if sweep {

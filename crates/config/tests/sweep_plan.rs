@@ -179,3 +179,40 @@ fn a_span_with_too_few_distinct_frequencies_is_refused() {
     c.sweep.as_mut().unwrap().stop_hz = Some(15000.1);
     assert!(c.validate_sweep().is_ok());
 }
+
+/// `sweep` runs none of `[experiment]`'s operating points, so its rules' warnings, weighed at
+/// the experiment's rates ("at 100 deg/s"), say so when `sweep` asks; `run` gets them plain,
+/// and the sweep's own rules (a 4-bit DAC's rounding of each swept drive) stay plain in both.
+#[test]
+fn the_experiments_warnings_say_sweep_does_not_run_it() {
+    use gyroemu_config::EXPERIMENT_WARNING;
+    let text = preset_text("m2tfg-coriolis")
+        .unwrap()
+        .replace(
+            "[board]",
+            "[board]\nadc_bits = 12\nadc_full_scale_v = 0.05\ndac_bits = 4",
+        )
+        .replace("dac_full_scale = 1.0", "dac_full_scale = 2.0");
+    let c = parse_config(&text).unwrap();
+    let run = c.validate().unwrap();
+    let sweep = c.validate_sweep().unwrap();
+    let adc = |w: &&String| w.contains("the ADC's LSB") && w.contains("deg/s");
+    assert!(run.iter().filter(adc).count() == 2, "{run:?}");
+    assert!(
+        run.iter().all(|w| !w.starts_with(EXPERIMENT_WARNING)),
+        "{run:?}"
+    );
+    // Every warning `run` gets comes first in `sweep`'s, marked where it weighs the rates.
+    for (r, s) in run.iter().zip(&sweep) {
+        let marked = s.strip_prefix(EXPERIMENT_WARNING);
+        assert_eq!(marked.unwrap_or(s), r);
+        if adc(&r) {
+            assert!(marked.is_some(), "{s}");
+        }
+    }
+    let own: Vec<&String> = sweep[run.len()..].iter().collect();
+    assert!(
+        !own.is_empty() && own.iter().all(|w| !w.starts_with(EXPERIMENT_WARNING)),
+        "{sweep:?}"
+    );
+}
