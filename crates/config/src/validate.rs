@@ -52,9 +52,14 @@ impl Config {
             .all(|s| p.section_clean(s))
             && p.clean(&["experiment.rates_dps"])
         {
-            self.validate_regime(&mut p, &mut warnings);
-            self.validate_table_alias(&mut p);
-            self.validate_settling(&mut p, &mut warnings);
+            // Under a `[pll]` the run holds the carrier where the lock ends, on the locked
+            // mode's resonance, not at `drive.carrier_hz`, where it starts (the rules judged
+            // a 6-bit DAC's pattern at 15010 Hz for a run at 15000.0006 Hz).
+            let held = self.expected_lock();
+            let judged = held.as_ref().unwrap_or(self);
+            judged.validate_regime(&mut p, &mut warnings, held.is_some());
+            judged.validate_table_alias(&mut p);
+            judged.validate_settling(&mut p, &mut warnings);
         }
         if for_sweep {
             for w in &mut warnings[experiment_from..] {

@@ -31,11 +31,15 @@ impl Config {
     /// [`drift_gains`]) of the theory's phase change, through the bounding box of the
     /// ratio's and relative phase's values. Rotating runs: see
     /// [`Config::rotating_dac_drift_rad`] (an exact pattern cannot move psi).
-    pub(crate) fn validate_dac_rounding(&self, warnings: &mut Vec<String>) {
+    ///
+    /// `locked` (a PLL's expected lock): the carrier ends within the loop's error of this one,
+    /// so its pattern drifts too slowly to average over a window, from an offset no rule can
+    /// know: the pattern is judged as drifting (every offset) even where this carrier repeats.
+    pub(crate) fn validate_dac_rounding(&self, warnings: &mut Vec<String>, locked: bool) {
         let Some(bits) = self.board.dac_bits else {
             return;
         };
-        let Some(pattern) = self.dac_pattern(bits) else {
+        let Some(pattern) = self.dac_pattern(bits, locked) else {
             return;
         };
         if self.shape() == Shape::Rotating {
@@ -53,6 +57,7 @@ impl Config {
             }
             return;
         }
+        let mut dynamic = 0.0;
         let (ratios, exact_ratio, drift) = match pattern {
             DacPattern::Exact([p1, p2], [q1, q2]) => {
                 (vec![(q2 / q1) / (p2 / p1)], (p2 / p1).norm(), None)
@@ -61,8 +66,12 @@ impl Config {
                 q,
                 ratios,
                 phase_span,
+                envelope,
                 ..
-            } => (ratios, self.f2() / self.drive.f1, Some((q, phase_span))),
+            } => {
+                dynamic = self.drift_dynamics_mdeg(envelope);
+                (ratios, self.f2() / self.drive.f1, Some((q, phase_span)))
+            }
         };
         let dev = self.driven_device();
         // Common gains and phases cancel in every phase the board reads (each against zero
@@ -142,6 +151,7 @@ impl Config {
             let pointwise = span / DEG * 1e3 + ratio_part;
             worst = worst.max(4.0 / core::f64::consts::PI * pointwise);
         }
+        worst = worst.max(dynamic);
         if worst > WARN_HOLD_ERROR_MDEG {
             let what = match drift {
                 None => format!(
@@ -150,18 +160,77 @@ impl Config {
                     -t_lo / DEG
                 ),
                 Some((q, span)) => format!(
-                    "the carrier's sample pattern does not repeat (it drifts against the samples, nearest {q}-sample pattern), so the DAC's rounding of the two drives changes with the drift: their fundamentals' ratio F2/F1 ranges over {:.6e} ..= {:.6e} (unrounded {exact_ratio:.6e}), their phase difference moves by {:.3e} ..= {:.3e} deg and each drive's own phase stays within +-{:.3e} deg (over every drift offset)",
+                    "the carrier's sample pattern does not repeat (it drifts against the samples, nearest {q}-sample pattern), so the DAC's rounding of the two drives changes with the drift: their fundamentals' ratio F2/F1 ranges over {:.6e} ..= {:.6e} (unrounded {exact_ratio:.6e}), their phase difference moves by {:.3e} ..= {:.3e} deg and each drive's own phase stays within +-{:.3e} deg (over every drift offset){}",
                     exact_ratio * r_lo,
                     exact_ratio * r_hi,
                     -t_hi / DEG,
                     -t_lo / DEG,
-                    span / DEG
+                    span / DEG,
+                    if dynamic > 0.0 {
+                        format!(", and the plant follows the drives' slow change with a lag that differs with the rate (up to {dynamic:.3e} mdeg of what follows, a bound)")
+                    } else {
+                        String::new()
+                    }
                 ),
             };
             warnings.push(format!(
                 "board.dac_bits = {bits}: {what}, which moves the measured phase from the theory by up to {worst:.3e} mdeg at these rates, as a drive mismatch would; raise board.dac_bits (equal drives at a whole multiple of 4 samples per carrier period round alike)"
             ));
         }
+    }
+
+    /// What the drift's slow change of the drives' fundamentals does through the plant's
+    /// dynamics in a Coriolis run, mdeg (0 for other runs). A fundamental `G(t)` that changes
+    /// slowly against the mechanical time constant reaches each mode as `R G + R' dG/dt /
+    /// (2 pi j)` (`R` the mode's response at the carrier, `R'` its frequency derivative), and
+    /// the window's average of `dG/dt` is `(G(T) - G(0)) / T`: the rate's lane and the
+    /// zero-rate reference read the same `G`, so their phases differ from the theory by at
+    /// most `|R'/R (rate) - R'/R (0)| |dG| / (2 pi T |G|)`, with `|dG|/|G|` at most
+    /// `envelope`. Twice that covers a code step within a time constant of the window's
+    /// ends; a Hann window's weights double it again. The quasi-static terms (the ratio's
+    /// box) miss it: two drives that are shifted copies (a quadrature pair at 16 samples per
+    /// period) keep their ratio at every offset, yet a 6-bit DAC on a PLL's lock moved the
+    /// phase 0.55 mdeg at 175 deg/s (this bound: see the test).
+    fn drift_dynamics_mdeg(&self, envelope: f64) -> f64 {
+        if self.shape() != Shape::Coriolis || envelope.is_nan() || envelope <= 0.0 {
+            return 0.0;
+        }
+        let dev = self.driven_device();
+        let p = &dev.plant;
+        let shift = (90.0 + dev.phase_shifter_error_deg) * DEG;
+        let force = [
+            Complex64::new(dev.drive[0], 0.0),
+            Complex64::from_polar(dev.drive[1], -shift),
+        ];
+        let fc = dev.carrier_hz;
+        let hb = (p.mode1.f0_hz / p.mode1.q).min(p.mode2.f0_hz / p.mode2.q) / 2.0;
+        let d = 1e-3 * hb;
+        // R'/R of mode m at rate w (rad/s), 1/Hz, by a central difference of ln R.
+        let slope = |w: f64, m: usize| {
+            let v = |f: f64| gyroemu_resonator::continuous_steady_state(p, w, f, force)[2 + m];
+            (v(fc + d) / v(fc - d)).ln() / (2.0 * d)
+        };
+        let window_s = self
+            .experiment
+            .rates_dps
+            .iter()
+            .map(|&r| self.plan_point(r).window.span() / self.fs_out_hz())
+            .fold(f64::INFINITY, f64::min);
+        let ends = match self.experiment.window {
+            crate::config::WindowKind::Hann => 4.0,
+            _ => 2.0,
+        };
+        let mut worst: f64 = 0.0;
+        for m in 0..2 {
+            let at_zero = slope(0.0, m);
+            for &rate in &self.experiment.rates_dps {
+                let e = (slope(rate * DEG, m) - at_zero).norm();
+                if e.is_finite() {
+                    worst = worst.max(e);
+                }
+            }
+        }
+        ends * worst * envelope / (core::f64::consts::TAU * window_s) / DEG * 1e3
     }
 
     /// What a drifting carrier pattern's rounding can do to a rotating run's psi (rad). Each
@@ -305,7 +374,10 @@ impl Config {
     /// fundamentals (each relative to its unquantised one) that the drift offset gives.
     /// `None` if a fundamental vanishes (the dead-drive rules speak) or the NCO cannot be
     /// built.
-    fn dac_pattern(&self, bits: u32) -> Option<DacPattern> {
+    ///
+    /// `any_offset`: a repeating carrier is judged as a drifting one (at beat 0), over every
+    /// offset of its pattern against the samples.
+    fn dac_pattern(&self, bits: u32, any_offset: bool) -> Option<DacPattern> {
         const MAX_SPAN: u64 = 4096;
         let nco = gyroemu_nco::Nco::new(self.carrier_hz(), self.fs_hz(), 0.0).ok()?;
         let step_word = nco.step_word();
@@ -318,12 +390,14 @@ impl Config {
         // A pattern repeating only after thousands of samples still drifts within its period
         // (15001 Hz at 240 kHz repeats each second, its rounding beats at 16 Hz; a table run
         // moved 0.76 mdeg, unwarned): exact only for a short one.
-        let Some(n) = (1..=MAX_SPAN).find(|&n| near_whole(n)) else {
+        let exact = (1..=MAX_SPAN).find(|&n| near_whole(n));
+        let Some(n) = exact.filter(|_| !any_offset || self.shape() == Shape::Rotating) else {
             let x = step_word as f64 / 2f64.powi(64);
             let q = nearest_pattern(x, 4096)?;
             let beat = (q as f64 * x - (q as f64 * x).round()).abs() * self.fs_hz();
             let mut ratios = Vec::new();
             let mut phase_span: f64 = 0.0;
+            let mut envelope: f64 = 0.0;
             let cuts = 2.0 * q as f64 + core::f64::consts::TAU * (gains[0] + gains[1]) / lsb;
             if self.shape() != Shape::Rotating && cuts > MAX_DRIFT_CUTS {
                 // Too fine a DAC to follow every threshold (a few ms per 1e6): each sample's
@@ -335,6 +409,7 @@ impl Config {
                     .map(|(r, t)| Complex64::from_polar(1.0 + r, t))
                     .to_vec();
                 phase_span = eps.min(1.0).asin();
+                envelope = 2.0 * eps / (1.0 - eps.min(0.5));
             } else if self.shape() != Shape::Rotating {
                 let s = shifter.apply(Complex64::new(1.0, 0.0));
                 let drives = [(gains[0], 0.0), (gains[1] * s.norm(), s.arg())];
@@ -378,10 +453,16 @@ impl Config {
                         ratios: vec![Complex64::new(0.0, 0.0)],
                         beat,
                         phase_span: core::f64::consts::PI,
+                        envelope: 0.0,
                     });
                 }
                 for t in &tan {
                     phase_span = phase_span.max(0.5 * (t.1.atan() - t.0.atan()));
+                }
+                // Every G_k has a positive real part here: |G_k| >= its smallest one.
+                for k in 0..2 {
+                    let diam = (re[k].1 - re[k].0).hypot(im[k].1 - im[k].0);
+                    envelope = envelope.max(diam / re[k].0);
                 }
                 // A Coriolis window that spans many beats averages each drive over the whole
                 // offset range but at most one partial beat, so its average lies within
@@ -423,6 +504,7 @@ impl Config {
                 ratios,
                 beat,
                 phase_span,
+                envelope,
             });
         };
         let quantise = |x: f64| dac_code(x, lsb, half) * lsb;
@@ -460,6 +542,9 @@ enum DacPattern {
         beat: f64,
         /// Half the range of either drive's own fundamental phase over the offset, rad.
         phase_span: f64,
+        /// The largest distance between two values of either drive's fundamental over the
+        /// offset, relative to its smallest magnitude (0 where not followed).
+        envelope: f64,
     },
 }
 
@@ -563,18 +648,39 @@ fn drift_gains(
         .iter()
         .map(|&phi| Complex64::from_polar(1.0, -phi))
         .collect();
-    visit((ends[0], rot[0]), (ends[1], rot[1]), &sums);
+    // An interval narrower than this share of the offset range is one a run sits in with
+    // that chance at most: two drives that are shifted copies (a quadrature drive at a
+    // multiple of 4 samples per period) cross their thresholds at the same offset but for
+    // the rounding of their phases, and the sliver between read a mismatch of a whole code
+    // (113 mdeg stated, 0.55 measured, on a PLL's lock at 16 samples per period, 6 bits).
+    let wide = |lo: f64, hi: f64| hi - lo > SLIVER * w;
+    if wide(ends[0], ends[1]) {
+        visit((ends[0], rot[0]), (ends[1], rot[1]), &sums);
+    }
+    let mut past = 0;
     for (i, &(_, k, m)) in cuts.iter().enumerate() {
         let (lo, hi) = (ends[i + 1], ends[i + 2]);
+        // The code just past the crossing, read clear of its threshold: at the middle of the
+        // next interval that is not a sliver. Two drives crossing at one offset (but for
+        // rounding) left a zero-width interval whose middle sat on the threshold, the code
+        // was not moved, and the stale code read a mismatch of a whole code from there on.
+        past = past.max(i + 2);
+        while past + 1 < ends.len() && !wide(lo, ends[past]) {
+            past += 1;
+        }
         let (a, beta) = drives[k];
-        let new = code(a * (TAU * m as f64 / q as f64 + beta + 0.5 * (lo + hi)).cos());
+        let new = code(a * (TAU * m as f64 / q as f64 + beta + 0.5 * (lo + ends[past])).cos());
         let old = &mut codes[k][m as usize];
         if new != *old {
             sums[k] += unit(k, m) * (new - *old);
             *old = new;
         }
-        if hi > lo {
+        if wide(lo, hi) {
             visit((lo, rot[i + 1]), (hi, rot[i + 2]), &sums);
         }
     }
 }
+
+/// See [`drift_gains`]: intervals of the drift offset narrower than this share of its range
+/// are not weighed.
+const SLIVER: f64 = 1e-9;

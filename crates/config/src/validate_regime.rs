@@ -65,7 +65,9 @@ impl Config {
     /// The regime rules, for a config whose keys are each valid; appends warnings. An
     /// unstable plant or a node out of range stops them (the rest would weigh a chain that
     /// cannot run).
-    pub(crate) fn validate_regime(&self, p: &mut Rules, warnings: &mut Vec<String>) {
+    /// `locked`: this is a `[pll]` config's expected lock ([`Config::expected_lock`]), whose
+    /// carrier sits near, not on, its value, at an offset against the samples no rule can know.
+    pub(crate) fn validate_regime(&self, p: &mut Rules, warnings: &mut Vec<String>, locked: bool) {
         if let Err(e) = self.resonator_params().validate() {
             let key = match e.param {
                 "quadrature_coupling_rad2_s2" => "device.quadrature_coupling_rad2_s2",
@@ -93,7 +95,7 @@ impl Config {
         ]) {
             self.validate_noise_phase(warnings);
         }
-        self.validate_dac_rounding(warnings);
+        self.validate_dac_rounding(warnings, locked);
         self.validate_mixer_product(warnings);
         self.validate_table_harmonics(warnings);
         self.validate_table_step(warnings);

@@ -110,14 +110,18 @@ fn the_rotating_excitation_does_not_depend_on_the_drives_ratio() {
 
 /// As [`config`], with the carrier set by hand.
 fn config_at(kind: &str, carrier: f64, dac: &str, rates: &str, average: f64) -> Config {
-    parse_config(&format!(
+    parse_config(&text_at(kind, carrier, dac, rates, average)).unwrap()
+}
+
+/// The text of [`config_at`].
+fn text_at(kind: &str, carrier: f64, dac: &str, rates: &str, average: f64) -> String {
+    format!(
         "[device]\nf0_hz = 15000.0\nq = 2000.0\nangular_gain = 1.0\n\
          [drive]\nf1 = 1.0\nf2 = 1.0\ncarrier_hz = {carrier:?}\n\
          [board]\nfs_hz = 240000.0\ntia_gain_ohm = 1e6\ntia_pole_hz = 60000.0\nlpf_order = 4\n\
          lpf_cutoff_hz = 200.0\ndecimation = 100\ndac_full_scale = 1.5\n{dac}\n\
          [experiment]\nkind = \"{kind}\"\nrates_dps = {rates}\naverage_s = {average:?}\n"
-    ))
-    .unwrap()
+    )
 }
 
 /// The Coriolis lag of every point and mode against the zero-rate point, rad.
@@ -176,4 +180,47 @@ fn a_drifting_carrier_pattern_is_stated_and_the_runs_stay_within_the_bound() {
     let ideal = config_at("rotating", 15000.0, "", "[360.0, 720.0]", 1.0);
     let e = largest_change_mdeg(&raw_psi(&c), &raw_psi(&ideal));
     assert!(e < 1e-3, "{e} mdeg");
+}
+
+/// A `[pll]` run holds the carrier where the lock ends: within the loop's error of the
+/// resonance, at an offset against the samples no rule can know. The rules judged the
+/// nominal start instead (15010 Hz, a 1503-sample pattern), and a lock started on the
+/// resonance was judged as an exact 16-sample pattern and left unwarned while a 6-bit DAC
+/// moved its run by 0.55 mdeg. Now the lock's carrier is judged at every offset: equal
+/// quadrature drives at 16 samples per period are shifted copies, so their ratio stays 1 at
+/// every offset (the stated range), and what remains is the plant following the drives' slow
+/// change, bounded; runs at carriers a lock can end at stay within the bound.
+#[test]
+fn a_pll_lock_is_judged_near_the_resonance_at_every_offset() {
+    let rates = "[25.0, 175.0]";
+    for (bits, start) in [(6, 15010.0), (8, 15000.0)] {
+        let dac = format!("dac_bits = {bits}");
+        let c = text_at("coriolis", start, &dac, rates, 2.0) + "[pll]\nmode = 1\n";
+        let c = parse_config(&c).unwrap();
+        let w = c.validate().unwrap();
+        let bound = stated_mdeg(&w, "board.dac_bits").expect("a DAC warning");
+        let s = w.iter().find(|s| s.starts_with("board.dac_bits")).unwrap();
+        assert!(s.contains("nearest 16-sample pattern"), "{s}");
+        let range = &s[s.find("ranges over ").unwrap() + 12..];
+        let (lo, hi) = range.split_once(" ..= ").unwrap();
+        let hi = hi.split_once(' ').unwrap().0;
+        for v in [lo, hi] {
+            let v: f64 = v.parse().unwrap();
+            assert!((v - 1.0).abs() < 1e-6, "the ratio of shifted copies: {s}");
+        }
+        let mut seen: f64 = 0.0;
+        for delta in [2e-4, 5.88e-4, 2e-3, 1e-2] {
+            let carrier = 15000.0 + delta;
+            let e = largest_change_mdeg(
+                &lags(&config_at("coriolis", carrier, &dac, rates, 2.0)),
+                &lags(&config_at("coriolis", carrier, "", rates, 2.0)),
+            );
+            assert!(
+                e <= bound,
+                "{bits} bits at {carrier} Hz: {e} > {bound} mdeg"
+            );
+            seen = seen.max(e);
+        }
+        assert!(seen > 0.05, "the case must show the effect: {seen} mdeg");
+    }
 }
