@@ -106,6 +106,33 @@ fn shards_by_flag_and_by_kubernetes_index_merge_to_the_one_machine_lot() {
     );
 }
 
+/// What validation warned of on stderr (the config's rules, and the drawn devices' grouped by
+/// text) is in `montecarlo.json` too: a lot read later had only the run's own warnings.
+#[test]
+fn the_validation_warnings_are_in_the_lots_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = tiny().replacen("settle_s = 0.1", "settle_s = 0.02", 1);
+    let cfg = config(dir.path(), "lot.toml", &text);
+    let out = dir.path().join("out");
+    let o = ok(lot(&cfg, &out, "2", &["--devices", "3"], &[]));
+    let prefix = format!("warning: {}: ", cfg.display());
+    let said: Vec<String> = stderr(&o)
+        .lines()
+        .filter_map(|l| l.strip_prefix(&prefix).map(String::from))
+        .collect();
+    assert!(said.iter().any(|w| w.contains("settle_s")), "{said:?}");
+    let m = json(&out.join("montecarlo.json"));
+    let kept: Vec<&str> = m["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect();
+    for w in &said {
+        assert!(kept.contains(&w.as_str()), "{w} not in {kept:?}");
+    }
+}
+
 #[test]
 fn a_printed_device_self_calibrates_to_the_lots_error() {
     let dir = tempfile::tempdir().unwrap();
