@@ -35,6 +35,9 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
     // With a [pll], both sweeps run at the carrier it locks (the drift scenario locks again at
     // each temperature).
     let (held, lock) = resolve_lock(cfg)?;
+    if let Some(l) = &lock {
+        reporter.note(&l.note());
+    }
     let (rot_cfg, cor_cfg) = sweep_configs(&held);
     let p = reporter.task("rotating sweep");
     let rotating = run_sweep(&rot_cfg, &|d, t| p.update(d, t), None)?;

@@ -25,6 +25,30 @@ pub struct CarrierLock {
     pub trace: Vec<LockSample>,
 }
 
+impl CarrierLock {
+    /// `cfg` as its sweeps run after this lock: the carrier held where the lock ended, the
+    /// `[pll]` section spent.
+    pub fn hold(&self, cfg: &Config) -> Config {
+        let mut held = cfg.clone();
+        held.drive.carrier_hz = Some(self.carrier_hz);
+        held.pll = None;
+        held
+    }
+
+    /// What the lock did, for the run's log: `pll: locked the carrier at F Hz after T s
+    /// (started at S Hz; ...)`.
+    pub fn note(&self) -> String {
+        format!(
+            "pll: locked the carrier at {} Hz after {} (started at {} Hz; the locked mode resonates at {} Hz as configured); the sweep runs at that carrier",
+            self.carrier_hz,
+            self.lock_time_s
+                .map_or("the lock run".to_string(), |t| format!("{t:.3} s")),
+            self.nominal_hz,
+            self.resonance_hz
+        )
+    }
+}
+
 /// The PLL that `design` (the config whose `[pll]`, device and board define the loop) puts on
 /// the board of `cfg`: its nominal carrier `cfg`'s, its update rate the decimated rate, its
 /// gains from the locked mode's nominal tau, its phase offset the chain's phase at the carrier
@@ -114,8 +138,5 @@ pub fn resolve_lock(cfg: &Config) -> Result<(Config, Option<CarrierLock>), Sweep
     let Some(lock) = lock_config_carrier(cfg, cfg)? else {
         return Ok((cfg.clone(), None));
     };
-    let mut held = cfg.clone();
-    held.drive.carrier_hz = Some(lock.carrier_hz);
-    held.pll = None;
-    Ok((held, Some(lock)))
+    Ok((lock.hold(cfg), Some(lock)))
 }

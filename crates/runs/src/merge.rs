@@ -64,7 +64,7 @@ fn merge_run(dir: &Path, split: Split, reporter: &dyn Reporter) -> Result<Vec<Pa
     // The shards swept at the carrier a [pll] locked: lock again (the same bits) to read out.
     let (held, lock) = resolve_lock(&cfg)?;
     if let Some(l) = &lock {
-        reporter.note(&crate::run::lock_note(l));
+        reporter.note(&l.note());
     }
     let r = finish_sweep(&held, &lanes)?;
     let written = write_run(dir, &held, &r, &run_title(&cfg)).map_err(RunError::from);

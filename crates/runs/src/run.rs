@@ -15,8 +15,8 @@ use gyroemu_board::LaneResult;
 use gyroemu_config::Config;
 use gyroemu_experiment::work::{measured_throughput, points_work};
 use gyroemu_experiment::{
-    dump_point, finish_sweep, resolve_lock, run_sweep_with, sweep_work, CarrierLock, Reporter,
-    SweepOptions, Work,
+    dump_point, finish_sweep, resolve_lock, run_sweep_with, sweep_work, Reporter, SweepOptions,
+    Work,
 };
 use gyroemu_report::{check_problems, run_title, write_run};
 use std::path::{Path, PathBuf};
@@ -213,7 +213,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     // (deterministic: a resume, a shard and a merge lock to the same bits).
     let (held, lock) = resolve_lock(cfg).map_err(|e| ledger.fail(e.into(), &prev))?;
     if let Some(l) = &lock {
-        reporter.note(&lock_note(l));
+        reporter.note(&l.note());
     }
     let saved = AtomicUsize::new(0);
     let on_group = |pts: &[(usize, LaneResult)]| -> Result<(), String> {
@@ -279,16 +279,4 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     let files = RunError::refused_unless(check, files).map_err(|e| ledger.fail(e, &swept.lanes))?;
     ledger.complete(&swept.lanes)?;
     Ok(RunOutcome::Complete(files))
-}
-
-/// What a lock did, for the run's log.
-pub fn lock_note(l: &CarrierLock) -> String {
-    format!(
-        "pll: locked the carrier at {} Hz after {} (started at {} Hz; the locked mode resonates at {} Hz as configured); the sweep runs at that carrier",
-        l.carrier_hz,
-        l.lock_time_s
-            .map_or("the lock run".to_string(), |t| format!("{t:.3} s")),
-        l.nominal_hz,
-        l.resonance_hz
-    )
 }

@@ -28,7 +28,12 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
     prepare_out(out)?;
     let _lock = lock_out(out, &command_line(), LockScope::Folder, &Terminal)?;
     let report = run_selfcal(&cfg, &Terminal)?;
-    let files = write_selfcal(out, &cfg, &report)?;
+    // With a [pll], the files name the carrier the sweeps ran at, as `run`'s do.
+    let ran = report
+        .lock
+        .as_ref()
+        .map_or_else(|| cfg.clone(), |l| l.hold(&cfg));
+    let files = write_selfcal(out, &ran, &report)?;
     if !files.removed.is_empty() {
         let names: Vec<String> = files
             .removed
