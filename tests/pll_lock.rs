@@ -26,11 +26,15 @@ fn fork() -> Config {
     )
 }
 
-fn with_pll(mut c: Config, start_offset_hz: f64) -> Config {
+fn with_pll(c: Config, start_offset_hz: f64) -> Config {
+    with_damped_pll(c, start_offset_hz, core::f64::consts::FRAC_1_SQRT_2)
+}
+
+fn with_damped_pll(mut c: Config, start_offset_hz: f64, damping: f64) -> Config {
     c.drive.carrier_hz = Some(c.device.f0_hz + start_offset_hz);
     c.pll = Some(gyroemu::config::PllConfig {
         natural_hz: None,
-        damping: core::f64::consts::FRAC_1_SQRT_2,
+        damping,
         lock_s: None,
         mode: 1,
     });
@@ -170,4 +174,29 @@ fn with_pll_unchecked(mut c: Config) -> Config {
         mode: 1,
     });
     c
+}
+
+/// An overdamped loop settles on its slow pole, w_n (zeta - sqrt(zeta^2 - 1)), about
+/// w_n/(2 zeta): the default lock run, 10 time constants 1/(zeta w_n), shrank as zeta grew,
+/// and every default lock from zeta = 1.5 on ended unlocked. Now it covers 10 of the slow
+/// pole's, and each lock lands where the chain's phase says, as at the default damping.
+#[test]
+fn an_overdamped_loop_locks_within_its_default_lock_run() {
+    let half_bw = 15e3 / (2.0 * 2000.0);
+    for zeta in [1.5, 3.0] {
+        let c = with_damped_pll(fork(), 2.0 * half_bw, zeta);
+        let w_n = core::f64::consts::TAU * c.pll_natural_hz().unwrap();
+        let slow = 1.0 / (w_n * (zeta - (zeta * zeta - 1.0).sqrt()));
+        assert!((c.pll_time_constant_s().unwrap() / slow - 1.0).abs() < 1e-12);
+        let p = pll_params(&c, &c).unwrap().unwrap();
+        let lock = lock_config_carrier(&c, &c)
+            .unwrap_or_else(|e| panic!("zeta {zeta}: {e}"))
+            .unwrap();
+        let want = true_lock_hz(&c, p.phase_offset_rad, 15e3 - 10.0, 15e3 + 10.0);
+        assert!(
+            (lock.carrier_hz - want).abs() < 1e-4 * half_bw,
+            "zeta {zeta}: locked {} Hz, truth {want} Hz",
+            lock.carrier_hz
+        );
+    }
 }

@@ -438,15 +438,29 @@ impl Config {
     }
 
     /// The lock run's length, s (set, or 16 mechanical time constants of the locked mode plus
-    /// 10 loop time constants 1/(zeta w_n)); `None` without a `[pll]` section.
+    /// 10 of the loop's [`Config::pll_time_constant_s`]); `None` without a `[pll]` section.
     pub fn pll_lock_s(&self) -> Option<f64> {
         let p = self.pll.as_ref()?;
-        let natural = self.pll_natural_hz()?;
+        let loop_tau = self.pll_time_constant_s()?;
         Some(p.lock_s.unwrap_or_else(|| {
             let q = self.device.q.max(self.device.q_mode2.unwrap_or(0.0));
-            16.0 * q / (core::f64::consts::PI * self.device.f0_hz)
-                + 10.0 / (p.damping * core::f64::consts::TAU * natural)
+            16.0 * q / (core::f64::consts::PI * self.device.f0_hz) + 10.0 * loop_tau
         }))
+    }
+
+    /// The closed loop's slowest time constant, s: its poles are `-w_n (zeta -+ sqrt(zeta^2 -
+    /// 1))`, so 1/(zeta w_n) up to critical damping and 1/(w_n (zeta - sqrt(zeta^2 - 1))),
+    /// about 2 zeta / w_n, above it (1/(zeta w_n) shrank with zeta there, and every default
+    /// lock of zeta >= 1.5 ended before the loop settled); `None` without a `[pll]` section.
+    pub fn pll_time_constant_s(&self) -> Option<f64> {
+        let zeta = self.pll.as_ref()?.damping;
+        let w_n = core::f64::consts::TAU * self.pll_natural_hz()?;
+        Some(if zeta <= 1.0 {
+            1.0 / (zeta * w_n)
+        } else {
+            // zeta - sqrt(zeta^2 - 1) without the cancellation: 1/(zeta + sqrt(zeta^2 - 1)).
+            (zeta + (zeta * zeta - 1.0).sqrt()) / w_n
+        })
     }
 }
 

@@ -223,13 +223,13 @@ impl Config {
             format!("must be within {lo:.4} .. {hi:.4} Hz (2 damping w_n tau >= 1, and at most a tenth of the update rate and 0.05 rad of low-pass lag)"),
         );
         }
-        if let Some(t) = self.pll_lock_s() {
-            let min = 5.0 / (pll.damping * core::f64::consts::TAU * natural);
+        if let (Some(t), Some(tau)) = (self.pll_lock_s(), self.pll_time_constant_s()) {
+            let min = 5.0 * tau;
             p.check(
                 t.is_finite() && t >= min,
                 "pll.lock_s",
                 t,
-                format!("must cover at least 5 loop time constants 1/(damping 2 pi natural_hz) = {min:.4} s"),
+                format!("must cover at least 5 of the loop's slowest time constants (1/(damping 2 pi natural_hz) up to damping 1, 1/(2 pi natural_hz (damping - sqrt(damping^2 - 1))) above) = {min:.4} s"),
             );
         }
     }
