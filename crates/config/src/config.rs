@@ -49,7 +49,7 @@ pub struct PllConfig {
     #[serde(default = "default_damping")]
     pub damping: f64,
     /// Length of the lock run, s; default 16 mechanical time constants plus 10 loop time
-    /// constants 1/(zeta w_n) (read it with [`Config::pll_lock_s`]).
+    /// constants [`Config::pll_time_constant_s`] (read it with [`Config::pll_lock_s`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lock_s: Option<f64>,
     /// The mode whose output the PLL locks on: 1 or 2.
