@@ -56,6 +56,39 @@ fn ideal_noiseless_selfcal_error_is_below_1e_4_for_lambda_1_and_0_6() {
     }
 }
 
+/// At -200 K (f0 -30 ppm/K: 90 Hz, 24 half-bandwidths above the carrier the loop starts
+/// from) the drift loop cannot pull in within its lock run: that temperature's tracked half
+/// is null with a warning naming it, and the scenario goes on (it failed the whole selfcal
+/// after its sweeps, advising a key the drift loop does not read). A temperature it can pull
+/// in is tracked as before.
+#[test]
+fn a_drift_temperature_the_loop_cannot_lock_is_null_and_said() {
+    let mut c = fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2);
+    c.selfcal = Some(SelfcalConfig {
+        f0_tc_ppm_per_k: -30.0,
+        q_tc_ppm_per_k: -3000.0,
+        ..Default::default()
+    });
+    let seen = std::sync::Mutex::new(Vec::new());
+    let record = |d: u64, t: u64| seen.lock().unwrap().push((d, t));
+    let d = drift_analysis(&c, &[-200.0, 40.0], 0.04, None, &record).unwrap();
+    let &(most, total) = seen.into_inner().unwrap().iter().max().unwrap();
+    assert_eq!(most, total, "the scenario reached {most} of {total}");
+    assert!(
+        d[0].pll.is_none() && d[0].pll_lock_time_s.is_none(),
+        "{:?}",
+        d[0]
+    );
+    let w = d[0].pll_warning.as_deref().expect("said");
+    assert!(w.contains("dT = -200 K") && w.contains("null"), "{w}");
+    assert!(d[0].open_loop.measured_deg_per_dps.is_finite());
+    assert!(
+        d[1].pll.is_some() && d[1].pll_warning.is_none(),
+        "{:?}",
+        d[1]
+    );
+}
+
 #[test]
 fn drift_selfcal_tracks_the_scale_factor_and_a_stale_one_misses_by_the_q_over_f0_ratio() {
     let mut c = fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2);

@@ -368,6 +368,9 @@ pub struct DriftPoint {
     pub pll: Option<DriftCase>,
     /// When the PLL's lock indicator came on for good, s.
     pub pll_lock_time_s: Option<f64>,
+    /// Why `pll` is `None` at this temperature though a loop fits: its lock did not hold
+    /// (the drifted resonance beyond what the loop pulls in within its lock run).
+    pub pll_warning: Option<String>,
 }
 
 /// [`drift_pll_design`] when its loop fits the board: the drift scenario then runs its
@@ -435,18 +438,36 @@ pub fn drift_analysis(
         };
         // The tracked case needs the lock, not the open-loop case: the two run side by side
         // (when one fails the other still runs to its end; the open-loop error comes first).
-        let tracked = || -> Result<(Option<DriftCase>, Option<f64>), SweepError> {
+        type Tracked = (Option<DriftCase>, Option<f64>, Option<String>);
+        let tracked = || -> Result<Tracked, SweepError> {
             let Some(design) = &design else {
-                return Ok((None, None));
+                return Ok((None, None, None));
             };
-            let lock = lock_config_carrier(&open, design)?.expect("the design has a [pll]");
+            // A lock that does not hold at one temperature leaves that temperature's tracked
+            // half out, said, rather than failing the whole selfcal after its sweeps (whose
+            // advice, pll.lock_s, named a key the drift loop does not read).
+            let lock = match lock_config_carrier(&open, design) {
+                Ok(lock) => lock.expect("the design has a [pll]"),
+                Err(SweepError::NotLocked(_)) => {
+                    at(2, 1, 1);
+                    at(3, 1, 1);
+                    return Ok((None, None, Some(format!(
+                        "selfcal.drift_delta_t_k: at dT = {dt:+} K the drift scenario's tracking PLL did not lock within its lock run ({:.4} s): the resonance moved to {} Hz, {:+.3} Hz from the carrier it starts at ({} Hz), beyond what the loop designed for the nominal device pulls in; this temperature's PLL-tracked half is null",
+                        design.pll_lock_s().unwrap_or(f64::NAN),
+                        open.device.f0_hz,
+                        open.device.f0_hz - open.carrier_hz(),
+                        open.carrier_hz()
+                    ))));
+                }
+                Err(e) => return Err(e),
+            };
             let mut tracked = open.clone();
             tracked.drive.carrier_hz = Some(lock.carrier_hz);
-            Ok((Some(case(&tracked, 2)?), lock.lock_time_s))
+            Ok((Some(case(&tracked, 2)?), lock.lock_time_s, None))
         };
         let (open_loop, tracked) = rayon::join(|| case(&open, 0), tracked);
         let open_loop = open_loop?;
-        let (pll, pll_lock_time_s) = tracked?;
+        let (pll, pll_lock_time_s, pll_warning) = tracked?;
         Ok(DriftPoint {
             delta_t_k: dt,
             f0_hz: open.device.f0_hz,
@@ -454,6 +475,7 @@ pub fn drift_analysis(
             open_loop,
             pll,
             pll_lock_time_s,
+            pll_warning,
         })
     };
     // Each offset's sweeps are lane groups of a few seconds: run side by side they fill the

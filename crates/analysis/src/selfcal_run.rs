@@ -26,6 +26,28 @@ pub struct SelfcalReport {
     pub lock: Option<CarrierLock>,
 }
 
+impl SelfcalReport {
+    /// The run's warnings: both sweeps', the Allan record's readings', then each drift
+    /// temperature whose tracking lock did not hold.
+    pub fn warnings(&self) -> Vec<String> {
+        let allan = self.allan.iter().flat_map(|a| a.warnings());
+        let drift = self
+            .drift
+            .iter()
+            .flatten()
+            .filter_map(|p| p.pll_warning.clone());
+        self.core
+            .rotating
+            .warnings
+            .iter()
+            .chain(&self.core.coriolis.warnings)
+            .cloned()
+            .chain(allan)
+            .chain(drift)
+            .collect()
+    }
+}
+
 /// What one analysis gives: its result, or `None` when the config does not ask for it.
 type Done<T> = Result<Option<T>, SweepError>;
 

@@ -108,7 +108,15 @@ fn write_selfcal_files(
             "coriolis": health_json(&core.coriolis.health),
         },
         "problems": core.rotating.problems.iter().chain(&core.coriolis.problems).collect::<Vec<_>>(),
-        "warnings": with_config_warnings(cfg.validate(), &core.rotating.warnings.iter().cloned().chain(core.coriolis.warnings.iter().cloned()).chain(allan.iter().flat_map(|a| a.warnings())).collect::<Vec<_>>()),
+        // The config's warnings and those of the sweeps selfcal derives from it, as stderr
+        // gave them, then the run's.
+        "warnings": with_config_warnings(
+            cfg.validate().and_then(|mut w| {
+                w.extend(gyroemu_analysis::selfcal::validate_selfcal(cfg)?);
+                Ok(w)
+            }),
+            &report.warnings()
+        ),
         "allan": allan.map(allan_json),
         "error_vs_averaging_time": taus,
         "drift": drift,

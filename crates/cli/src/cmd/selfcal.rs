@@ -46,16 +46,7 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
             names.join(", ")
         );
     }
-    let allan = report.allan.iter().flat_map(|a| a.warnings());
-    for w in report
-        .core
-        .rotating
-        .warnings
-        .iter()
-        .cloned()
-        .chain(report.core.coriolis.warnings.iter().cloned())
-        .chain(allan)
-    {
+    for w in report.warnings() {
         note!("warning: {w}");
     }
     let m = report.core.modes[0];
