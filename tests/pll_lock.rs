@@ -164,6 +164,15 @@ fn a_loop_that_cannot_be_built_is_refused_before_any_sample() {
     let e = c.validate().unwrap_err();
     assert_eq!(e.key.as_deref(), Some("pll.natural_hz"), "{e}");
     assert!(e.to_string().contains("no loop fits"), "{e}");
+    // The key is not in the config: the message says the value is its default.
+    assert!(e.to_string().contains("not set: its default"), "{e}");
+    let mut set = c.clone();
+    set.pll.as_mut().unwrap().natural_hz = Some(1.0);
+    let e = set.validate().unwrap_err();
+    assert!(
+        e.to_string().contains("no loop fits") && !e.to_string().contains("not set"),
+        "{e}"
+    );
 }
 
 fn with_pll_unchecked(mut c: Config) -> Config {

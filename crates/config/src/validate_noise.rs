@@ -212,7 +212,14 @@ impl Config {
             "pll.natural_hz",
             natural,
             format!(
-                "no loop fits: a PI on the frequency needs at least {lo:.4} Hz (2 damping w_n tau >= 1) but the low-pass's group delay and the update rate allow at most {hi:.4} Hz; raise board.lpf_cutoff_hz or pll.damping"
+                "{}no loop fits: a PI on the frequency needs at least {lo:.4} Hz (2 damping w_n tau >= 1) but the low-pass's group delay and the update rate allow at most {hi:.4} Hz; raise board.lpf_cutoff_hz or pll.damping",
+                // The key is not in the file: say whose value it is.
+                // (parse_config fills derived keys in: equal to the derivation is derived.)
+                if pll.natural_hz.is_none_or(|n| n.to_bits() == (lo * hi).sqrt().to_bits()) {
+                    "(not set: its default, the geometric mean of these bounds) "
+                } else {
+                    ""
+                }
             ),
         );
         if fits {
