@@ -324,8 +324,9 @@ pub fn reproduce(
         },
     );
     task.finish_writing(Some(point_samples), written);
-    for (job, (_, r, _)) in jobs.iter().zip(&runs) {
-        for w in &r.warnings {
+    for (job, (run, r, _)) in jobs.iter().zip(&runs) {
+        // The run's warnings, then why a dump recording has no WAV (as `run` says it).
+        for w in r.warnings.iter().chain(&run.dump_notes) {
             reporter.warn(&format!("{}: {w}", job.preset));
         }
         check_problems(job.preset, &r.problems)?;
