@@ -13,7 +13,7 @@ use gyroemu_board::DUMP_NODES;
 pub const MAX_RUN_SAMPLES: f64 = 9_007_199_254_740_992.0;
 
 /// How [`Config::validate_sweep`] begins a warning of the `[experiment]`'s rules.
-pub const EXPERIMENT_WARNING: &str = "weighed for `run` of [experiment] (its rates, drives and windows), which this sweep does not run: ";
+pub const EXPERIMENT_WARNING: &str = "judged for `run` of [experiment], at its rates and windows (the sweep drives one mode at a time at its own frequencies, where the figure differs; a range or clipping it names can hold here too): ";
 
 /// The same f64, bit for bit (a derived value equals its derivation exactly).
 fn same(a: f64, b: f64) -> bool {
@@ -31,7 +31,8 @@ impl Config {
     /// defaults included when the section is absent.
     /// The warnings of the rules that weigh the `[experiment]`'s operating points (its rates,
     /// settling, modulation or table) start with [`EXPERIMENT_WARNING`]: `sweep` does not
-    /// run them, and "at 5 deg/s" read as if it did.
+    /// run those points, and "at 5 deg/s" read as if it did (the ranges and clipping those
+    /// rules name can still hold for the sweep's own drive, so it is not said they do not).
     pub fn validate_sweep(&self) -> Result<Vec<String>, ConfigError> {
         self.validate_with(true, true)
     }

@@ -125,7 +125,7 @@ impl Config {
                 }
             }
         }
-        if let (Some((_, span)), Shape::RateTable { .. }) = (drift, self.shape()) {
+        if let (Some((_, span)), Shape::RateTable { freq_hz }) = (drift, self.shape()) {
             // A rate table reads the fundamental of each mode's phase at f_t, and the drift
             // moves that phase at the beat's harmonics, some near f_t: its own drive's phase
             // (half its range about the middle) and the ratio's effect at the peak rate
@@ -149,7 +149,25 @@ impl Config {
                 }
             }
             let pointwise = span / DEG * 1e3 + ratio_part;
-            worst = worst.max(4.0 / core::f64::consts::PI * pointwise);
+            let moved = 4.0 / core::f64::consts::PI * pointwise;
+            worst = worst.max(moved);
+            // The lag is the fundamental's angle: a change of `moved` against the response's
+            // amplitude A turns it by up to asin(moved / A), and by anything once it reaches
+            // A (it was stated as if it were the lag: 1248 mdeg where 5 deg/s moved the lag
+            // 12 875 mdeg, at 6 bits and 15000.01 Hz).
+            for &rate in &self.experiment.rates_dps {
+                let (amplitude, _) = dev.rate_table_response(rate * DEG, freq_hz);
+                for a in amplitude.map(|a| a.abs() / DEG * 1e3) {
+                    let lag = if moved < a {
+                        (moved / a).asin()
+                    } else {
+                        core::f64::consts::PI
+                    };
+                    if lag.is_finite() {
+                        worst = worst.max(lag / DEG * 1e3);
+                    }
+                }
+            }
         }
         worst = worst.max(dynamic);
         if worst > WARN_HOLD_ERROR_MDEG {

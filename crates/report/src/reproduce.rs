@@ -501,7 +501,7 @@ fn write_job(
     let dir = out.join(job.preset);
     // In parallel: the last experiment to finish has the pool to itself.
     let (run, figure) = rayon::join(
-        || write_run(&dir, &job.cfg, r, job.title),
+        || write_run(&dir, &job.cfg, &job.cfg, r, job.title),
         || -> Result<_, ReportError> {
             let Some(name) = figure_name(job.preset) else {
                 return Ok(None);

@@ -35,13 +35,16 @@ pub struct SelfcalFiles {
 }
 
 /// Writes the self-calibration's files into `out`, then deletes the analysis files of an
-/// earlier run that this one did not write.
+/// earlier run that this one did not write. `cfg` is the config the sweeps ran (a `[pll]`'s
+/// held carrier in place of the section), `judged` the one whose validation warnings stderr
+/// gave before the run (the user's).
 pub fn write_selfcal(
     out: &Path,
     cfg: &Config,
+    judged: &Config,
     report: &SelfcalReport,
 ) -> Result<SelfcalFiles, ReportError> {
-    let written = write_selfcal_files(out, cfg, report)?;
+    let written = write_selfcal_files(out, cfg, judged, report)?;
     let mut removed = Vec::new();
     for name in SELFCAL_ANALYSIS_FILES {
         let p = out.join(name);
@@ -60,6 +63,7 @@ pub fn write_selfcal(
 fn write_selfcal_files(
     out: &Path,
     cfg: &Config,
+    judged: &Config,
     report: &SelfcalReport,
 ) -> Result<Vec<PathBuf>, ReportError> {
     let core = &report.core;
@@ -111,8 +115,8 @@ fn write_selfcal_files(
         // The config's warnings and those of the sweeps selfcal derives from it, as stderr
         // gave them, then the run's.
         "warnings": with_config_warnings(
-            cfg.validate().and_then(|mut w| {
-                w.extend(gyroemu_analysis::selfcal::validate_selfcal(cfg)?);
+            judged.validate().and_then(|mut w| {
+                w.extend(gyroemu_analysis::selfcal::validate_selfcal(judged)?);
                 Ok(w)
             }),
             &report.warnings()

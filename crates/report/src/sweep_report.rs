@@ -81,7 +81,9 @@ pub fn results_table(r: &SweepResult) -> CsvTable {
 }
 
 /// The content of `summary.json`: deterministic (no timings), so reruns compare byte for byte.
-pub fn summary(cfg: &Config, r: &SweepResult) -> serde_json::Value {
+/// `cfg` is the config the sweep ran (a `[pll]`'s held carrier in place of the section),
+/// `judged` the one whose validation warnings stderr gave before the run (the user's).
+pub fn summary(cfg: &Config, judged: &Config, r: &SweepResult) -> serde_json::Value {
     let fit = |k: usize| {
         json!({
             "slope_deg_per_dps": r.fit[k].slope,
@@ -108,7 +110,7 @@ pub fn summary(cfg: &Config, r: &SweepResult) -> serde_json::Value {
         "point_samples_emulated": r.point_samples,
         "converter_counts": health_json(&r.health),
         "problems": r.problems,
-        "warnings": with_config_warnings(cfg.validate(), &r.warnings),
+        "warnings": with_config_warnings(judged.validate(), &r.warnings),
         "config": cfg,
     })
 }
@@ -347,17 +349,19 @@ pub fn sweep_figure(cfg: &Config, r: &SweepResult, title: &str) -> Figure {
 /// The files [`write_run`] writes into its folder.
 pub const RUN_FILES: [&str; 3] = ["results.csv", "summary.json", "plot.png"];
 
-/// Writes `results.csv`, `summary.json` and `plot.png` into `dir`; returns their paths.
+/// Writes `results.csv`, `summary.json` and `plot.png` into `dir`; returns their paths. `cfg`
+/// and `judged` as for [`summary`].
 pub fn write_run(
     dir: &Path,
     cfg: &Config,
+    judged: &Config,
     r: &SweepResult,
     title: &str,
 ) -> Result<Vec<PathBuf>, ReportError> {
     create_dir(dir)?;
     let [csv, json, png] = RUN_FILES.map(|f| dir.join(f));
     write_csv(&csv, &results_table(r))?;
-    write_json(&json, &summary(cfg, r))?;
+    write_json(&json, &summary(cfg, judged, r))?;
     render_png(&sweep_figure(cfg, r, title), &png)?;
     Ok(vec![csv, json, png])
 }

@@ -67,7 +67,7 @@ fn merge_run(dir: &Path, split: Split, reporter: &dyn Reporter) -> Result<Vec<Pa
         reporter.note(&l.note());
     }
     let r = finish_sweep(&held, &lanes)?;
-    let written = write_run(dir, &held, &r, &run_title(&cfg)).map_err(RunError::from);
+    let written = write_run(dir, &held, &cfg, &r, &run_title(&cfg)).map_err(RunError::from);
     for w in &r.warnings {
         reporter.warn(w);
     }

@@ -267,7 +267,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     }
     let written = finish_sweep(&held, &swept.lanes)
         .map_err(RunError::from)
-        .and_then(|r| Ok((write_run(out, &held, &r, &run_title(cfg))?, r)));
+        .and_then(|r| Ok((write_run(out, &held, cfg, &r, &run_title(cfg))?, r)));
     let (mut files, r) = written.map_err(|e| ledger.fail(e, &swept.lanes))?;
     for w in &r.warnings {
         reporter.warn(w);

@@ -33,7 +33,7 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
         .lock
         .as_ref()
         .map_or_else(|| cfg.clone(), |l| l.hold(&cfg));
-    let files = write_selfcal(out, &ran, &report)?;
+    let files = write_selfcal(out, &ran, &cfg, &report)?;
     if !files.removed.is_empty() {
         let names: Vec<String> = files
             .removed
