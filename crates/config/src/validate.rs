@@ -29,6 +29,7 @@ impl Config {
 
     /// [`Config::validate`] plus the rules of the `[sweep]` that `gyroemu sweep` runs, its
     /// defaults included when the section is absent.
+    ///
     /// The warnings of the rules that weigh the `[experiment]`'s operating points (its rates,
     /// settling, modulation or table) start with [`EXPERIMENT_WARNING`]: `sweep` does not
     /// run those points, and "at 5 deg/s" read as if it did (the ranges and clipping those
