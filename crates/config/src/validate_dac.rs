@@ -46,7 +46,18 @@ impl Config {
             let DacPattern::Drifting { q, beat, .. } = pattern else {
                 // Each drive's fundamental is then its envelope through one fixed describing
                 // function: both sidebands of a drive scale alike and psi does not move
-                // (measured: below 2e-7 mdeg at 4 bits).
+                // (measured: below 2e-7 mdeg at 4 bits). A lock's carrier sits near such a
+                // pattern and drifts through it slowly: that slow change is bounded apart.
+                let worst = if locked {
+                    self.rotating_lock_dynamics_mdeg(bits)
+                } else {
+                    0.0
+                };
+                if worst > WARN_HOLD_ERROR_MDEG {
+                    warnings.push(format!(
+                        "board.dac_bits = {bits}: a PLL's lock ends near, not on, a carrier whose samples repeat, so the DAC's rounding of each rotating drive drifts slowly with the carrier's offset against the samples, and the plant follows that change with a lag that differs between the two sidebands, which moves psi by up to {worst:.3e} mdeg at these rates (a bound, the rounding's share of each sideband taken at its largest, 4 LSB over the drive); raise board.dac_bits"
+                    ));
+                }
                 return;
             };
             let worst = self.rotating_dac_drift_rad(bits, q, beat) / DEG * 1e3;
@@ -249,6 +260,61 @@ impl Config {
             }
         }
         ends * worst * envelope / (core::f64::consts::TAU * window_s) / DEG * 1e3
+    }
+
+    /// The slow drift of a PLL-locked rotating run's DAC rounding seen through the plant's
+    /// dynamics, mdeg. At a fixed offset both sidebands of a drive scale alike and psi does
+    /// not move; as the offset drifts, each sideband's share of the rounding changes slowly
+    /// (by at most 4 LSB over the drive's amplitude: the rounding's fundamental is within
+    /// LSB/a of a sample pattern of amplitude a, so each sideband within 2 LSB of its A/2),
+    /// and each sideband's response follows as `R G + R' dG/dt / (2 pi j)` (see
+    /// [`Config::drift_dynamics_mdeg`]): psi, half the difference of the two sidebands'
+    /// phases, moves by at most `|R'/R(fc - fm) - R'/R(fc + fm)| / 2` times that change over
+    /// `2 pi T` and over what is left of the gain, twice for a code step near the window's
+    /// ends, twice again for Hann. An 8-bit DAC on a lock moved psi 0.15 mdeg, unwarned.
+    fn rotating_lock_dynamics_mdeg(&self, bits: u32) -> f64 {
+        let half = (1u64 << (bits - 1)) as f64;
+        let lsb = self.board.dac_full_scale / half;
+        let change = (4.0 * lsb / self.drive.f1.min(self.f2())).min(2.0);
+        let dev = self.driven_device();
+        let p = &dev.plant;
+        let fc = dev.carrier_hz;
+        let hb = (p.mode1.f0_hz / p.mode1.q).min(p.mode2.f0_hz / p.mode2.q) / 2.0;
+        let d = 1e-3 * hb;
+        let j = Complex64::new(0.0, 1.0);
+        let eps = dev.phase_shifter_error_deg * DEG;
+        let [f1, f2] = dev.drive;
+        // R'/R of mode k's velocity at the sideband `sign` of modulation fm, 1/Hz.
+        let slope = |sign: f64, fm: f64, k: usize| {
+            let turn = Complex64::from_polar(1.0, -sign * eps);
+            let force = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
+            let f = fc + sign * fm;
+            let v = |f: f64| gyroemu_resonator::continuous_steady_state(p, 0.0, f, force)[2 + k];
+            (v(f + d) / v(f - d)).ln() / (2.0 * d)
+        };
+        let ends = match self.experiment.window {
+            crate::config::WindowKind::Hann => 4.0,
+            _ => 2.0,
+        };
+        // Each sideband's gain stays within 2 LSB/F of 1, so the change is relative to at
+        // least 1 - change/2 of it (a 4-bit DAC: 0.63); none left past that.
+        let left = 1.0 - 0.5 * change;
+        if left <= 0.0 {
+            return 180.0e3;
+        }
+        let mut worst: f64 = 0.0;
+        for &rate in self.experiment.rates_dps.iter().filter(|r| **r != 0.0) {
+            let fm = rate.abs() / 360.0;
+            let window_s = self.plan_point(rate).window.span() / self.fs_out_hz();
+            for k in 0..2 {
+                let e = 0.5 * (slope(-1.0, fm, k) - slope(1.0, fm, k)).norm() * change * ends
+                    / (core::f64::consts::TAU * window_s * left);
+                if e.is_finite() {
+                    worst = worst.max(e);
+                }
+            }
+        }
+        worst / DEG * 1e3
     }
 
     /// What a drifting carrier pattern's rounding can do to a rotating run's psi (rad). Each
