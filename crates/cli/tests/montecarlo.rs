@@ -97,8 +97,13 @@ fn shards_by_flag_and_by_kubernetes_index_merge_to_the_one_machine_lot() {
     }
     let env = [("JOB_COMPLETION_INDEX", "2"), ("GYROEMU_SHARD_COUNT", "3")];
     ok(lot(&cfg, &split, "1", &["--devices", "6"], &env));
-    ok(gyroemu(&["merge", s(&split)], &[]));
+    let merged = ok(gyroemu(&["merge", s(&split)], &[]));
     assert_same_outputs(&one, &split);
+    // The merge prints the lot's figures as the one machine did.
+    assert_eq!(
+        String::from_utf8_lossy(&merged.stdout),
+        String::from_utf8_lossy(&o.stdout)
+    );
     let m = json(&split.join("manifest.json"));
     assert_eq!(
         (m["kind"].as_str(), m["status"].as_str()),

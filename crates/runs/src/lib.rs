@@ -29,7 +29,7 @@ pub use error::RunError;
 pub use lock::{lock_out, utc_text, LockInfo, LockScope, OutLock, LOCK_FILE};
 pub use lot_run::{check_lot, check_lot_size, run_lot, LotOutcome, MAX_DEVICES};
 pub use manifest::RunKind;
-pub use merge::merge;
+pub use merge::{merge, Merged};
 pub use resume::{previous_devices, previous_points};
 pub use run::{check_run, lock_subfolders, prepare_out, run, RunOutcome, RunRequest};
 pub use shard::{check_split, resolve_shard, Shard, ShardFrom};

@@ -7,17 +7,19 @@ use crate::device_file::{lot_hash, DeviceFile};
 use crate::error::RunError;
 use crate::lot_run::check_unreliable;
 use crate::merge_split::{bad, Split};
+use gyroemu_analysis::montecarlo::LotSummary;
 use gyroemu_config::parse_config;
 use gyroemu_experiment::Reporter;
 use gyroemu_report::write_lot;
 use std::path::PathBuf;
 
-/// Checks the lot's shards in `dir` and writes its files there.
+/// Checks the lot's shards in `dir` and writes its files there; returns them and the lot's
+/// figures.
 pub(crate) fn merge_lot(
     dir: &std::path::Path,
     split: Split,
     reporter: &dyn Reporter,
-) -> Result<Vec<PathBuf>, RunError> {
+) -> Result<(Vec<PathBuf>, LotSummary), RunError> {
     let (first_name, first) = (&split.first_name, &split.first);
     let n = first.points_total;
     // A hand-edited manifest could claim any size; the items are listed from it below.
@@ -66,14 +68,17 @@ pub(crate) fn merge_lot(
         })
         .collect::<Result<Vec<_>, _>>()?;
     // Untrusted devices fail the merge after its files are written: the manifest says so too.
+    let mut lot = None;
     let written = write_lot(dir, &cfg, &devices)
         .map_err(RunError::from)
         .and_then(|(files, summary)| {
             let check = check_unreliable(&dir.display().to_string(), &summary, &devices);
+            lot = Some(summary);
             RunError::refused_unless(check, files)
         });
     let (mut files, path) = split.finish(dir, n, written)?;
     files.push(path);
     reporter.note(&format!("merged {} shards ({n} devices)", split.count));
-    Ok(files)
+    let lot = lot.expect("a lot whose files were written has its summary");
+    Ok((files, lot))
 }

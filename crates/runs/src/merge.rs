@@ -7,21 +7,36 @@ use crate::error::RunError;
 use crate::manifest::RunKind;
 use crate::merge_split::{bad, read_split, Split};
 use crate::points::{config_hash, PointFile};
+use gyroemu_analysis::montecarlo::LotSummary;
 use gyroemu_config::parse_config;
 use gyroemu_experiment::{finish_sweep, resolve_lock, Reporter};
 use gyroemu_report::{check_problems, run_title, write_run};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+/// What a merge wrote, and a lot's figures (what `montecarlo` prints of it).
+#[derive(Debug)]
+pub struct Merged {
+    /// The files written.
+    pub files: Vec<PathBuf>,
+    /// A lot's summary; `None` for a sweep.
+    pub lot: Option<LotSummary>,
+}
+
 /// Checks the shards in `dir` and writes the results one machine would have written there
 /// (a sweep's `results.csv`, `summary.json`, `plot.png`; a lot's `devices.csv`,
 /// `montecarlo.json`, `histogram.png`, `percentiles.png`) and the run manifest; returns the
-/// files written.
-pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Vec<PathBuf>, RunError> {
+/// files written, and a lot's summary.
+pub fn merge(dir: &Path, reporter: &dyn Reporter) -> Result<Merged, RunError> {
     let split = read_split(dir)?;
     match split.kind {
-        RunKind::Run => merge_run(dir, split, reporter),
-        RunKind::Montecarlo => crate::lot_merge::merge_lot(dir, split, reporter),
+        RunKind::Run => merge_run(dir, split, reporter).map(|files| Merged { files, lot: None }),
+        RunKind::Montecarlo => {
+            crate::lot_merge::merge_lot(dir, split, reporter).map(|(files, lot)| Merged {
+                files,
+                lot: Some(lot),
+            })
+        }
     }
 }
 

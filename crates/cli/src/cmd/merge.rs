@@ -1,6 +1,6 @@
 //! `gyroemu merge DIR`.
 
-use crate::input::{command_line, list_written, listing_refused};
+use crate::input::{command_line, list_written, listing_refused, print_out};
 use crate::progress::Terminal;
 use crate::signals;
 use anyhow::Result;
@@ -21,7 +21,11 @@ pub fn merge_command(dir: &Path) -> Result<()> {
     } else {
         None
     };
-    let files = listing_refused(gyroemu_runs::merge(dir, &Terminal), dir, None)?;
-    list_written(dir, &files);
+    let merged = listing_refused(gyroemu_runs::merge(dir, &Terminal), dir, None)?;
+    // A lot's figures, as `montecarlo` prints them on one machine.
+    if let Some(lot) = &merged.lot {
+        print_out(&crate::cmd::montecarlo::summary_text(lot))?;
+    }
+    list_written(dir, &merged.files);
     Ok(())
 }

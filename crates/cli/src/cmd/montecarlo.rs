@@ -97,7 +97,7 @@ pub fn montecarlo_command(a: &MonteCarloArgs) -> Result<()> {
 }
 
 /// The lot's figures for the terminal.
-fn summary_text(s: &LotSummary) -> String {
+pub(crate) fn summary_text(s: &LotSummary) -> String {
     // Three decimals of a percent, or four significant digits below 0.1 % (a 1 ppm spec
     // printed as 0.000 %).
     let pct = |x: f64| {
