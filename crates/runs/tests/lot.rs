@@ -98,11 +98,15 @@ fn shards_merged_equal_one_machine_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
     let one = dir.path().join("one");
     let r = run_into(&cfg, &one, 7, None, false, None);
-    let Ok(LotOutcome::Complete { files, summary }) = r.outcome else {
+    let Ok(LotOutcome::Complete {
+        files,
+        summary: whole,
+    }) = r.outcome
+    else {
         panic!("a whole lot completes: {:?}", r.outcome);
     };
     assert_eq!(files.len(), 5, "the four lot files and the manifest");
-    assert_eq!(summary.devices, 7);
+    assert_eq!(whole.devices, 7);
     assert_eq!(r.computed, 7);
     let m = json(&one.join("manifest.json"));
     assert_eq!(
@@ -127,8 +131,10 @@ fn shards_merged_equal_one_machine_byte_for_byte() {
         json(&split.join("shard-1-of-3.json"))["points"],
         serde_json::json!([1, 4])
     );
-    let files = merge(&split, &Quiet).unwrap();
-    assert_eq!(files.len(), 5);
+    let merged = merge(&split, &Quiet).unwrap();
+    assert_eq!(merged.files.len(), 5);
+    // The merge's figures are the one machine's.
+    assert_eq!(merged.lot, Some(whole));
     assert_same_files(&one, &split);
     assert_eq!(json(&split.join("manifest.json"))["kind"], "montecarlo");
 }
