@@ -64,9 +64,9 @@ impl Config {
 
     /// With a `[pll]`, the config its sweep is expected to run: the carrier on the locked
     /// mode's resonance (where the loop steers it) and the `[pll]` spent; `None` without one.
-    /// The rules that weigh the signal at the ADC (its size, the noise against it) judge this
-    /// config: the nominal carrier is only where the lock starts, and can sit far down the
-    /// resonance's skirt.
+    /// The regime and settling rules judge this config (validation hands it to them, and
+    /// [`Config::noise_phase`] takes it): the nominal carrier is only where the lock starts,
+    /// and can sit far down the resonance's skirt.
     pub fn expected_lock(&self) -> Option<Config> {
         let p = self.pll.as_ref()?;
         let mut held = self.clone();

@@ -225,30 +225,14 @@ impl Config {
             return 0.0;
         }
         let dev = self.driven_device();
-        let p = &dev.plant;
-        let shift = (90.0 + dev.phase_shifter_error_deg) * DEG;
-        let force = [
-            Complex64::new(dev.drive[0], 0.0),
-            Complex64::from_polar(dev.drive[1], -shift),
-        ];
-        let fc = dev.carrier_hz;
-        let hb = (p.mode1.f0_hz / p.mode1.q).min(p.mode2.f0_hz / p.mode2.q) / 2.0;
-        let d = 1e-3 * hb;
-        // R'/R of mode m at rate w (rad/s), 1/Hz, by a central difference of ln R.
-        let slope = |w: f64, m: usize| {
-            let v = |f: f64| gyroemu_resonator::continuous_steady_state(p, w, f, force)[2 + m];
-            (v(fc + d) / v(fc - d)).ln() / (2.0 * d)
-        };
+        let force = dev.coriolis_force();
+        let slope = |w: f64, m: usize| log_slope(&dev.plant, w, dev.carrier_hz, force, m);
         let window_s = self
             .experiment
             .rates_dps
             .iter()
             .map(|&r| self.plan_point(r).window.span() / self.fs_out_hz())
             .fold(f64::INFINITY, f64::min);
-        let ends = match self.experiment.window {
-            crate::config::WindowKind::Hann => 4.0,
-            _ => 2.0,
-        };
         let mut worst: f64 = 0.0;
         for m in 0..2 {
             let at_zero = slope(0.0, m);
@@ -259,7 +243,17 @@ impl Config {
                 }
             }
         }
-        ends * worst * envelope / (core::f64::consts::TAU * window_s) / DEG * 1e3
+        self.window_ends() * worst * envelope / (core::f64::consts::TAU * window_s) / DEG * 1e3
+    }
+
+    /// What the drift bounds of [`Config::drift_dynamics_mdeg`] allow for the window's ends:
+    /// twice the first-order term covers a code step within a time constant of them, and a
+    /// Hann window's weights double it again.
+    fn window_ends(&self) -> f64 {
+        match self.experiment.window {
+            crate::config::WindowKind::Hann => 4.0,
+            _ => 2.0,
+        }
     }
 
     /// The slow drift of a PLL-locked rotating run's DAC rounding seen through the plant's
@@ -277,25 +271,12 @@ impl Config {
         let lsb = self.board.dac_full_scale / half;
         let change = (4.0 * lsb / self.drive.f1.min(self.f2())).min(2.0);
         let dev = self.driven_device();
-        let p = &dev.plant;
-        let fc = dev.carrier_hz;
-        let hb = (p.mode1.f0_hz / p.mode1.q).min(p.mode2.f0_hz / p.mode2.q) / 2.0;
-        let d = 1e-3 * hb;
-        let j = Complex64::new(0.0, 1.0);
-        let eps = dev.phase_shifter_error_deg * DEG;
-        let [f1, f2] = dev.drive;
         // R'/R of mode k's velocity at the sideband `sign` of modulation fm, 1/Hz.
         let slope = |sign: f64, fm: f64, k: usize| {
-            let turn = Complex64::from_polar(1.0, -sign * eps);
-            let force = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
-            let f = fc + sign * fm;
-            let v = |f: f64| gyroemu_resonator::continuous_steady_state(p, 0.0, f, force)[2 + k];
-            (v(f + d) / v(f - d)).ln() / (2.0 * d)
+            let f = dev.carrier_hz + sign * fm;
+            log_slope(&dev.plant, 0.0, f, dev.sideband_force(sign), k)
         };
-        let ends = match self.experiment.window {
-            crate::config::WindowKind::Hann => 4.0,
-            _ => 2.0,
-        };
+        let ends = self.window_ends();
         // Each sideband's gain stays within 2 LSB/F of 1, so the change is relative to at
         // least 1 - change/2 of it (a 4-bit DAC: 0.63); none left past that.
         let left = 1.0 - 0.5 * change;
@@ -763,6 +744,20 @@ fn drift_gains(
             visit((lo, rot[i + 1]), (hi, rot[i + 2]), &sums);
         }
     }
+}
+
+/// `R'/R` of mode `k`'s velocity under `force` at `f_hz` and the rate `w` (rad/s), 1/Hz: a
+/// central difference of `ln R` over a thousandth of the narrower half-bandwidth.
+fn log_slope(
+    p: &gyroemu_resonator::ResonatorParams,
+    w: f64,
+    f_hz: f64,
+    force: [Complex64; 2],
+    k: usize,
+) -> Complex64 {
+    let d = 1e-3 * (p.mode1.f0_hz / p.mode1.q).min(p.mode2.f0_hz / p.mode2.q) / 2.0;
+    let v = |f: f64| gyroemu_resonator::continuous_steady_state(p, w, f, force)[2 + k];
+    (v(f_hz + d) / v(f_hz - d)).ln() / (2.0 * d)
 }
 
 /// See [`drift_gains`]: intervals of the drift offset narrower than this share of its range

@@ -63,9 +63,6 @@ impl Config {
     /// noise dithers it (its RMS at the ADC input at least an LSB; an undithered ADC's error
     /// is systematic, and the ADC-LSB rule states it). `None` without `[noise]`.
     pub(crate) fn carrier_noise_density(&self) -> Option<[f64; 2]> {
-        if let Some(held) = self.expected_lock() {
-            return held.carrier_noise_density();
-        }
         let n = self.noise.as_ref()?;
         let b = &self.board;
         let chain = ChainResponse::new(&self.board_params()).ok()?;

@@ -228,18 +228,13 @@ impl Config {
     /// [`Config::tia_output_span`]'s amplitudes at each emulated rate (deg/s): per mode the
     /// smallest and the largest over the point's run.
     pub(crate) fn tia_output_per_rate(&self) -> Option<Vec<(f64, [LoHi; 2])>> {
-        if let Some(held) = self.expected_lock() {
-            return held.tia_output_per_rate();
-        }
         let chain = ChainResponse::new(&self.board_params()).ok()?;
         let plant = self.resonator_params();
         let dev = self.driven_device();
         let fc = self.carrier_hz();
         // Velocity to the ADC's input: transduction, the hold's fundamental, the TIA.
         let g = |f: f64| chain.dac_hold(f) * chain.tia(f) * self.device.transduction_a_s_per_m;
-        let [f1, f2] = dev.drive;
-        let shift = (90.0 + dev.phase_shifter_error_deg) * DEG;
-        let force = [Complex64::new(f1, 0.0), Complex64::from_polar(f2, -shift)];
+        let force = dev.coriolis_force();
         let mut per_rate = Vec::new();
         for rate in self.emulated_rates_dps() {
             let omega = rate * DEG;
@@ -596,12 +591,7 @@ fn rotating_sideband(
     fm: f64,
     sign: f64,
 ) -> [Complex64; 2] {
-    let [f1, f2] = dev.drive;
-    let eps = dev.phase_shifter_error_deg * DEG;
-    let turn = Complex64::from_polar(1.0, -sign * eps);
-    let j = Complex64::new(0.0, 1.0);
-    let f = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
-    let x = continuous_steady_state(&dev.plant, 0.0, fc + sign * fm, f);
+    let x = continuous_steady_state(&dev.plant, 0.0, fc + sign * fm, dev.sideband_force(sign));
     [x[2], x[3]]
 }
 

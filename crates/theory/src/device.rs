@@ -59,8 +59,7 @@ impl DrivenDevice {
         if self.is_ideal() {
             return coriolis_theta_rad(self.f0(), p.mode1.q, p.angular_gain, f1, f2, omega);
         }
-        let shift = (90.0 + self.phase_shifter_error_deg) * DEG;
-        let force = [Complex64::new(f1, 0.0), Complex64::from_polar(f2, -shift)];
+        let force = self.coriolis_force();
         let v = |w: f64| continuous_steady_state(p, w, self.carrier_hz, force);
         let (x0, x) = (v(0.0), v(omega));
         [lag_rad(x[2], x0[2]), lag_rad(x[3], x0[3])]
@@ -78,13 +77,14 @@ impl DrivenDevice {
             return [rotating_psi_rad(self.f0(), p.mode1.q, omega); 2];
         }
         let fm = omega / core::f64::consts::TAU;
-        let [f1, f2] = self.drive;
         let j = Complex64::new(0.0, 1.0);
-        let eps = self.phase_shifter_error_deg * DEG;
         let v = |sign: f64| {
-            let turn = Complex64::from_polar(1.0, -sign * eps);
-            let force = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
-            continuous_steady_state(p, 0.0, self.carrier_hz + sign * fm, force)
+            continuous_steady_state(
+                p,
+                0.0,
+                self.carrier_hz + sign * fm,
+                self.sideband_force(sign),
+            )
         };
         let (vp, vm) = (v(1.0), v(-1.0));
         let m = [
@@ -121,16 +121,12 @@ impl DrivenDevice {
             return [0.0; 2];
         }
         let fm = omega / core::f64::consts::TAU;
-        let [f1, f2] = self.drive;
         let j = Complex64::new(0.0, 1.0);
-        let eps = self.phase_shifter_error_deg * DEG;
         let Ok(plant) = Resonator::<f64>::new(&self.plant, 0.0) else {
             return [f64::NAN; 2];
         };
         let v = |sign: f64| {
-            let turn = Complex64::from_polar(1.0, -sign * eps);
-            let force = [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn];
-            plant.held_steady_state(self.carrier_hz + sign * fm, force)
+            plant.held_steady_state(self.carrier_hz + sign * fm, self.sideband_force(sign))
         };
         let (vp, vm) = (v(1.0), v(-1.0));
         let m = [
@@ -145,10 +141,20 @@ impl DrivenDevice {
     }
 
     /// The force phasors of the Coriolis drives: `F1` on mode 1, `F2` after the phase shifter.
-    fn coriolis_force(&self) -> [Complex64; 2] {
+    pub fn coriolis_force(&self) -> [Complex64; 2] {
         let [f1, f2] = self.drive;
         let shift = (90.0 + self.phase_shifter_error_deg) * DEG;
         [Complex64::new(f1, 0.0), Complex64::from_polar(f2, -shift)]
+    }
+
+    /// The force phasors of the rotating drive's sideband `sign` (+1 upper, -1 lower):
+    /// `F1/2` on mode 1 and `-+j F2/2` on mode 2, turned by the phase shifter's error
+    /// (THEORY.md section 4).
+    pub fn sideband_force(&self, sign: f64) -> [Complex64; 2] {
+        let [f1, f2] = self.drive;
+        let turn = Complex64::from_polar(1.0, -sign * self.phase_shifter_error_deg * DEG);
+        let j = Complex64::new(0.0, 1.0);
+        [Complex64::new(0.5 * f1, 0.0), -j * sign * 0.5 * f2 * turn]
     }
 
     /// The velocity envelopes of both modes on the rate table `amplitude sin(2 pi table_hz t)`
