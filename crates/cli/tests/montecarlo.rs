@@ -120,21 +120,13 @@ fn the_validation_warnings_are_in_the_lots_json() {
     let cfg = config(dir.path(), "lot.toml", &text);
     let out = dir.path().join("out");
     let o = ok(lot(&cfg, &out, "2", &["--devices", "3"], &[]));
-    let prefix = format!("warning: {}: ", cfg.display());
-    let said: Vec<String> = stderr(&o)
-        .lines()
-        .filter_map(|l| l.strip_prefix(&prefix).map(String::from))
-        .collect();
+    let err = stderr(&o);
+    let said = config_warnings(&err, &cfg);
     assert!(said.iter().any(|w| w.contains("settle_s")), "{said:?}");
     let m = json(&out.join("montecarlo.json"));
-    let kept: Vec<&str> = m["warnings"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|w| w.as_str().unwrap())
-        .collect();
+    let kept = strings(&m["warnings"]);
     for w in &said {
-        assert!(kept.contains(&w.as_str()), "{w} not in {kept:?}");
+        assert!(kept.contains(w), "{w} not in {kept:?}");
     }
 }
 

@@ -47,18 +47,9 @@ fn check_locked(cmd: &str, kind: &str, file: &str) {
     assert!(j["config"]["pll"].is_null(), "{}", j["config"]);
     // The config's warnings are those stderr gave before the run (judged for the lock to
     // come), not the held carrier's again: they disagreed where a rule judges the two apart.
-    let prefix = format!("warning: {}: ", cfg.display());
-    let said: Vec<&str> = err
-        .lines()
-        .filter_map(|l| l.strip_prefix(&prefix))
-        .collect();
+    let said = config_warnings(&err, &cfg);
     assert!(!said.is_empty(), "{cmd}: the case must warn: {err}");
-    let kept: Vec<&str> = j["warnings"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|w| w.as_str().unwrap())
-        .collect();
+    let kept = strings(&j["warnings"]);
     assert_eq!(
         &kept[..said.len().min(kept.len())],
         &said[..],

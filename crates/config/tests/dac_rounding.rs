@@ -182,6 +182,28 @@ fn a_drifting_carrier_pattern_is_stated_and_the_runs_stay_within_the_bound() {
     assert!(e < 1e-3, "{e} mdeg");
 }
 
+/// The largest change the DAC of `(kind, dac, rates, average_s)` makes to the phases `read`
+/// gives of runs at carriers a lock can end at, 15000 Hz + each of `deltas`: each change
+/// asserted within `bound`, mdeg.
+fn worst_near_lock(
+    (kind, dac, rates, average): (&str, &str, &str, f64),
+    deltas: &[f64],
+    read: fn(&Config) -> Vec<[f64; 2]>,
+    bound: f64,
+) -> f64 {
+    let mut seen: f64 = 0.0;
+    for delta in deltas {
+        let carrier = 15000.0 + delta;
+        let e = largest_change_mdeg(
+            &read(&config_at(kind, carrier, dac, rates, average)),
+            &read(&config_at(kind, carrier, "", rates, average)),
+        );
+        assert!(e <= bound, "{dac} at {carrier} Hz: {e} > {bound} mdeg");
+        seen = seen.max(e);
+    }
+    seen
+}
+
 /// A `[pll]` run holds the carrier where the lock ends: within the loop's error of the
 /// resonance, at an offset against the samples no rule can know. The rules judged the
 /// nominal start instead (15010 Hz, a 1503-sample pattern), and a lock started on the
@@ -208,19 +230,8 @@ fn a_pll_lock_is_judged_near_the_resonance_at_every_offset() {
             let v: f64 = v.parse().unwrap();
             assert!((v - 1.0).abs() < 1e-6, "the ratio of shifted copies: {s}");
         }
-        let mut seen: f64 = 0.0;
-        for delta in [2e-4, 5.88e-4, 2e-3, 1e-2] {
-            let carrier = 15000.0 + delta;
-            let e = largest_change_mdeg(
-                &lags(&config_at("coriolis", carrier, &dac, rates, 2.0)),
-                &lags(&config_at("coriolis", carrier, "", rates, 2.0)),
-            );
-            assert!(
-                e <= bound,
-                "{bits} bits at {carrier} Hz: {e} > {bound} mdeg"
-            );
-            seen = seen.max(e);
-        }
+        let deltas = [2e-4, 5.88e-4, 2e-3, 1e-2];
+        let seen = worst_near_lock(("coriolis", &dac, rates, 2.0), &deltas, lags, bound);
         assert!(seen > 0.05, "the case must show the effect: {seen} mdeg");
     }
 }
@@ -238,19 +249,8 @@ fn a_rotating_run_on_a_pll_lock_is_stated_and_holds() {
         let c = text_at("rotating", 15010.0, &dac, rates, 7.2) + "[pll]\nmode = 1\n";
         let w = parse_config(&c).unwrap().validate().unwrap();
         let bound = stated_mdeg(&w, "board.dac_bits").expect("a DAC warning");
-        let mut seen: f64 = 0.0;
-        for delta in [2e-4, 6e-4, 2e-3] {
-            let carrier = 15000.0 + delta;
-            let e = largest_change_mdeg(
-                &raw_psi(&config_at("rotating", carrier, &dac, rates, 7.2)),
-                &raw_psi(&config_at("rotating", carrier, "", rates, 7.2)),
-            );
-            assert!(
-                e <= bound,
-                "{bits} bits at {carrier} Hz: {e} > {bound} mdeg"
-            );
-            seen = seen.max(e);
-        }
+        let deltas = [2e-4, 6e-4, 2e-3];
+        let seen = worst_near_lock(("rotating", &dac, rates, 7.2), &deltas, raw_psi, bound);
         assert!(
             seen > 0.05,
             "{bits} bits: the case must show the effect: {seen} mdeg"

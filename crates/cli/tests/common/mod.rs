@@ -57,6 +57,24 @@ pub fn json(p: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
+/// A JSON array of strings, such as a file's `warnings`.
+pub fn strings(v: &Value) -> Vec<&str> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect()
+}
+
+/// The warnings a command gave on stderr for its config file `cfg`
+/// (`warning: CFG: ...`), in order.
+pub fn config_warnings<'a>(err: &'a str, cfg: &Path) -> Vec<&'a str> {
+    let prefix = format!("warning: {}: ", cfg.display());
+    err.lines()
+        .filter_map(|l| l.strip_prefix(&prefix))
+        .collect()
+}
+
 /// Every file of `names` exists in both folders with the same bytes.
 pub fn assert_same_files(a: &Path, b: &Path, names: &[&str]) {
     for f in names {
