@@ -56,6 +56,16 @@ fn ideal_noiseless_selfcal_error_is_below_1e_4_for_lambda_1_and_0_6() {
     }
 }
 
+/// `c` with the drift scenario's temperature coefficients: f0 -30 ppm/K, Q -3000 ppm/K.
+fn drifting(mut c: Config) -> Config {
+    c.selfcal = Some(SelfcalConfig {
+        f0_tc_ppm_per_k: -30.0,
+        q_tc_ppm_per_k: -3000.0,
+        ..Default::default()
+    });
+    c
+}
+
 /// At -200 K (f0 -30 ppm/K: 90 Hz, 24 half-bandwidths above the carrier the loop starts
 /// from) the drift loop cannot pull in within its lock run: that temperature's tracked half
 /// is null with a warning naming it, and the scenario goes on (it failed the whole selfcal
@@ -63,12 +73,7 @@ fn ideal_noiseless_selfcal_error_is_below_1e_4_for_lambda_1_and_0_6() {
 /// in is tracked as before.
 #[test]
 fn a_drift_temperature_the_loop_cannot_lock_is_null_and_said() {
-    let mut c = fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2);
-    c.selfcal = Some(SelfcalConfig {
-        f0_tc_ppm_per_k: -30.0,
-        q_tc_ppm_per_k: -3000.0,
-        ..Default::default()
-    });
+    let c = drifting(fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2));
     let seen = std::sync::Mutex::new(Vec::new());
     let record = |d: u64, t: u64| seen.lock().unwrap().push((d, t));
     let d = drift_analysis(&c, &[-200.0, 40.0], 0.04, None, &record).unwrap();
@@ -91,12 +96,7 @@ fn a_drift_temperature_the_loop_cannot_lock_is_null_and_said() {
 
 #[test]
 fn drift_selfcal_tracks_the_scale_factor_and_a_stale_one_misses_by_the_q_over_f0_ratio() {
-    let mut c = fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2);
-    c.selfcal = Some(SelfcalConfig {
-        f0_tc_ppm_per_k: -30.0,
-        q_tc_ppm_per_k: -3000.0,
-        ..Default::default()
-    });
+    let c = drifting(fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2));
     let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
     let nominal = core.modes[0].coriolis.slope_deg_per_dps;
     let deltas = [-30.0, 40.0];
@@ -299,13 +299,8 @@ fn an_open_loop_drift_error_carries_an_interval_as_wide_as_its_smaller_slope_mak
     let seeds = 0..6u64;
     let n = seeds.clone().count() as f64;
     for seed in seeds {
-        let mut c = fast_cfg(&rates, 3.6);
+        let mut c = drifting(fast_cfg(&rates, 3.6));
         c.noise = tia_noise(seed, 5e-12);
-        c.selfcal = Some(SelfcalConfig {
-            f0_tc_ppm_per_k: -30.0,
-            q_tc_ppm_per_k: -3000.0,
-            ..Default::default()
-        });
         let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
         let m = core.modes[0];
         let nominal = m.coriolis.slope_deg_per_dps;
