@@ -1,6 +1,6 @@
 //! A dump of a clipped run says so on its own: its SigMF metadata carries the converter events
 //! of the blocks its window spans, and `gyroemu inspect` warns where any is not zero (the
-//! run's warning is not beside the dump when it is read later).
+//! run's warning is not beside the dump when it is read later), and so does its CSV.
 
 mod common;
 
@@ -31,17 +31,20 @@ fn inspect_warns_of_a_dump_whose_window_clipped_and_only_then() {
             assert_eq!(adc > 0.5 * counted, clipped, "{stem}: {g}");
             assert_eq!(adc == 0.0, !clipped, "{stem}: {g}");
             assert_eq!(g["gyroemu:dac_clipped_samples_mode1"].as_f64(), Some(0.0));
-            let file = out.join(format!("{stem}.sigmf-meta"));
-            let o = ok(gyroemu(
-                &["inspect", s(&file), "--out", s(&dir.path().join("insp"))],
-                &[],
-            ));
-            let text = String::from_utf8_lossy(&o.stdout);
-            assert_eq!(
-                text.contains("warning: the board clipped") && text.contains("ADC mode 1: "),
-                clipped,
-                "{text}"
-            );
+            // The CSV beside the recording warns alike (its events are in the metadata).
+            for ext in ["sigmf-meta", "csv"] {
+                let file = out.join(format!("{stem}.{ext}"));
+                let o = ok(gyroemu(
+                    &["inspect", s(&file), "--out", s(&dir.path().join("insp"))],
+                    &[],
+                ));
+                let text = String::from_utf8_lossy(&o.stdout);
+                assert_eq!(
+                    text.contains("warning: the board clipped") && text.contains("ADC mode 1: "),
+                    clipped,
+                    "{ext}: {text}"
+                );
+            }
         }
     }
 }

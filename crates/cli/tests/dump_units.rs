@@ -65,7 +65,12 @@ fn inspected(file: &Path, out: &Path) -> Vec<(String, String)> {
     let o = ok(gyroemu(&["inspect", s(file), "--out", s(out)], &[]));
     String::from_utf8_lossy(&o.stdout)
         .lines()
-        .filter(|l| l.starts_with("  ") && !l.trim_start().starts_with("channel "))
+        .filter(|l| l.starts_with("  "))
+        .filter(|l| {
+            !["channel ", "note: ", "warning: "]
+                .iter()
+                .any(|p| l.trim_start().starts_with(p))
+        })
         .map(|l| {
             let mut w = l.split_whitespace();
             let (name, unit) = (w.next().unwrap(), w.next().unwrap());

@@ -95,8 +95,95 @@ pub enum DumpSource {
 pub fn read_dump(path: &Path) -> Result<Dump, IoError> {
     match dump_source(path) {
         DumpSource::Sigmf(meta) => read_sigmf(&meta),
-        DumpSource::Csv(csv) => read_csv_dump(&csv),
+        DumpSource::Csv(csv) => {
+            let mut d = read_csv_dump(&csv)?;
+            take_sibling_meta(&mut d);
+            Ok(d)
+        }
     }
+}
+
+/// A CSV carries samples only: the converter events of its window and the operating point are
+/// in the SigMF metadata gyroemu writes beside it. They are taken from there when that
+/// recording holds exactly the CSV's samples (same channels, first sample and bits, the rate
+/// within the CSV's time stamps' rounding); otherwise a note says the CSV's own reading cannot
+/// tell a clipped window from a clean one.
+fn take_sibling_meta(d: &mut Dump) {
+    let name = d.path.file_name().unwrap_or_default().to_string_lossy();
+    let meta = d.path.with_file_name(format!(
+        "{}.sigmf-meta",
+        name.strip_suffix(".csv").unwrap_or(&name)
+    ));
+    let cannot = "so the converter events of its window (a clipped DAC, TIA or ADC) are unknown \
+                  and a clipped window reads clean here";
+    if !meta.exists() {
+        d.notes.push(format!(
+            "a CSV carries no converter event counts nor operating point, and no `{}` is beside \
+             it: {cannot}",
+            meta.display()
+        ));
+        return;
+    }
+    let why_not = match read_sigmf(&meta) {
+        Err(e) => format!("could not be read ({e})"),
+        Ok(m) => match same_recording(d, &m) {
+            None => {
+                d.extra = m.extra;
+                d.notes.push(format!(
+                    "converter events and operating point from `{}`, which holds the same \
+                     samples",
+                    meta.display()
+                ));
+                return;
+            }
+            Some(differs) => format!("holds another recording ({differs})"),
+        },
+    };
+    d.notes.push(format!(
+        "`{}` beside this CSV {why_not}, {cannot}",
+        meta.display()
+    ));
+}
+
+/// What differs between a CSV's recording and a SigMF one, if anything.
+fn same_recording(csv: &Dump, sigmf: &Dump) -> Option<String> {
+    let names = |d: &Dump| {
+        d.channels
+            .iter()
+            .map(|c| c.name.clone())
+            .collect::<Vec<_>>()
+    };
+    if names(csv) != names(sigmf) {
+        return Some(format!(
+            "channels {:?}, the CSV's {:?}",
+            names(sigmf),
+            names(csv)
+        ));
+    }
+    if csv.global_index != sigmf.global_index || csv.frames() != sigmf.frames() {
+        return Some(format!(
+            "{} samples from index {}, the CSV's {} from {}",
+            sigmf.frames(),
+            sigmf.global_index,
+            csv.frames(),
+            csv.global_index
+        ));
+    }
+    // The CSV's rate is read from its time column to 1e-6 of itself (read_csv_dump refuses
+    // worse).
+    if (csv.sample_rate_hz / sigmf.sample_rate_hz - 1.0).abs() > 2e-6 {
+        return Some(format!(
+            "{} Hz, the CSV's {} Hz",
+            sigmf.sample_rate_hz, csv.sample_rate_hz
+        ));
+    }
+    let same_bits = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    let same = csv
+        .data
+        .iter()
+        .zip(&sigmf.data)
+        .all(|(a, b)| same_bits(a, b));
+    (!same).then(|| "other sample values".to_string())
 }
 
 fn read_err(path: &Path, reason: impl Into<String>) -> IoError {

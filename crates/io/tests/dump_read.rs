@@ -61,8 +61,80 @@ fn sigmf_and_csv_read_back_bit_exact() {
     // The rate from the sample and time columns: exact to the time stamps' rounding.
     assert!((d.sample_rate_hz / 2_400.0 - 1.0).abs() < 1e-9);
     assert!((d.t0_s - 99.0 / 240_000.0).abs() < 1e-9);
-    assert!(d.extra.is_empty());
+    // The operating point (and converter events) from the metadata beside it.
+    assert_eq!(d.extra.get("f0_hz"), Some(&15_000.0));
+    assert_eq!(d.extra.get("omega_hz"), Some(&0.25));
+    assert_eq!(d.notes.len(), 1, "{:?}", d.notes);
+    assert!(
+        d.notes[0].contains("holds the same samples"),
+        "{:?}",
+        d.notes
+    );
     check_samples(&d, &r);
+}
+
+/// A CSV read alone, or beside metadata of another recording, takes no events from it and
+/// says that a clipped window would read clean.
+#[test]
+fn a_csv_takes_the_metadata_beside_it_only_for_the_same_samples() {
+    let unknown = "a clipped window reads clean here";
+    let check = |edit: &dyn Fn(&Path), needle: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        recorder().write(dir.path(), "x").unwrap();
+        edit(dir.path());
+        let d = read_dump(&dir.path().join("x.csv")).unwrap();
+        assert!(d.extra.is_empty(), "{needle}: {:?}", d.extra);
+        assert_eq!(d.notes.len(), 1, "{:?}", d.notes);
+        let note = &d.notes[0];
+        assert!(note.contains(needle) && note.contains(unknown), "{note}");
+    };
+    let meta = |dir: &Path| dir.join("x.sigmf-meta");
+    check(
+        &|dir| std::fs::remove_file(meta(dir)).unwrap(),
+        "a CSV carries no converter event counts",
+    );
+    check(
+        &|dir| std::fs::write(meta(dir), "{").unwrap(),
+        "could not be read (",
+    );
+    // One sample's last digit edited in the CSV: still a valid CSV, not the same samples.
+    check(
+        &|dir| {
+            let path = dir.join("x.csv");
+            let mut rows = lines(&path);
+            let cells: Vec<String> = rows[5].split(',').map(String::from).collect();
+            let v: f64 = cells[4].parse().unwrap();
+            rows[5] = [&cells[..4], &[format!("{:?}", v * (1.0 + 1e-15))]]
+                .concat()
+                .join(",");
+            write_lines(&path, &rows);
+        },
+        "other sample values",
+    );
+    check(
+        &|dir| {
+            edit_meta(&meta(dir), |m| {
+                m["captures"][0]["core:global_index"] = serde_json::json!(1_001);
+            });
+        },
+        "300 samples from index 1001, the CSV's 300 from 1000",
+    );
+    check(
+        &|dir| {
+            edit_meta(&meta(dir), |m| {
+                m["global"]["core:sample_rate"] = serde_json::json!(2_401.0)
+            })
+        },
+        "2401 Hz, the CSV's",
+    );
+    check(
+        &|dir| {
+            edit_meta(&meta(dir), |m| {
+                m["global"]["gyroemu:channels"][1]["name"] = serde_json::json!("tia2_v");
+            });
+        },
+        "channels [",
+    );
 }
 
 #[test]
