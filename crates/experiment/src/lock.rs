@@ -35,14 +35,15 @@ impl CarrierLock {
         held
     }
 
-    /// What the lock did, for the run's log: `pll: locked the carrier at F Hz after T s
-    /// (started at S Hz; ...)`.
+    /// What the lock did, for the run's log: `pll: locked the carrier at F Hz, the lock
+    /// indicator on from T s (started at S Hz; ...)`. T is when the indicator came on for
+    /// good, about a loop period after the error entered its band.
     pub fn note(&self) -> String {
         format!(
-            "pll: locked the carrier at {} Hz after {} (started at {} Hz; the locked mode resonates at {} Hz as configured); the sweep runs at that carrier",
+            "pll: locked the carrier at {} Hz, the lock indicator on from {} (started at {} Hz; the locked mode resonates at {} Hz as configured); every sweep that follows runs at that carrier",
             self.carrier_hz,
             self.lock_time_s
-                .map_or("the lock run".to_string(), |t| format!("{t:.3} s")),
+                .map_or("the end of the lock run".to_string(), |t| format!("{t:.3} s")),
             self.nominal_hz,
             self.resonance_hz
         )
