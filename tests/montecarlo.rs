@@ -33,6 +33,30 @@ fn device(cfg: &Config, i: u64) -> DeviceResult {
 }
 
 #[test]
+fn a_lot_ignores_what_selfcal_ignores() {
+    // Rate 0 beside the preset's rotating `kind` and a `[dump]` at a rate not listed: `run`
+    // refuses both, a lot (selfcal on each device) reads neither.
+    let clean = tiny();
+    assert_eq!(
+        clean.experiment.kind,
+        gyroemu::config::ExperimentKind::Rotating
+    );
+    let mut c = clean.clone();
+    c.experiment.rates_dps.insert(0, 0.0);
+    c.dump = Some(gyroemu::config::DumpConfig {
+        rate_dps: Some(60.0),
+        start_s: None,
+        duration_s: None,
+        nodes: None,
+    });
+    assert!(c.validate().is_err());
+    assert_eq!(
+        validate_lot(&c, &[0, 1]).unwrap(),
+        validate_lot(&clean, &[0, 1]).unwrap()
+    );
+}
+
+#[test]
 fn each_device_equals_selfcal_on_its_own_config_bit_for_bit() {
     let cfg = tiny();
     let devices = [0u64, 5, 17];

@@ -423,6 +423,41 @@ fn rate_0_is_refused_in_a_rotating_run_and_left_out_of_selfcals_rotating_sweep()
 }
 
 #[test]
+fn selfcal_judges_the_config_as_it_reads_it_not_the_parts_it_ignores() {
+    // `run` refuses each of these; selfcal ignores what it refuses on (its rotating sweep
+    // leaves rate 0 out whatever `kind` says; `[dump]`, `rate_table` and `table_freq_hz` are
+    // not its), so it must accept them with the warnings of the config without them.
+    use gyroemu::config::{DumpConfig, RateTable};
+    let clean = fast_cfg(&[50.0, 100.0, 150.0], 7.2);
+    let want = validate_selfcal(&clean).unwrap();
+    let mut with_zero = clean.clone();
+    with_zero.experiment.rates_dps.insert(0, 0.0);
+    let mut dumped = clean.clone();
+    dumped.dump = Some(DumpConfig {
+        rate_dps: Some(60.0),
+        start_s: None,
+        duration_s: None,
+        nodes: None,
+    });
+    let mut table = clean.clone();
+    table.experiment.rate_table = RateTable::Sinusoid;
+    table.experiment.table_freq_hz = Some(1.0);
+    for (what, c) in [("rate 0", &with_zero), ("dump", &dumped), ("table", &table)] {
+        assert!(c.validate().is_err(), "{what}: run refuses it");
+        assert_eq!(validate_selfcal(c).unwrap(), want, "{what}");
+        let (rot, _) = gyroemu::analysis::selfcal::sweep_configs(c);
+        assert_eq!(rot.experiment.rates_dps, [50.0, 100.0, 150.0], "{what}");
+    }
+    // What selfcal does read is judged still: the same parts beside a too short average.
+    for c in [&with_zero, &dumped, &table] {
+        let mut short = c.clone();
+        short.experiment.average_s = 2.0;
+        let e = validate_selfcal(&short).unwrap_err();
+        assert_eq!(e.key.as_deref(), Some("experiment.average_s"), "{e}");
+    }
+}
+
+#[test]
 fn selfcal_lists_its_sweeps_problems_with_the_configs_own() {
     // A low-pass above the output Nyquist (the config's own problem) and an averaging time
     // shorter than half a period of 25 deg/s (the rotating sweep's): one message with both;
@@ -446,12 +481,15 @@ fn selfcal_names_the_run_each_added_warning_holds_for() {
     // a different size for each run selfcal makes (the rate-table sweep, each drifted
     // device). Each such warning must name its runs, and say each text once.
     let c = preset("m2tfg-selfcal").unwrap();
-    let own = c.validate().unwrap();
-    let extra = validate_selfcal(&c).unwrap();
+    // The config's own warnings (as selfcal reads it) first, then the added ones.
+    let own = gyroemu::analysis::selfcal::as_read(&c).validate().unwrap();
+    let all = validate_selfcal(&c).unwrap();
+    assert!(all.starts_with(&own), "{all:#?}");
+    let extra = &all[own.len()..];
     let dac: Vec<&String> = extra.iter().filter(|w| w.contains("dac_bits")).collect();
     assert!(dac.len() >= 2, "{extra:#?}");
     let runs = |w: &str| w.rsplit_once(" (in the ").map(|(_, r)| r.to_string());
-    for w in &extra {
+    for w in extra {
         let r = runs(w).unwrap_or_else(|| panic!("no run named: {w}"));
         assert!(r.ends_with(" of selfcal)"), "{w}");
         // Not a warning of the config itself, said again with a run named.

@@ -141,12 +141,26 @@ pub fn drift_pll_design(cfg: &Config) -> Config {
     d
 }
 
-/// Validates every config `selfcal` will run (both sweeps, and each drifted device) before
-/// any sample is computed; returns the warnings they add to those of `cfg.validate()`, or
-/// every problem in one error (the sweeps' under keys `cfg`'s own problems do not name; the
-/// analyses' configs only once `cfg` is valid).
+/// `cfg` as `selfcal` (and a lot's device) reads it: what it ignores left out (`[dump]`, the
+/// rate table's form and frequency) and, for a rotating config, rate 0, which its rotating
+/// sweep leaves out. So an unused part never refuses it (a `[dump]` naming a rate the config
+/// no longer lists did), while a rule of the kind the config names keeps its plain wording;
+/// the other kind's sweep is judged as such.
+pub fn as_read(cfg: &Config) -> Config {
+    let (rot, cor) = sweep_configs(cfg);
+    match cfg.experiment.kind {
+        ExperimentKind::Rotating => rot,
+        ExperimentKind::Coriolis => cor,
+    }
+}
+
+/// Validates every config `selfcal` will run (the config as it reads it, [`as_read`], both
+/// sweeps, and each drifted device) before any sample is computed; returns the config's
+/// warnings, then those the runs it derives add, or every problem in one error (the sweeps'
+/// under keys the config's own problems do not name; the analyses' configs only once the
+/// config is valid).
 pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
-    let base = cfg.validate();
+    let base = as_read(cfg).validate();
     // A slope needs two distinct rates besides zero, and its 95 % interval a third (the
     // residual scatter has points - 2 degrees of freedom).
     let mut distinct: Vec<f64> = Vec::new();
@@ -253,9 +267,13 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
     }
     match ConfigError::from_problems(problems) {
         Some(e) => Err(e),
-        None => Ok(warnings
+        None => Ok(base
             .into_iter()
-            .map(|(w, runs)| format!("{w} (in the {} of selfcal)", runs.join(", the ")))
+            .chain(
+                warnings
+                    .into_iter()
+                    .map(|(w, runs)| format!("{w} (in the {} of selfcal)", runs.join(", the "))),
+            )
             .collect()),
     }
 }

@@ -34,8 +34,15 @@ impl Config {
     /// settling, modulation or table) start with [`EXPERIMENT_WARNING`]: `sweep` does not
     /// run those points, and "at 5 deg/s" read as if it did (the ranges and clipping those
     /// rules name can still hold for the sweep's own drive, so it is not said they do not).
+    /// `[dump]` and `[selfcal]`, which `sweep` ignores, are not judged: an unused section
+    /// never refuses it.
     pub fn validate_sweep(&self) -> Result<Vec<String>, ConfigError> {
-        self.validate_with(true, true)
+        let read = Config {
+            dump: None,
+            selfcal: None,
+            ..self.clone()
+        };
+        read.validate_with(true, true)
     }
 
     fn validate_with(&self, sweep: bool, for_sweep: bool) -> Result<Vec<String>, ConfigError> {

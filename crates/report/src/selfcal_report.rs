@@ -115,10 +115,7 @@ fn write_selfcal_files(
         // The config's warnings and those of the sweeps selfcal derives from it, as stderr
         // gave them, then the run's.
         "warnings": with_config_warnings(
-            judged.validate().and_then(|mut w| {
-                w.extend(gyroemu_analysis::selfcal::validate_selfcal(judged)?);
-                Ok(w)
-            }),
+            gyroemu_analysis::selfcal::validate_selfcal(judged),
             &report.warnings()
         ),
         "allan": allan.map(allan_json),

@@ -64,8 +64,8 @@ pub fn validate_lot_capped(
         selfcal: None,
         ..cfg.clone()
     };
-    let mut warnings = plain.validate().map_err(LotRefusal::Config)?;
-    warnings.extend(validate_selfcal(&plain).map_err(LotRefusal::Config)?);
+    // As selfcal reads it: `[dump]`, `kind` and `rate_table` are not the lot's.
+    let mut warnings = validate_selfcal(&plain).map_err(LotRefusal::Config)?;
     let mut refused = Vec::new();
     let mut refused_devices = 0usize;
     // Warning text -> (first device, devices).
@@ -77,8 +77,7 @@ pub fn validate_lot_capped(
             .par_iter()
             .map(|&i| {
                 let dev = device_config(cfg, &draw_device(mc, i));
-                let r = dev.validate().and_then(|mut w| {
-                    w.extend(validate_selfcal(&dev)?);
+                let r = validate_selfcal(&dev).and_then(|w| {
                     // Planned only once valid: the work of a refused device means nothing.
                     let work = if force {
                         Work::default()

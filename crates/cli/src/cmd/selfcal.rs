@@ -15,10 +15,9 @@ use std::path::Path;
 /// table on the same board, plus the analyses the config asks for.
 pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
     let (cfg, text) = read_config(config)?;
-    // The config's own rules and selfcal's (its derived sweeps) in one refusal.
-    let extra = validate_selfcal(&cfg).map_err(|e| refused(config, &text, e))?;
-    let own = cfg.validate().map_err(|e| refused(config, &text, e))?;
-    for w in own.iter().chain(&extra) {
+    // The config's own rules, as selfcal reads it, and its derived runs' in one refusal.
+    let warnings = validate_selfcal(&cfg).map_err(|e| refused(config, &text, e))?;
+    for w in &warnings {
         note!("warning: {}: {w}", config.display());
     }
     let work = selfcal_work(&cfg);
