@@ -77,14 +77,14 @@ pub fn validate_lot_capped(
             .par_iter()
             .map(|&i| {
                 let dev = device_config(cfg, &draw_device(mc, i));
-                let r = validate_selfcal(&dev).and_then(|w| {
+                let r = validate_selfcal(&dev).map(|w| {
                     // Planned only once valid: the work of a refused device means nothing.
                     let work = if force {
                         Work::default()
                     } else {
                         device_work(&dev).0
                     };
-                    Ok((w, work))
+                    (w, work)
                 });
                 (i, r)
             })
