@@ -134,7 +134,7 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// Print a complete, commented config that `run` accepts.
+    /// Print a preset's commented config that `run` accepts (its keys; the guide's section 3 lists every optional one).
     Config {
         /// Preset name (default: m2tfg-coriolis); `--list` shows them.
         #[arg(long)]
