@@ -7,7 +7,7 @@
 mod common;
 
 use gyroemu::analysis::selfcal::{linearised_slope, run_selfcal_core, validate_selfcal};
-use gyroemu::analysis::selfcal_analyses::{drift_analysis, tau_analysis};
+use gyroemu::analysis::selfcal_analyses::{drift_analysis, drift_tracking_design, tau_analysis};
 use gyroemu::analysis::selfcal_work;
 use gyroemu::config::presets::preset;
 use gyroemu::config::{Config, NoiseConfig, SelfcalConfig};
@@ -447,6 +447,22 @@ fn selfcal_judges_the_config_as_it_reads_it_not_the_parts_it_ignores() {
         assert_eq!(validate_selfcal(c).unwrap(), want, "{what}");
         let (rot, _) = gyroemu::analysis::selfcal::sweep_configs(c);
         assert_eq!(rot.experiment.rates_dps, [50.0, 100.0, 150.0], "{what}");
+    }
+    // The drift scenario's tracking loop is judged on the config as selfcal reads it too
+    // (rate 0 had left it out as "not fitting the board").
+    let drift = |c: &Config| {
+        let mut c = c.clone();
+        c.selfcal = Some(SelfcalConfig {
+            drift_delta_t_k: vec![10.0],
+            ..Default::default()
+        });
+        c
+    };
+    let want = validate_selfcal(&drift(&clean)).unwrap();
+    assert!(drift_tracking_design(&drift(&clean)).is_some());
+    for c in [&with_zero, &dumped, &table] {
+        assert_eq!(validate_selfcal(&drift(c)).unwrap(), want);
+        assert!(drift_tracking_design(&drift(c)).is_some());
     }
     // What selfcal does read is judged still: the same parts beside a too short average.
     for c in [&with_zero, &dumped, &table] {

@@ -126,9 +126,11 @@ pub fn drifted(cfg: &Config, delta_t_k: f64) -> Config {
 }
 
 /// The config whose `[pll]` designs the drift scenario's loop: the user's, or the default
-/// loop (derived natural frequency and lock time) on the nominal device.
+/// loop (derived natural frequency and lock time) on the nominal device; as selfcal reads
+/// the config ([`as_read`]), so that whether the loop fits is not judged on what selfcal
+/// ignores (a rotating config's rate 0 had dropped the tracked half).
 pub fn drift_pll_design(cfg: &Config) -> Config {
-    let mut d = cfg.clone();
+    let mut d = as_read(cfg);
     if d.pll.is_none() {
         d.pll = Some(PllConfig {
             natural_hz: None,

@@ -111,6 +111,37 @@ fn shards_by_flag_and_by_kubernetes_index_merge_to_the_one_machine_lot() {
     );
 }
 
+/// A lot reads its config as selfcal does: rate 0 beside the preset's rotating `kind`, and a
+/// `[dump]` at a rate it does not list, neither refuse it, nor its merge (which validated the
+/// config as `run` would, and refused a lot its shards had run).
+#[test]
+fn a_lot_with_parts_selfcal_ignores_runs_and_merges() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = tiny().replacen(
+        "rates_dps = [900.0, 1800.0, 2700.0]",
+        "rates_dps = [0.0, 900.0, 1800.0, 2700.0]",
+        1,
+    ) + "\n[dump]\nrate_dps = 60.0\n";
+    let cfg = config(dir.path(), "lot.toml", &text);
+    let one = dir.path().join("one");
+    ok(lot(&cfg, &one, "2", &["--devices", "2"], &[]));
+    let split = dir.path().join("split");
+    for sh in ["0/2", "1/2"] {
+        ok(lot(
+            &cfg,
+            &split,
+            "1",
+            &["--devices", "2", "--shard", sh],
+            &[],
+        ));
+    }
+    ok(gyroemu(&["merge", s(&split)], &[]));
+    assert_same_outputs(&one, &split);
+    // `run` does refuse that config (exit 2).
+    let o = gyroemu(&["run", s(&cfg), "--out", s(&dir.path().join("run"))], &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
 /// What validation warned of on stderr (the config's rules, and the drawn devices' grouped by
 /// text) is in `montecarlo.json` too: a lot read later had only the run's own warnings.
 #[test]
