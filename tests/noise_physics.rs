@@ -90,8 +90,87 @@ fn brownian_motion_obeys_equipartition() {
     }
 }
 
+/// The TIA output's samples of a run with the TIA's input current noise alone, at `fs_hz`
+/// (f0 = 1 kHz, a negligible drive), `seconds` long, both modes interleaved.
+fn tia_noise_samples(fs_hz: f64, pole_hz: Option<f64>, seconds: f64) -> Vec<f64> {
+    let mut cfg: Config = preset("m2tfg-coriolis").unwrap();
+    cfg.device.f0_hz = 1000.0;
+    cfg.device.q = 100.0;
+    cfg.device.mode2_f0_offset_hz = 0.0;
+    cfg.device.q_mode2 = None;
+    cfg.device.quadrature_coupling_rad2_s2 = 0.0;
+    cfg.drive.carrier_hz = None;
+    cfg.drive.f1 = 1e-30;
+    cfg.drive.f2 = Some(1e-30);
+    cfg.board.fs_hz = Some(fs_hz);
+    cfg.board.tia_pole_hz = pole_hz;
+    cfg.board.decimation = None;
+    cfg.board.lpf_cutoff_hz = None;
+    cfg.noise = Some(noise(None, 1e-12, 0.0));
+    cfg.resolve();
+    cfg.validate().unwrap();
+    let m = cfg.decimation();
+    let nodes = vec!["tia".to_string()];
+    let start_s = 0.1;
+    let mut probe = Probe::new(&nodes, fs_hz, m, start_s, seconds, 0);
+    let fs_out = cfg.fs_out_hz();
+    let p = Point {
+        rate_rad_s: 0.0,
+        window: Window::Boxcar {
+            n: ((start_s + seconds) * fs_out) as u64,
+            frac: 0.0,
+        },
+    };
+    let opts = RunOptions {
+        probe: Some(&mut probe),
+        ..Default::default()
+    };
+    Board::<f64>::new(&cfg.board_params(), &[0.0], &[0])
+        .unwrap()
+        .run(0, &[p], opts, &|_| {})
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    probe.write(dir.path(), "tia").unwrap();
+    let bytes = std::fs::read(dir.path().join("tia_fullrate.sigmf-data")).unwrap();
+    bytes
+        .chunks_exact(8)
+        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+        .collect()
+}
+
+#[test]
+fn tia_input_noise_has_its_density_however_few_samples_a_period() {
+    // A white input current of one-sided density S has per-sample variance S fs/2; the TIA
+    // y[n] = a y[n-1] + (1 - a) R x[n] passes white noise with power gain (1 - a)^2 R^2 /
+    // (1 - a^2). The current enters sample by sample (no hold), so no sinc(f0/fs) belongs in
+    // it: one made the variance 1/sinc^2(1/3) = 1.46 times this at 3 samples a period.
+    let (s, r) = (1e-24, 1e6);
+    for (fs, pole) in [(3000.0, None), (4000.0, None), (4000.0, Some(1000.0))] {
+        let x = tia_noise_samples(fs, pole, 100.0);
+        let a = pole.map_or(0.0, |p: f64| (-2.0 * PI * p / fs).exp());
+        let gain2 = (1.0 - a) * (1.0 - a) * r * r / (1.0 - a * a);
+        let want = s * fs / 2.0 * gain2;
+        for mode in 0..2 {
+            let v: Vec<f64> = x.iter().skip(mode).step_by(2).copied().collect();
+            let ms = v.iter().map(|y| y * y).sum::<f64>() / v.len() as f64;
+            // 4e5 samples: the mean square is within about 0.5 % (1 sigma) of its expectation.
+            assert!(
+                (ms / want - 1.0).abs() < 0.03,
+                "fs {fs}, pole {pole:?}, mode {}: {ms:e} against {want:e} ({:.4})",
+                mode + 1,
+                ms / want
+            );
+        }
+    }
+}
+
 /// Phase (rad) of mode 1's averaged phasor at zero rate, for 64 independent streams.
 fn zero_rate_phases(cfg: &Config, average_s: f64) -> (Vec<f64>, f64) {
+    zero_rate_phases_of(cfg, average_s, 16)
+}
+
+/// [`zero_rate_phases`] for `4 groups` streams.
+fn zero_rate_phases_of(cfg: &Config, average_s: f64, groups: u64) -> (Vec<f64>, f64) {
     let fs_out = cfg.fs_out_hz();
     let n_avg = (average_s * fs_out) as u64;
     let t = n_avg as f64 / fs_out;
@@ -103,7 +182,7 @@ fn zero_rate_phases(cfg: &Config, average_s: f64) -> (Vec<f64>, f64) {
         },
     };
     let mut phases = Vec::new();
-    for g in 0..16u64 {
+    for g in 0..groups {
         let streams: Vec<u64> = (0..4).map(|i| 4 * g + i).collect();
         let r = Board::<f64x4>::new(&cfg.board_params(), &[0.0; 4], &streams)
             .unwrap()
@@ -149,6 +228,37 @@ fn tia_input_noise_gives_the_snr_phase_noise() {
     assert!(
         (got / expected - 1.0).abs() < TOL,
         "phase noise {got:e} rad, closed form {expected:e}"
+    );
+}
+
+#[test]
+fn the_stated_scatter_counts_the_noise_the_decimation_folds_back() {
+    // A first-order low-pass at 1190 Hz beside fs_out = 2400 Hz passes the demodulated TIA
+    // noise at every multiple of fs_out, and taking every 100th sample folds it onto DC: a
+    // phase scatters about 1.29 times what the carrier's density alone gives, which the
+    // stated sigma once was. A Coriolis reading is two phases (the point's and the zero-rate
+    // reference's), so one phase has 1/sqrt(2) of the reading's sigma at a rate near 0.
+    let (mut cfg, _) = board_cfg();
+    cfg.board.lpf_order = 1;
+    cfg.board.lpf_cutoff_hz = Some(1190.0);
+    cfg.board.decimation = Some(100);
+    cfg.noise = Some(noise(None, 2e-12, 0.0));
+    cfg.experiment.rates_dps = vec![1e-6];
+    cfg.experiment.average_s = 0.5;
+    cfg.validate().unwrap();
+    let span_s = cfg.plan_point(0.0).span_samples() / cfg.fs_out_hz();
+    let stated = cfg.noise_phase().unwrap()[0].sigma_rad[0] / 2f64.sqrt();
+    let (ph, t) = zero_rate_phases_of(&cfg, 0.5, 64);
+    assert!(
+        (t / span_s - 1.0).abs() < 1e-9,
+        "{t} s averaged, {span_s} s stated"
+    );
+    // 256 streams: a standard deviation within 15 % at 3.4 standard errors (4.4 %).
+    let got = std_dev(&ph);
+    assert!(
+        (got / stated - 1.0).abs() < 0.15,
+        "scatter {got:e} rad, stated {stated:e} rad ({:.3})",
+        got / stated
     );
 }
 

@@ -7,7 +7,7 @@ use crate::schema::{CONVERTER_BITS, PLL_MODE};
 use crate::validate::MAX_RUN_SAMPLES;
 use crate::validate_regime::NODE_RANGE;
 use gyroemu_core::flicker::{FlickerDesign, FlickerParams};
-use gyroemu_core::noise::held_white_sigma;
+use gyroemu_core::noise::{held_white_sigma, white_sigma};
 use gyroemu_core::Response;
 use gyroemu_tia::Tia;
 
@@ -262,19 +262,16 @@ impl Config {
         let modes = [plant.mode1, plant.mode2];
         let r = self.board.tia_gain_ohm;
         let white_gain = tia.white_noise_gain();
-        // A white input current of density `d` A/sqrt(Hz): its largest per-sample deviation
-        // over the modes, as the board draws it, and that through the TIA.
+        // A white input current of density `d` A/sqrt(Hz): its per-sample deviation, as the
+        // board draws it, and that through the TIA.
         let white = |d: f64| {
-            let s = modes
-                .iter()
-                .map(|m| held_white_sigma(d * d, fs, m.f0_hz))
-                .fold(0.0, |a: f64, b| if b.is_nan() { b } else { a.max(b) });
+            let s = white_sigma(d * d, fs);
             (s, s * white_gain)
         };
         let within = |x: f64| x <= hi; // NaN is not
         let rule = |what: &str, s_i: f64, s_v: f64| {
             format!(
-                "gives {what} a per-sample current of standard deviation {s_i:.3e} A (sqrt(density^2 fs_hz/2) / sinc(f0/fs_hz), as the board draws it) and {s_v:.3e} V at the TIA output (x {white_gain:.3e} ohm, the discretised TIA's white-noise gain tia_gain_ohm sqrt((1 - a)/(1 + a))), which must stay within {hi:e} (the node range, so products of two stay finite): lower it"
+                "gives {what} a per-sample current of standard deviation {s_i:.3e} A (sqrt(density^2 fs_hz/2), as the board draws it) and {s_v:.3e} V at the TIA output (x {white_gain:.3e} ohm, the discretised TIA's white-noise gain tia_gain_ohm sqrt((1 - a)/(1 + a))), which must stay within {hi:e} (the node range, so products of two stay finite): lower it"
             )
         };
         let i_c = n.tia_current_noise_a_per_rthz;

@@ -61,7 +61,9 @@ impl Config {
     /// force through the mode's velocity response and transduction (uncoupled modes), both
     /// through the TIA at the carrier, and an ADC's rounding (step^2/12 a sample) where that
     /// noise dithers it (its RMS at the ADC input at least an LSB; an undithered ADC's error
-    /// is systematic, and the ADC-LSB rule states it). `None` without `[noise]`.
+    /// is systematic, and the ADC-LSB rule states it). The wide-band parts (the TIA's input
+    /// noise and the ADC's) count what the decimation folds onto the averaged output too
+    /// ([`Config::decimation_fold`]). `None` without `[noise]`.
     pub(crate) fn carrier_noise_density(&self) -> Option<[f64; 2]> {
         let n = self.noise.as_ref()?;
         let b = &self.board;
@@ -97,8 +99,31 @@ impl Config {
                     0.0
                 }
             });
-            (i_n * i_n + brownian) * tia + adc
+            let (fold_tia, fold_white) = self.decimation_fold(&chain);
+            i_n * i_n * tia * fold_tia + brownian * tia + adc * fold_white
         }))
+    }
+
+    /// What the decimation folds onto the decimated output's DC, against the low-pass's own
+    /// DC: `(sum_k |L(k fs_out)|^2 |H(fc + k fs_out)|^2 / |H(fc)|^2, sum_k |L(k fs_out)|^2) /
+    /// |L(0)|^2` over the multiples of the output rate in the input band (L the stage-1
+    /// low-pass, H the TIA). Why: the demodulated noise at each multiple of fs_out lands on DC
+    /// when the output is taken every M samples; a low-pass that leaves it (first order near
+    /// the output Nyquist) made the read-out scatter 1.29 times the stated sigma.
+    pub(crate) fn decimation_fold(&self, chain: &ChainResponse) -> (f64, f64) {
+        let fs_out = self.fs_out_hz();
+        let fc = self.carrier_hz();
+        let k_max = (0.5 * self.fs_hz() / fs_out).floor() as i64;
+        let dc = chain.lowpass(0.0).norm_sqr();
+        let tia_fc = chain.tia(fc).norm_sqr();
+        let (mut tia, mut white) = (0.0, 0.0);
+        for k in -k_max..=k_max {
+            let f = k as f64 * fs_out;
+            let l = chain.lowpass(f).norm_sqr() / dc;
+            tia += l * chain.tia(fc + f).norm_sqr() / tia_fc;
+            white += l;
+        }
+        (tia, white)
     }
 
     /// At each listed non-zero rate, the noise a reading's phase carries
@@ -205,7 +230,7 @@ impl Config {
                 )
             };
             warnings.push(format!(
-                "the noise at the carrier (about {:.3e} V/sqrt(Hz) at the ADC input, the white sources together), averaged over the point's span, against the TIA output of mode {} at {} deg/s (about {amplitude:.3e} V) {scatter}; average longer (experiment.average_s) or lower the noise",
+                "the noise at the carrier (about {:.3e} V/sqrt(Hz) at the ADC input, the white sources together, with the noise the decimation folds onto the output), averaged over the point's span, against the TIA output of mode {} at {} deg/s (about {amplitude:.3e} V) {scatter}; average longer (experiment.average_s) or lower the noise",
                 density.sqrt(),
                 k + 1,
                 p.rate_dps,

@@ -75,15 +75,23 @@ pub(crate) fn step(s: &mut [u64x4; 4]) -> u64x4 {
     out
 }
 
-/// Standard deviation per sample of a white sequence held for one sample period (as every
-/// source in the chain is: the plant and TIA see zero-order-held inputs) whose one-sided
-/// density near `f_hz` is `psd_one_sided` (unit^2/Hz). Held white noise of variance s^2 has
-/// one-sided density 2 s^2 / fs * sinc^2(f / fs); the sinc is divided out at the frequency
-/// that matters (the carrier), so the density there is exact.
+/// Standard deviation per sample of a white sequence whose one-sided density is
+/// `psd_one_sided` (unit^2/Hz) at every frequency: `sqrt(psd fs / 2)`. Why: a source added to
+/// a sampled signal (the TIA's input current, which the TIA takes sample by sample, without a
+/// hold) has the density of its samples, flat.
+pub fn white_sigma(psd_one_sided: f64, fs_hz: f64) -> f64 {
+    (psd_one_sided * fs_hz / 2.0).sqrt()
+}
+
+/// Standard deviation per sample of a white sequence held for one sample period (the force:
+/// the plant is discretised with a zero-order hold on its input) whose one-sided density near
+/// `f_hz` is `psd_one_sided` (unit^2/Hz). Held white noise of variance s^2 has one-sided
+/// density 2 s^2 / fs * sinc^2(f / fs); the sinc is divided out at the frequency that matters
+/// (the carrier), so the density there is exact.
 pub fn held_white_sigma(psd_one_sided: f64, fs_hz: f64, f_hz: f64) -> f64 {
     let x = core::f64::consts::PI * f_hz / fs_hz;
     let sinc = if x == 0.0 { 1.0 } else { x.sin() / x };
-    (psd_one_sided * fs_hz / 2.0).sqrt() / sinc
+    white_sigma(psd_one_sided, fs_hz) / sinc
 }
 
 #[cfg(test)]
