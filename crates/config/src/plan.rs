@@ -41,19 +41,35 @@ impl Config {
     }
 
     /// The settling time used: the configured one, or 16 mechanical time constants (phase
-    /// error below 0.01 mdeg, THEORY.md section 7) plus 40 low-pass time constants.
+    /// error below 0.01 mdeg, THEORY.md section 7) plus the low-pass's share
+    /// ([`Config::lowpass_settle_s`]).
     pub fn settle_s(&self) -> f64 {
         self.experiment
             .settle_s
             .unwrap_or_else(|| self.default_settle_s())
     }
 
-    /// The default settling: 16 mechanical time constants (of the higher Q) plus 40 of the
-    /// low-pass.
+    /// The default settling: 16 mechanical time constants (of the higher Q) plus the
+    /// low-pass's share ([`Config::lowpass_settle_s`]).
     pub fn default_settle_s(&self) -> f64 {
         let q = self.device.q.max(self.device.q_mode2.unwrap_or(0.0));
-        16.0 * mechanical_tau_s(self.device.f0_hz, q)
-            + 40.0 / (2.0 * core::f64::consts::PI * self.lpf_cutoff_hz())
+        16.0 * mechanical_tau_s(self.device.f0_hz, q) + self.lowpass_settle_s()
+    }
+
+    /// The stage-1 low-pass's share of a default settling: 40 time constants 1 / (2 pi
+    /// lpf_cutoff_hz), times sin(pi/8) / sin(pi/(2 order)) above order 4. Why: a Butterworth's
+    /// slowest pole decays at 2 pi fc sin(pi/(2 order)), so 40 time constants leave a
+    /// fourth-order filter's start-up at e^-15.3 but an eighth-order one's at e^-7.8, which
+    /// moved a rotating reading by 4.6 mdeg and a rate table's by tens of degrees, unwarned;
+    /// the factor gives every order the fourth order's e^-15.3.
+    pub fn lowpass_settle_s(&self) -> f64 {
+        use core::f64::consts::PI;
+        // Clamped to the orders the rules allow: a refused order must not make the derived
+        // settling, and so the run's span, a second refusal.
+        let r = crate::schema::LPF_ORDER;
+        let order = (self.board.lpf_order as u64).clamp(r.lo, r.hi) as f64;
+        let slower = ((PI / 8.0).sin() / (PI / (2.0 * order)).sin()).max(1.0);
+        40.0 * slower / (2.0 * PI * self.lpf_cutoff_hz())
     }
 
     /// Settling in decimated samples (the whole output periods that cover `settle_s`).

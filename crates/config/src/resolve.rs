@@ -206,8 +206,8 @@ impl Config {
 
     /// The `[sweep]` section with every key filled in (the section's defaults when it is
     /// absent): `start_hz`/`stop_hz` 10 half-bandwidths beyond the lower/upper resonance,
-    /// `settle_s` 16 mechanical time constants of the slower mode plus 40 low-pass time
-    /// constants, `average_s` 2 mechanical time constants.
+    /// `settle_s` 16 mechanical time constants of the slower mode plus the low-pass's share
+    /// ([`Config::lowpass_settle_s`]), `average_s` 2 mechanical time constants.
     pub fn sweep_resolved(&self) -> SweepConfig {
         let given = self.sweep.clone().unwrap_or_default();
         let [(f1, b1), (f2, b2)] = self.mode_resonances_hz();
@@ -216,10 +216,11 @@ impl Config {
         SweepConfig {
             start_hz: Some(given.start_hz.unwrap_or((f1 - n * b1).min(f2 - n * b2))),
             stop_hz: Some(given.stop_hz.unwrap_or((f1 + n * b1).max(f2 + n * b2))),
-            settle_s: Some(given.settle_s.unwrap_or_else(|| {
-                SWEEP_SETTLE_TAUS * tau
-                    + 40.0 / (2.0 * core::f64::consts::PI * self.lpf_cutoff_hz())
-            })),
+            settle_s: Some(
+                given
+                    .settle_s
+                    .unwrap_or_else(|| SWEEP_SETTLE_TAUS * tau + self.lowpass_settle_s()),
+            ),
             average_s: Some(given.average_s.unwrap_or(SWEEP_AVERAGE_TAUS * tau)),
             ..given
         }
@@ -374,7 +375,7 @@ impl Config {
                     "sweep.settle_s",
                     given.settle_s.is_none(),
                     full.settle_s,
-                    format!("{SWEEP_SETTLE_TAUS} mechanical time constants Q/(pi f0) of the slower mode plus 40 low-pass time constants"),
+                    format!("{SWEEP_SETTLE_TAUS} mechanical time constants Q/(pi f0) of the slower mode plus 40 low-pass time constants 1/(2 pi lpf_cutoff_hz), times sin(pi/8)/sin(pi/(2 lpf_order)) above order 4"),
                 ),
                 (
                     "sweep.average_s",

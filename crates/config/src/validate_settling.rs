@@ -252,13 +252,14 @@ fn impulse_head(
 }
 
 impl Config {
-    /// The start-up a hand-set `experiment.settle_s` leaves in the averaging windows, bounded
-    /// per point from the plant's decay and the low-pass's exact start-up; a warning with the
-    /// bound, or a refusal when the start-up can be as large as the signal read.
+    /// The start-up the settling leaves in the averaging windows, hand-set or the default
+    /// (which once went unchecked: an eighth-order low-pass left tens of degrees in a rate
+    /// table's reading), bounded per point from the plant's decay and the low-pass's exact
+    /// start-up; a warning with the bound, or a refusal when the start-up can be as large as
+    /// the signal read.
     pub(crate) fn validate_settling(&self, p: &mut Rules, warnings: &mut Vec<String>) {
-        let Some(settle) = self.experiment.settle_s else {
-            return;
-        };
+        let settle = self.settle_s();
+        let set = self.experiment.settle_s.is_some();
         if !p.clean(&[
             "experiment.settle_s",
             "experiment.average_s",
@@ -272,14 +273,23 @@ impl Config {
         };
         let tau = self.slowest_tau_s();
         let fc = self.lpf_cutoff_hz();
+        let settling = if set {
+            format!("experiment.settle_s = {settle}")
+        } else {
+            format!("the default settling ({settle:.4} s; experiment.settle_s not set)")
+        };
         let what = format!(
-            "experiment.settle_s = {settle} leaves the plant's start-up (tau = {tau} s) and the stage-1 low-pass's (order {} at {fc} Hz) in the averaging window",
+            "{settling} leaves the plant's start-up (tau = {tau} s) and the stage-1 low-pass's (order {} at {fc} Hz) in the averaging window",
             self.board.lpf_order
         );
-        let fix = format!(
-            "raise settle_s (the default, {:.4} s here, is 16 tau + 40/(2 pi lpf_cutoff_hz)) or remove the key",
-            16.0 * tau + 40.0 / (core::f64::consts::TAU * fc)
-        );
+        let fix = if set {
+            format!(
+                "raise settle_s (the default, {:.4} s here, is 16 tau + 40/(2 pi lpf_cutoff_hz), longer above order 4) or remove the key",
+                self.default_settle_s()
+            )
+        } else {
+            "set experiment.settle_s longer".to_string()
+        };
         // The low-pass's own start-up on the sidebands read is exact (no bound): once it is as
         // large as what the filter passes of them, the phase read is undetermined and no bound
         // on it exists, so the run is refused. The rest is a bound, stated in a warning.

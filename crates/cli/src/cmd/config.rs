@@ -27,7 +27,7 @@ pub fn resolved_command(path: &Path) -> Result<()> {
     }
     if cfg.experiment.settle_s.is_none() {
         out.push_str(&format!(
-            "# experiment.settle_s is not set: {} s are discarded (16 mechanical time constants Q/(pi f0) plus 40 of the low-pass).\n",
+            "# experiment.settle_s is not set: {} s are discarded (16 mechanical time constants Q/(pi f0) plus 40 of the low-pass, 1/(2 pi lpf_cutoff_hz), times sin(pi/8)/sin(pi/(2 lpf_order)) above order 4).\n",
             cfg.settle_s()
         ));
     }
