@@ -67,7 +67,7 @@ fn full_rate_dump(c: &Config, nodes: &[&str], start_s: f64, dur_s: f64) -> gyroe
 
 /// The Allan deviation of the zero-rate mode-1 phase, rad, at taus in `[lo, hi]` s.
 fn phase_adev(c: &Config, record_s: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
-    let a = allan_analysis(c, record_s, 1.0, &quiet).unwrap();
+    let a = allan_analysis(c, record_s, 1.0, 0.0, &quiet).unwrap();
     a.phase_deg
         .iter()
         .filter(|p| p.tau_s >= lo && p.tau_s <= hi)
@@ -103,12 +103,76 @@ fn drive_phase_flicker_leaves_the_flicker_allan_floor_on_the_phase() {
         n.tia_current_noise_a_per_rthz = 2e-12;
         n.flicker_f_lo_hz = Some(1e-3);
     });
-    let a = allan_analysis(&c, 200.0, 1.0, &quiet).unwrap();
+    let a = allan_analysis(&c, 200.0, 1.0, 0.0, &quiet).unwrap();
     let r = a.readings.unwrap();
     let bi = r.bias_instability_deg_per_h / 3600.0;
     let want = floor.to_degrees() / gyroemu::core::flicker::ADEV_PER_BIAS_INSTABILITY;
     assert!((bi / want - 1.0).abs() < 0.25, "BI {bi} against {want}");
     assert!(r.tau_at_min_s > 3.0, "{r:?}");
+}
+
+#[test]
+fn the_model_fit_counts_the_scale_factors_error_and_names_a_term_it_lacks() {
+    // The rate-equivalent terms are the phase's over the measured scale factor: a scale known
+    // to 1 +- r (95 %) puts each term within its interval times [1/(1 + r), 1/(1 - r)] (a
+    // flicker-dominated sweep missed the scale by 43 % while B's interval was 5 % wide).
+    let c = flicker_cfg(|n| {
+        n.drive_phase_flicker_rad_per_rthz = 1e-4;
+        n.tia_current_noise_a_per_rthz = 2e-12;
+        n.flicker_f_lo_hz = Some(1e-3);
+    });
+    let exact = allan_analysis(&c, 60.0, 1.0, 0.0, &quiet).unwrap();
+    let widened = allan_analysis(&c, 60.0, 1.0, 0.5, &quiet).unwrap();
+    let (e, w) = (
+        exact.readings.unwrap().model_fit,
+        widened.readings.unwrap().model_fit,
+    );
+    let terms = |f: &gyroemu::analysis::allan::fit::NoiseModelFit| {
+        [
+            (f.arw_deg_per_rt_h, f.arw_deg_per_rt_h_ci95),
+            (f.bias_instability_deg_per_h, f.bias_instability_deg_per_h_ci95),
+            (
+                f.rate_random_walk_deg_per_h_per_rt_h,
+                f.rate_random_walk_deg_per_h_per_rt_h_ci95,
+            ),
+            (f.quantisation_deg, f.quantisation_deg_ci95),
+        ]
+    };
+    let near = |a: f64, b: f64| (a / b - 1.0).abs() < 1e-12;
+    let mut checked = 0;
+    for ((ve, [lo, hi]), (vw, [wlo, whi])) in terms(&e).into_iter().zip(terms(&w)) {
+        assert_eq!(ve.to_bits(), vw.to_bits(), "the value itself is the same");
+        // A determined term's lower end, or 0 (an undetermined one's), and its upper end.
+        assert!(if lo > 0.0 { near(wlo, lo / 1.5) } else { wlo == lo }, "{lo} -> {wlo}");
+        if hi.is_finite() && hi > 0.0 {
+            assert!(near(whi, hi / 0.5), "{hi} -> {whi}");
+            checked += 1;
+        }
+    }
+    assert!(checked >= 1, "no term with an interval: {e:?}");
+    // The 1/tau^2 coefficient goes as the scale's inverse square, of either sign.
+    let ([lo, hi], [wlo, whi]) = (
+        e.tau_minus2_coefficient_dps2_s2_ci95,
+        w.tau_minus2_coefficient_dps2_s2_ci95,
+    );
+    let ends = |x: f64| [x / 2.25, x / 0.25];
+    assert!(near(wlo, ends(lo)[0].min(ends(lo)[1])), "{lo} -> {wlo}");
+    assert!(near(whi, ends(hi)[0].max(ends(hi)[1])), "{hi} -> {whi}");
+    // The carrier's flicker leaves a term the model has not: said, and only then.
+    assert_eq!(exact.model_warning, None);
+    let with_carrier = flicker_cfg(|n| {
+        n.carrier_phase_flicker_rad_per_rthz = 1e-3;
+        n.flicker_f_lo_hz = Some(1e-2);
+    });
+    let a = allan_analysis(&with_carrier, 20.0, 1.0, 0.0, &quiet).unwrap();
+    assert!(a.model_warning.is_some());
+    assert!(
+        a.warnings()
+            .iter()
+            .any(|w| w.contains("carrier_phase_flicker") && w.contains("ln(tau)/tau^2")),
+        "{:?}",
+        a.warnings()
+    );
 }
 
 #[test]

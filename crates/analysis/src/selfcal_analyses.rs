@@ -2,7 +2,9 @@
 //! the Allan deviation of the zero-rate phase output, the self-calibration error against the
 //! averaging time (one long rotating run read at checkpoints), and a temperature drift.
 
-use crate::allan::{noise_readings_settled, overlapping_adev, AllanPoint, NoiseReadings};
+use crate::allan::{
+    fit::NoiseModelFit, noise_readings_settled, overlapping_adev, AllanPoint, NoiseReadings,
+};
 pub use crate::selfcal::drift_pll_design;
 use crate::selfcal::{drifted, run_selfcal_core, sweep_configs};
 use crate::selfcal_combined::{combined_slope, CombinedSlope};
@@ -37,7 +39,20 @@ pub struct AllanResult {
     pub readings: Option<NoiseReadings>,
     /// The scale factor used, deg of phase per deg/s.
     pub scale_deg_per_dps: f64,
+    /// Its relative 95 % half-width (the rate-table slope's), counted in every interval of
+    /// `readings.model_fit`: the rate-equivalent terms are the phase's over the measured
+    /// scale, which a noisy sweep misses by more than the fit's own intervals allowed.
+    pub scale_rel_ci95: f64,
+    /// Why the noise-model fit's terms may not be the device's, if a configured source has a
+    /// term the model lacks (the carrier's phase flicker).
+    pub model_warning: Option<&'static str>,
 }
+
+/// The carrier's phase flicker turns the drives and the demodulation alike, so it cancels
+/// below the envelope corner and leaves a high-passed 1/f phase, whose Allan variance falls
+/// as ln(tau)/tau^2: IEEE Std 952's model has no such term, and its fit took it as angle random
+/// walk (3.3 to 3.8 deg/sqrt(h) with tight intervals for a source with none) and quantisation.
+const FLICKER_ANGLE_WARNING: &str = "noise.carrier_phase_flicker_rad_per_rthz is set: the carrier's flicker cancels below the envelope corner f0/(2Q) and leaves a term whose Allan variance falls as ln(tau)/tau^2, which IEEE Std 952's model has not; the fit takes it as angle random walk and quantisation, so allan.model_fit can read N and Q (with intervals) where the device has neither, or too large";
 
 impl AllanResult {
     /// Why a reading is absent, only a bound, or unreliable: one line each, for the run's
@@ -46,7 +61,11 @@ impl AllanResult {
         let Some(r) = self.readings else {
             return vec!["Allan deviation: too few points for any reading".into()];
         };
-        let mut w = Vec::new();
+        let mut w: Vec<String> = self
+            .model_warning
+            .iter()
+            .map(|m| format!("Allan deviation: {m}"))
+            .collect();
         if let Some(why) = r.arw_warning {
             w.push(format!(
                 "Allan deviation: angle random walk not read: {why}"
@@ -68,11 +87,13 @@ impl AllanResult {
 }
 
 /// Runs `record_s` of the board at zero rate (Coriolis drive) on four streams and reads the
-/// Allan deviation of the mode-1 phase. `scale_deg_per_dps` converts phase to rate.
+/// Allan deviation of the mode-1 phase. `scale_deg_per_dps` converts phase to rate; its
+/// relative 95 % half-width `scale_rel_ci95` widens every interval of the noise-model fit.
 pub fn allan_analysis(
     cfg: &Config,
     record_s: f64,
     scale_deg_per_dps: f64,
+    scale_rel_ci95: f64,
     progress: Progress,
 ) -> Result<AllanResult, SweepError> {
     let (_, cor) = sweep_configs(cfg);
@@ -141,15 +162,59 @@ pub fn allan_analysis(
             ..*p
         })
         .collect();
+    // Below ten mechanical time constants the resonator still rolls the curve off.
+    let mut readings = noise_readings_settled(&rate, 10.0 * cor.slowest_tau_s());
+    if let Some(r) = &mut readings {
+        widen_by_scale(&mut r.model_fit, scale_rel_ci95);
+    }
+    let flicker = cfg
+        .noise
+        .as_ref()
+        .is_some_and(|n| n.carrier_phase_flicker_rad_per_rthz > 0.0);
     Ok(AllanResult {
         tau0_s: tau0,
         record_s: n_avg as f64 / fs_out,
-        // Below ten mechanical time constants the resonator still rolls the curve off.
-        readings: noise_readings_settled(&rate, 10.0 * cor.slowest_tau_s()),
+        readings,
         phase_deg: phase,
         rate_dps: rate,
         scale_deg_per_dps,
+        scale_rel_ci95,
+        model_warning: flicker.then_some(FLICKER_ANGLE_WARNING),
     })
+}
+
+/// Each interval of `fit` as wide as the scale's error makes it: a rate-equivalent term is
+/// the phase's over the scale (the tau^-2 coefficient over its square), and the true scale
+/// lies within `1 +- rel` of the one used (95 %), so the term within `[lo, hi]` times
+/// `[1/(1 + rel), 1/(1 - rel)]` (to every positive value once `rel` reaches 1).
+fn widen_by_scale(fit: &mut NoiseModelFit, rel: f64) {
+    if rel.is_nan() || rel <= 0.0 {
+        return;
+    }
+    let span = |power: i32| {
+        let hi = if rel < 1.0 {
+            (1.0 - rel).powi(-power)
+        } else {
+            f64::INFINITY
+        };
+        ((1.0 + rel).powi(-power), hi)
+    };
+    let widen = |ci: &mut [f64; 2], power: i32| {
+        let (a, b) = span(power);
+        // 0 stays 0 when b is infinite; a NaN end (an undetermined term) stays NaN.
+        let times = |x: f64, f: f64| if x == 0.0 { 0.0 } else { x * f };
+        let [lo, hi] = *ci;
+        // Either end times a factor in [a, b] (a bound may be negative): the extremes.
+        *ci = [
+            times(lo, a).min(times(lo, b)),
+            times(hi, a).max(times(hi, b)),
+        ];
+    };
+    widen(&mut fit.arw_deg_per_rt_h_ci95, 1);
+    widen(&mut fit.bias_instability_deg_per_h_ci95, 1);
+    widen(&mut fit.rate_random_walk_deg_per_h_per_rt_h_ci95, 1);
+    widen(&mut fit.quantisation_deg_ci95, 1);
+    widen(&mut fit.tau_minus2_coefficient_dps2_s2_ci95, 2);
 }
 
 /// The self-calibration at one averaging time.

@@ -81,9 +81,11 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
             return Ok(None);
         };
         let p = reporter.task("allan record");
-        let a = allan_analysis(&held, t, m.coriolis.slope_deg_per_dps, &|d, n| {
-            p.update(d, n)
-        })?;
+        // The rate-table slope's own 95 % error, relative, in every interval of the fit.
+        let c = &m.coriolis;
+        let rel =
+            gyroemu_experiment::fit::t95(c.dof) * c.std_err_deg_per_dps / c.slope_deg_per_dps.abs();
+        let a = allan_analysis(&held, t, c.slope_deg_per_dps, rel, &|d, n| p.update(d, n))?;
         p.finish(None);
         Ok(Some(a))
     };
