@@ -130,7 +130,10 @@ fn the_model_fit_counts_the_scale_factors_error_and_names_a_term_it_lacks() {
     let terms = |f: &gyroemu::analysis::allan::fit::NoiseModelFit| {
         [
             (f.arw_deg_per_rt_h, f.arw_deg_per_rt_h_ci95),
-            (f.bias_instability_deg_per_h, f.bias_instability_deg_per_h_ci95),
+            (
+                f.bias_instability_deg_per_h,
+                f.bias_instability_deg_per_h_ci95,
+            ),
             (
                 f.rate_random_walk_deg_per_h_per_rt_h,
                 f.rate_random_walk_deg_per_h_per_rt_h_ci95,
@@ -143,7 +146,14 @@ fn the_model_fit_counts_the_scale_factors_error_and_names_a_term_it_lacks() {
     for ((ve, [lo, hi]), (vw, [wlo, whi])) in terms(&e).into_iter().zip(terms(&w)) {
         assert_eq!(ve.to_bits(), vw.to_bits(), "the value itself is the same");
         // A determined term's lower end, or 0 (an undetermined one's), and its upper end.
-        assert!(if lo > 0.0 { near(wlo, lo / 1.5) } else { wlo == lo }, "{lo} -> {wlo}");
+        assert!(
+            if lo > 0.0 {
+                near(wlo, lo / 1.5)
+            } else {
+                wlo == lo
+            },
+            "{lo} -> {wlo}"
+        );
         if hi.is_finite() && hi > 0.0 {
             assert!(near(whi, hi / 0.5), "{hi} -> {whi}");
             checked += 1;

@@ -32,6 +32,8 @@ fn allan(readings: Option<NoiseReadings>) -> AllanResult {
         rate_dps: curve(SCALE),
         readings,
         scale_deg_per_dps: SCALE,
+        scale_rel_ci95: 0.0,
+        model_warning: None,
     }
 }
 
@@ -149,6 +151,8 @@ fn fitted_allan() -> AllanResult {
         rate_dps: rate,
         readings,
         scale_deg_per_dps: SCALE,
+        scale_rel_ci95: 0.0,
+        model_warning: None,
     }
 }
 
