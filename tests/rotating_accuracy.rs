@@ -188,3 +188,34 @@ fn a_hann_window_over_few_periods_reads_psi_exactly() {
         }
     }
 }
+
+#[test]
+fn the_sweeps_line_is_fitted_across_psis_branch_wrap() {
+    // A strong quadrature coupling puts psi near -90 deg at small rates, so the readings of
+    // -500 and +25 deg/s sit on either side of the branch cut (each on its theory's branch).
+    // The line through them read a slope of -0.081 for a small-rate theory of +0.0244; along
+    // rate, unwrapped by half turns, it follows the readings (a line through a curve: within
+    // a few per cent of the small-rate slope).
+    let mut cfg = config(
+        "rotating",
+        15e3,
+        2000.0,
+        1.0,
+        1.0,
+        &[25.0, 175.0, 1000.0, -500.0],
+        8.0,
+    );
+    cfg.device.quadrature_coupling_rad2_s2 = 1e7;
+    cfg.validate().unwrap();
+    let r = run(&cfg);
+    let low = r.points.iter().find(|p| p.rate_dps == 25.0).unwrap();
+    let neg = r.points.iter().find(|p| p.rate_dps == -500.0).unwrap();
+    assert!(
+        low.phase_deg[0] < -85.0 && neg.phase_deg[0] > 45.0,
+        "{low:?} {neg:?}"
+    );
+    for k in 0..2 {
+        let ratio = r.fit[k].slope / r.theory_slope_deg_per_dps[k];
+        assert!((ratio - 1.0).abs() < 0.05, "mode {}: {ratio}", k + 1);
+    }
+}

@@ -228,6 +228,38 @@ fn clipping_warnings(h: &Health, points: &[(f64, bool, Health)], coriolis: bool)
     w
 }
 
+/// `ys` (degrees, at `xs`), each moved by whole `period`s to within half a period of the
+/// reading at the next smaller x, for the line fit: each reading sits on its theory's branch,
+/// and a strongly coupled device's psi crosses -90 deg between rates (a fit through that wrap
+/// read a slope of -0.081 against a theory of +0.0244 while every point matched its theory).
+/// A NaN stays NaN and is stepped over; readings already continuous keep their bits.
+fn unwrapped_along(xs: &[f64], ys: &[f64], period: f64) -> Vec<f64> {
+    let mut order: Vec<usize> = (0..xs.len().min(ys.len())).collect();
+    order.sort_by(|&a, &b| xs[a].total_cmp(&xs[b]));
+    let mut out = ys.to_vec();
+    let mut prev: Option<f64> = None;
+    for i in order {
+        let y = ys[i];
+        if !y.is_finite() {
+            continue;
+        }
+        let moved = match prev {
+            Some(p) => {
+                let k = ((p - y) / period).round();
+                if k == 0.0 {
+                    y
+                } else {
+                    y + k * period
+                }
+            }
+            None => y,
+        };
+        out[i] = moved;
+        prev = Some(moved);
+    }
+    out
+}
+
 /// `x` moved by a whole number of half turns into `(centre - pi/2, centre + pi/2]`, and
 /// whether that number was odd. `x` itself is moved (not `x - centre`), so a reading already on
 /// its branch keeps its bits.
@@ -527,8 +559,16 @@ pub fn post_process_with(
         .collect();
     let warnings = clipping_warnings(&health, &per_point, matches!(shape, Shape::Coriolis));
     let xs: Vec<f64> = out.iter().map(|p| p.rate_dps).collect();
-    let fit =
-        [0, 1].map(|k| fit_line(&xs, &out.iter().map(|p| p.phase_deg[k]).collect::<Vec<_>>()));
+    // psi is read on a half turn's branch, a phase on a turn's.
+    let period = if matches!(shape, Shape::Rotating) {
+        180.0
+    } else {
+        360.0
+    };
+    let fit = [0, 1].map(|k| {
+        let ys: Vec<f64> = out.iter().map(|p| p.phase_deg[k]).collect();
+        fit_line(&xs, &unwrapped_along(&xs, &ys, period))
+    });
     let slope = small_rate_slope(cfg);
     Ok(SweepResult {
         shape,
