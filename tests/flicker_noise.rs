@@ -291,12 +291,8 @@ fn tia_voltage_flicker_has_its_corner_in_the_tia_output() {
     let y = d.channel("tia1_v").unwrap().to_vec();
     let psd = gyroemu_spectrum::welch(&y, fs, Some(1 << 16)).unwrap();
     let density = psd.density();
-    // White part: the held white sequence's density at f, e_n^2 sinc^2(f/fs)/sinc^2(f0/fs).
-    let sinc = |f: f64| {
-        let x = core::f64::consts::PI * f / fs;
-        x.sin() / x
-    };
-    let white = |f: f64| e_n * e_n * (sinc(f) / sinc(c.device.f0_hz)).powi(2);
+    // White part: e_n^2 at every frequency (the TIA takes its input sample by sample).
+    let white = |_: f64| e_n * e_n;
     let tia = gyroemu::tia::Tia::<f64>::new(&c.board_params().tia).unwrap();
     let (mut got, mut want) = (0.0, 0.0);
     for k in 1..psd.power.len() {
@@ -310,6 +306,64 @@ fn tia_voltage_flicker_has_its_corner_in_the_tia_output() {
     }
     // 14 segments x ~50 bins: a few per cent of scatter.
     assert!((got / want - 1.0).abs() < 0.1, "{got:e} against {want:e}");
+}
+
+#[test]
+fn a_tia_flicker_off_its_law_at_the_carrier_is_said_with_its_size() {
+    // At fs_hz = 36 kHz the carrier (15 kHz) lies far above fs/20, where the design follows
+    // 1/f within its ripple: the TIA's density there is the design's, above e_n^2 corner/f.
+    // The warning states the excess of the whole TIA noise at the carrier, in power; the
+    // TIA output's spectrum around the carrier shows it.
+    let (e_n, corner) = (1e-7, 1.5e6);
+    let text = format!(
+        "[device]\nf0_hz = 15000.0\nq = 2000.0\nangular_gain = 1.0\n[drive]\nf1 = 1e-30\nf2 = 1e-30\n[board]\nfs_hz = 36000.0\ntia_pole_hz = 17000.0\nlpf_cutoff_hz = 200.0\ndecimation = 15\n[experiment]\nkind = \"coriolis\"\nrates_dps = [100.0]\naverage_s = 1.0\n[noise]\nseed = 5\ntia_voltage_noise_v_per_rthz = {e_n:e}\ntia_voltage_flicker_corner_hz = {corner:e}\nflicker_f_lo_hz = 0.1\n"
+    );
+    let c = gyroemu::config::parse_config(&text).unwrap();
+    let w = c.validate().unwrap();
+    let said = w
+        .iter()
+        .find(|w| w.contains("voltage flicker is designed"))
+        .expect("the warning");
+    let stated: f64 = {
+        let rest = &said[said.find("TIA noise there by ").unwrap() + 19..];
+        rest[..rest.find(" %").unwrap()].parse().unwrap()
+    };
+    assert!(stated > 20.0, "{said}");
+    let fs = c.fs_hz();
+    let d = full_rate_dump(&c, &["tia"], 0.05, 4.0);
+    let y = d.channel("tia1_v").unwrap().to_vec();
+    let psd = gyroemu_spectrum::welch(&y, fs, Some(1 << 12)).unwrap();
+    let density = psd.density();
+    let tia = gyroemu::tia::Tia::<f64>::new(&c.board_params().tia).unwrap();
+    let (mut got, mut law) = (0.0, 0.0);
+    for k in 1..psd.power.len() {
+        let f = psd.freq_hz(k);
+        if (f - 15_000.0).abs() > 300.0 {
+            continue;
+        }
+        let h = gyroemu::Response::response(&tia, f).norm() / c.board.tia_gain_ohm;
+        got += density[k];
+        law += e_n * e_n * (1.0 + corner / f) * h * h;
+    }
+    // About 70 bins of 35 segments: a few per cent of scatter.
+    let measured = 100.0 * (got / law - 1.0);
+    assert!(
+        (measured - stated).abs() < 8.0,
+        "{measured:.1} % measured against {stated} % stated"
+    );
+    // At 240 kHz (16 samples a period) the same source follows its law at the carrier.
+    let at_16 = text
+        .replace("fs_hz = 36000.0", "fs_hz = 240000.0")
+        .replace("tia_pole_hz = 17000.0", "tia_pole_hz = 60000.0")
+        .replace("decimation = 15", "decimation = 100");
+    let w = gyroemu::config::parse_config(&at_16)
+        .unwrap()
+        .validate()
+        .unwrap();
+    assert!(
+        !w.iter().any(|w| w.contains("voltage flicker is designed")),
+        "{w:?}"
+    );
 }
 
 #[test]
