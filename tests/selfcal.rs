@@ -464,6 +464,20 @@ fn selfcal_judges_the_config_as_it_reads_it_not_the_parts_it_ignores() {
         assert_eq!(validate_selfcal(&drift(c)).unwrap(), want);
         assert!(drift_tracking_design(&drift(c)).is_some());
     }
+    // A refused rate is named by its index in the user's list, rate 0 counted (the rotating
+    // sweep's list leaves it out: index 2, the 50 in the file, was named for the 1e8).
+    let mut far = with_zero.clone();
+    far.experiment.rates_dps = vec![0.0, 50.0, 100.0, 1e8, 150.0];
+    let e = validate_selfcal(&far).unwrap_err();
+    let keys: Vec<Option<String>> = e.problems().into_iter().map(|p| p.key).collect();
+    assert!(
+        keys.contains(&Some("experiment.rates_dps[3]".into())),
+        "{e}"
+    );
+    assert!(
+        !keys.contains(&Some("experiment.rates_dps[2]".into())),
+        "{e}"
+    );
     // What selfcal does read is judged still: the same parts beside a too short average.
     for c in [&with_zero, &dumped, &table] {
         let mut short = c.clone();
@@ -524,4 +538,28 @@ fn selfcal_names_the_run_each_added_warning_holds_for() {
     for (i, t) in texts.iter().enumerate() {
         assert!(!texts[i + 1..].contains(t), "{t} said twice");
     }
+}
+
+#[test]
+fn the_allan_fit_is_widened_by_the_rate_table_slopes_own_error() {
+    // The rate-equivalent Allan terms divide the phase by the measured rate-table slope of
+    // mode 1; their intervals count that slope's 95 % relative half-width, t95(dof) se/|s|.
+    let mut c = fast_cfg(&[50.0, 100.0, 150.0, 175.0], 7.2);
+    c.noise = tia_noise(3, 2e-12);
+    c.selfcal = Some(SelfcalConfig {
+        allan_record_s: Some(20.0),
+        ..Default::default()
+    });
+    validate_selfcal(&c).unwrap();
+    let r = gyroemu::analysis::run_selfcal(&c, &gyroemu::experiment::Quiet).unwrap();
+    let s = &r.core.modes[0].coriolis;
+    let want =
+        gyroemu::experiment::fit::t95(s.dof) * s.std_err_deg_per_dps / s.slope_deg_per_dps.abs();
+    let a = r.allan.unwrap();
+    assert_eq!(a.scale_deg_per_dps, s.slope_deg_per_dps);
+    assert!(
+        want > 0.0 && (a.scale_rel_ci95 / want - 1.0).abs() < 1e-12,
+        "{} vs {want}",
+        a.scale_rel_ci95
+    );
 }

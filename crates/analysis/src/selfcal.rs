@@ -156,13 +156,46 @@ pub fn as_read(cfg: &Config) -> Config {
     }
 }
 
+/// `e`'s problems, of a config whose rates are `cfg`'s without rate 0 (the rotating sweep's,
+/// or a rotating config as selfcal reads it), keyed by the index in `cfg`'s own list: a
+/// refusal of `rates_dps = [0.0, 25.0, 50.0, 1e5]` named `experiment.rates_dps[2]` (50 in
+/// the file) for the 1e5 at index 3.
+fn at_users_rate(cfg: &Config, e: ConfigError) -> ConfigError {
+    let users: Vec<usize> = (0..cfg.experiment.rates_dps.len())
+        .filter(|&i| cfg.experiment.rates_dps[i] != 0.0)
+        .collect();
+    let list: Vec<ConfigError> = e
+        .problems()
+        .into_iter()
+        .map(|mut p| {
+            let index = p
+                .key
+                .as_deref()
+                .and_then(|k| k.strip_prefix("experiment.rates_dps["))
+                .and_then(|k| k.strip_suffix(']'))
+                .and_then(|j| j.parse::<usize>().ok());
+            if let Some(&i) = index.and_then(|j| users.get(j)) {
+                p.key = Some(format!("experiment.rates_dps[{i}]"));
+            }
+            p
+        })
+        .collect();
+    ConfigError::from_problems(list).unwrap_or(e)
+}
+
 /// Validates every config `selfcal` will run (the config as it reads it, [`as_read`], both
 /// sweeps, and each drifted device) before any sample is computed; returns the config's
 /// warnings, then those the runs it derives add, or every problem in one error (the sweeps'
 /// under keys the config's own problems do not name; the analyses' configs only once the
 /// config is valid).
 pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
-    let base = as_read(cfg).validate();
+    // Every config with the rotating sweep's rates (rate 0 left out) has its problems keyed
+    // by the index in the user's list.
+    let users = |r: Result<Vec<String>, ConfigError>| r.map_err(|e| at_users_rate(cfg, e));
+    let base = match cfg.experiment.kind {
+        ExperimentKind::Rotating => users(as_read(cfg).validate()),
+        ExperimentKind::Coriolis => as_read(cfg).validate(),
+    };
     // A slope needs two distinct rates besides zero, and its 95 % interval a third (the
     // residual scatter has points - 2 degrees of freedom).
     let mut distinct: Vec<f64> = Vec::new();
@@ -196,7 +229,7 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
             }
             let (rot, cor) = sweep_configs(cfg);
             for (what, r) in [
-                ("rotating sweep", rot.validate()),
+                ("rotating sweep", users(rot.validate())),
                 ("rate-table sweep", cor.validate()),
             ] {
                 for p in r.err().map(|e| e.problems()).unwrap_or_default() {
@@ -228,13 +261,13 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
         }
         Err(e) => problems.push(e.map_details(|d| format!("{d} (in the {what} of selfcal)"))),
     };
-    add("rotating sweep", rot.validate());
+    add("rotating sweep", users(rot.validate()));
     add("rate-table sweep", cor.validate());
     if let Some(s) = &cfg.selfcal {
         if !s.drift_delta_t_k.is_empty() && cfg.pll.is_none() {
             // The PLL-tracked half of the drift scenario locks with the default loop; where
             // none fits the board, that half is left out (null), and said so.
-            if let Err(e) = drift_pll_design(cfg).validate() {
+            if let Err(e) = users(drift_pll_design(cfg).validate()) {
                 add("drift scenario", Ok(vec![format!(
                     "selfcal.drift_delta_t_k: the drift scenario's PLL-tracked half is left out (null): the default carrier PLL does not fit this board ({}); add a [pll] section that fits to get it",
                     e.problems().iter().map(|p| p.to_string()).collect::<Vec<_>>().join("; ")
@@ -244,14 +277,14 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
         for &dt in &s.drift_delta_t_k {
             let (r, c) = sweep_configs(&drifted(cfg, dt));
             let what = format!("drift scenario at dT = {dt:+} K");
-            add(&what, r.validate());
+            add(&what, users(r.validate()));
             add(&what, c.validate());
         }
         if let Some(t) = s.tau_max_s {
             let mut r = rot.clone();
             r.experiment.average_s = t;
             // That run's averaging time is selfcal.tau_max_s: its refusal names the key set.
-            let v = r.validate().map_err(|e| {
+            let v = users(r.validate()).map_err(|e| {
                 let list = e
                     .problems()
                     .into_iter()

@@ -45,14 +45,14 @@ pub struct AllanResult {
     pub scale_rel_ci95: f64,
     /// Why the noise-model fit's terms may not be the device's, if a configured source has a
     /// term the model lacks (the carrier's phase flicker).
-    pub model_warning: Option<&'static str>,
+    pub model_warning: Option<String>,
 }
 
 /// The carrier's phase flicker turns the drives and the demodulation alike, so it cancels
 /// below the envelope corner and leaves a high-passed 1/f phase, whose Allan variance falls
 /// as ln(tau)/tau^2: IEEE Std 952's model has no such term, and its fit took it as angle random
 /// walk (3.3 to 3.8 deg/sqrt(h) with tight intervals for a source with none) and quantisation.
-const FLICKER_ANGLE_WARNING: &str = "noise.carrier_phase_flicker_rad_per_rthz is set: the carrier's flicker cancels below the envelope corner f0/(2Q) and leaves a term whose Allan variance falls as ln(tau)/tau^2, which IEEE Std 952's model has not; the fit takes it as angle random walk and quantisation, so allan.model_fit can read N and Q (with intervals) where the device has neither, or too large";
+const FLICKER_ANGLE_WARNING: &str = "the carrier's flicker cancels below the envelope corner f0/(2Q) and leaves a term whose Allan variance falls as ln(tau)/tau^2, which IEEE Std 952's model has not; the fit takes it as angle random walk and quantisation, so allan.model_fit can read N and Q (with intervals) where the device has neither, or too large";
 
 impl AllanResult {
     /// Why a reading is absent, only a bound, or unreliable: one line each, for the run's
@@ -170,7 +170,8 @@ pub fn allan_analysis(
     let flicker = cfg
         .noise
         .as_ref()
-        .is_some_and(|n| n.carrier_phase_flicker_rad_per_rthz > 0.0);
+        .map(|n| n.carrier_phase_flicker_rad_per_rthz)
+        .filter(|&x| x > 0.0);
     Ok(AllanResult {
         tau0_s: tau0,
         record_s: n_avg as f64 / fs_out,
@@ -179,7 +180,9 @@ pub fn allan_analysis(
         rate_dps: rate,
         scale_deg_per_dps,
         scale_rel_ci95,
-        model_warning: flicker.then_some(FLICKER_ANGLE_WARNING),
+        model_warning: flicker.map(|x| {
+            format!("noise.carrier_phase_flicker_rad_per_rthz = {x}: {FLICKER_ANGLE_WARNING}")
+        }),
     })
 }
 

@@ -2,7 +2,7 @@
 //! linearised (the self-calibration, one mode or both together, and its analyses all read
 //! their slopes so).
 
-use gyroemu_experiment::fit::{fit_line, LineFit};
+use gyroemu_experiment::fit::{fit_line, unwrapped_along, LineFit};
 use serde::Serialize;
 
 /// A scale factor read from a sweep: the small-angle slope of the phase against the rate,
@@ -28,6 +28,7 @@ pub fn linearised_slope(rates_dps: &[f64], phase_deg: &[f64]) -> SlopeFit {
         slope_deg_per_dps: f.slope.to_degrees(),
         std_err_deg_per_dps: f.slope_std_err.to_degrees(),
         dof: rates_dps.len().saturating_sub(2),
-        plain_fit: fit_line(rates_dps, phase_deg),
+        // Across a branch wrap as the linearised slope is (tan's period is a half turn).
+        plain_fit: fit_line(rates_dps, &unwrapped_along(rates_dps, phase_deg, 180.0)),
     }
 }

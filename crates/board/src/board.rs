@@ -48,7 +48,7 @@ pub(crate) struct NoiseState<S> {
 /// current, per mode, each with the physical density at that mode's resonance: the force a
 /// held white sequence (the plant holds its input over a sample), the current a plain white
 /// one (the TIA takes its input sample by sample; a sinc correction made its density at f0
-/// 1/sinc^2(f0/fs) too high, 1.3 % at 16 samples per period, 48 % at 3).
+/// 1/sinc^2(f0/fs) too high, 1.3 % at 16 samples per period, 46 % at 3).
 pub(crate) fn noise_sigmas(p: &BoardParams) -> ([f64; 2], [f64; 2]) {
     let Some(n) = &p.noise else {
         return ([0.0; 2], [0.0; 2]);

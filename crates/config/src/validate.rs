@@ -34,12 +34,12 @@ impl Config {
     /// settling, modulation or table) start with [`EXPERIMENT_WARNING`]: `sweep` does not
     /// run those points, and "at 5 deg/s" read as if it did (the ranges and clipping those
     /// rules name can still hold for the sweep's own drive, so it is not said they do not).
-    /// `[dump]` and `[selfcal]`, which `sweep` ignores, are not judged: an unused section
-    /// never refuses it.
+    /// `[dump]`, which `sweep` ignores, is not judged: an unused section never refuses it.
+    /// `[selfcal]` is (its record lengths set the flicker sources' derived low corner, which
+    /// the sweep's noise uses, and a corner derived from it must keep saying so).
     pub fn validate_sweep(&self) -> Result<Vec<String>, ConfigError> {
         let read = Config {
             dump: None,
-            selfcal: None,
             ..self.clone()
         };
         read.validate_with(true, true)

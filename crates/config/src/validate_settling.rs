@@ -288,7 +288,14 @@ impl Config {
                 self.default_settle_s()
             )
         } else {
-            "set experiment.settle_s longer".to_string()
+            // Each low-pass e-fold, 1/(2 pi fc sin(pi/(2 order))) for a Butterworth's slowest
+            // pole, and each plant tau, divides what is left by e.
+            let order = self.board.lpf_order.max(1) as f64;
+            let fold =
+                1.0 / (core::f64::consts::TAU * fc * (core::f64::consts::PI / (2.0 * order)).sin());
+            format!(
+                "set experiment.settle_s longer than this default: each {fold:.4} s more (an e-fold of the low-pass's slowest pole, 1/(2 pi lpf_cutoff_hz sin(pi/(2 lpf_order)))) divides the low-pass's part by e, each tau = {tau:.4} s the plant's"
+            )
         };
         // The low-pass's own start-up on the sidebands read is exact (no bound): once it is as
         // large as what the filter passes of them, the phase read is undetermined and no bound

@@ -35,22 +35,27 @@ fn the_defaults_follow_the_device() {
 }
 
 #[test]
-fn the_sections_sweep_ignores_never_refuse_it() {
-    // A `[dump]` at a rate the config does not list and a `[selfcal]` below its 2 s floor:
-    // `run` refuses both; `sweep` reads neither, so it accepts them with the same warnings.
+fn the_dump_sweep_ignores_never_refuses_it() {
+    // A `[dump]` at a rate the config does not list: `run` refuses it; `sweep` does not read
+    // it, so it accepts it with the same warnings. (`[selfcal]` is judged: its records set the
+    // flicker's derived low corner, which the sweep uses.)
     let text = format!(
-        "{}\n[dump]\nrate_dps = 60.0\n[selfcal]\ntau_max_s = 1.0\n",
+        "{}\n[dump]\nrate_dps = 60.0\n",
         preset_text("m2tfg-sweep").unwrap()
     );
     let c = parse_config(&text).unwrap();
     let e = c.validate().unwrap_err();
-    let keys: Vec<Option<String>> = e.problems().into_iter().map(|p| p.key).collect();
-    assert!(keys.contains(&Some("dump.rate_dps".into())), "{e}");
-    assert!(keys.contains(&Some("selfcal.tau_max_s".into())), "{e}");
+    assert_eq!(e.key.as_deref(), Some("dump.rate_dps"), "{e}");
     assert_eq!(
         c.validate_sweep().unwrap(),
         sweep_preset().validate_sweep().unwrap()
     );
+    let selfcal = text.clone() + "[selfcal]\ntau_max_s = 1.0\n";
+    let e = parse_config(&selfcal)
+        .unwrap()
+        .validate_sweep()
+        .unwrap_err();
+    assert_eq!(e.key.as_deref(), Some("selfcal.tau_max_s"), "{e}");
     // What it reads is judged still.
     let bad = text.replace("points = 61", "points = 2");
     assert!(parse_config(&bad).unwrap().validate_sweep().is_err());

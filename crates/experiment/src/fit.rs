@@ -72,9 +72,70 @@ pub fn t95(dof: usize) -> f64 {
     }
 }
 
+/// `ys` (degrees, at `xs`), each moved by whole `period`s to within half a period of the
+/// reading at the next smaller x, for the line fit: each reading sits on its theory's branch,
+/// and a strongly coupled device's psi crosses -90 deg between rates (a fit through that wrap
+/// read a slope of -0.081 against a theory of +0.0244 while every point matched its theory).
+/// A NaN stays NaN and is stepped over; readings already continuous keep their bits.
+pub fn unwrapped_along(xs: &[f64], ys: &[f64], period: f64) -> Vec<f64> {
+    let mut order: Vec<usize> = (0..xs.len().min(ys.len())).collect();
+    order.sort_by(|&a, &b| xs[a].total_cmp(&xs[b]));
+    let mut out = ys.to_vec();
+    let mut prev: Option<f64> = None;
+    for i in order {
+        let y = ys[i];
+        if !y.is_finite() {
+            continue;
+        }
+        let moved = match prev {
+            Some(p) => {
+                let k = ((p - y) / period).round();
+                if k == 0.0 {
+                    y
+                } else {
+                    y + k * period
+                }
+            }
+            None => y,
+        };
+        out[i] = moved;
+        prev = Some(moved);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unwrapping_along_x_restores_a_line_folded_onto_a_branch() {
+        // A line of slope 0.1 deg per unit over rates given out of order, folded into
+        // (-90, 90]: unwrapped by half turns (neighbours under a quarter turn apart) it is the
+        // line again, up to one whole offset.
+        let xs = [500.0, -500.0, 25.0, 175.0, 1000.0, -100.0];
+        let line: Vec<f64> = xs.iter().map(|x| 0.1 * x - 80.0).collect();
+        let folded: Vec<f64> = line
+            .iter()
+            .map(|y| y - 180.0 * ((y - 0.0) / 180.0).round())
+            .collect();
+        assert!(
+            folded.iter().zip(&line).any(|(a, b)| a != b),
+            "the fold moved some"
+        );
+        let u = unwrapped_along(&xs, &folded, 180.0);
+        let offset = u[0] - line[0];
+        assert!((offset / 180.0 - (offset / 180.0).round()).abs() < 1e-12);
+        for (a, b) in u.iter().zip(&line) {
+            assert!((a - b - offset).abs() < 1e-9, "{a} vs {b}");
+        }
+        // Readings already continuous keep their bits; a NaN stays and is stepped over.
+        let ys = [1.0, f64::NAN, 3.5, -2.25];
+        let v = unwrapped_along(&[1.0, 2.0, 3.0, 0.0], &ys, 360.0);
+        assert_eq!(v[0].to_bits(), 1.0f64.to_bits());
+        assert!(v[1].is_nan());
+        assert_eq!((v[2], v[3]), (3.5, -2.25));
+    }
 
     #[test]
     fn recovers_an_exact_line_and_scores_noise() {

@@ -2,7 +2,7 @@
 //! compensated from the board's own stage responses, the exact theory beside every point, and
 //! the paper's best linear fit.
 
-use crate::fit::{fit_line, LineFit};
+use crate::fit::{fit_line, unwrapped_along, LineFit};
 use crate::leaks::Stage2Leaks;
 use gyroemu_board::{
     unleak_sidebands, unleak_table_harmonics, ChainResponse, Health, LaneResult, Point, Shape,
@@ -226,38 +226,6 @@ fn clipping_warnings(h: &Health, points: &[(f64, bool, Health)], coriolis: bool)
         }
     }
     w
-}
-
-/// `ys` (degrees, at `xs`), each moved by whole `period`s to within half a period of the
-/// reading at the next smaller x, for the line fit: each reading sits on its theory's branch,
-/// and a strongly coupled device's psi crosses -90 deg between rates (a fit through that wrap
-/// read a slope of -0.081 against a theory of +0.0244 while every point matched its theory).
-/// A NaN stays NaN and is stepped over; readings already continuous keep their bits.
-fn unwrapped_along(xs: &[f64], ys: &[f64], period: f64) -> Vec<f64> {
-    let mut order: Vec<usize> = (0..xs.len().min(ys.len())).collect();
-    order.sort_by(|&a, &b| xs[a].total_cmp(&xs[b]));
-    let mut out = ys.to_vec();
-    let mut prev: Option<f64> = None;
-    for i in order {
-        let y = ys[i];
-        if !y.is_finite() {
-            continue;
-        }
-        let moved = match prev {
-            Some(p) => {
-                let k = ((p - y) / period).round();
-                if k == 0.0 {
-                    y
-                } else {
-                    y + k * period
-                }
-            }
-            None => y,
-        };
-        out[i] = moved;
-        prev = Some(moved);
-    }
-    out
 }
 
 /// `x` moved by a whole number of half turns into `(centre - pi/2, centre + pi/2]`, and

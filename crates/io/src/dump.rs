@@ -124,6 +124,21 @@ fn take_sibling_meta(d: &mut Dump) {
         ));
         return;
     }
+    // Its data's size first: a recording of another length is told without reading it.
+    let data = meta.with_file_name(format!(
+        "{}.sigmf-data",
+        name.strip_suffix(".csv").unwrap_or(&name)
+    ));
+    let want = (d.frames() * d.channels.len() * 8) as u64;
+    if let Ok(got) = std::fs::metadata(&data).map(|m| m.len()) {
+        if got != want {
+            d.notes.push(format!(
+                "`{}` beside this CSV holds another recording ({got} bytes of data, the CSV's samples {want}), {cannot}",
+                meta.display()
+            ));
+            return;
+        }
+    }
     let why_not = match read_sigmf(&meta) {
         Err(e) => format!("could not be read ({e})"),
         Ok(m) => match same_recording(d, &m) {
@@ -177,7 +192,12 @@ fn same_recording(csv: &Dump, sigmf: &Dump) -> Option<String> {
             sigmf.sample_rate_hz, csv.sample_rate_hz
         ));
     }
-    let same_bits = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    // Bit for bit, but any NaN equals any NaN (a payload need not survive the CSV's text).
+    let same_bits = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()))
+    };
     let same = csv
         .data
         .iter()

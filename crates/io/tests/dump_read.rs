@@ -97,6 +97,15 @@ fn a_csv_takes_the_metadata_beside_it_only_for_the_same_samples() {
         &|dir| std::fs::write(meta(dir), "{").unwrap(),
         "could not be read (",
     );
+    // Data of another length: told from its size, unread.
+    check(
+        &|dir| {
+            let data = dir.join("x.sigmf-data");
+            let bytes = std::fs::read(&data).unwrap();
+            std::fs::write(&data, &bytes[..bytes.len() - 24]).unwrap();
+        },
+        "holds another recording (7176 bytes of data, the CSV's samples 7200)",
+    );
     // One sample's last digit edited in the CSV: still a valid CSV, not the same samples.
     check(
         &|dir| {

@@ -145,8 +145,8 @@ pub fn validate_lot_capped(
             .collect();
         warnings.push(format!(
             "{} more distinct device warnings (from device {} on); to see a device's, run \
-             `gyroemu config --resolved` on its config from `gyroemu montecarlo CONFIG \
-             --print-device I`",
+             `gyroemu selfcal` on its config from `gyroemu montecarlo CONFIG --print-device I` \
+             (it validates it as the lot does, before any sample)",
             grouped.len() - LISTED_DEVICES,
             devices.iter().next().copied().unwrap_or_default()
         ));
