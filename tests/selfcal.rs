@@ -478,6 +478,19 @@ fn selfcal_judges_the_config_as_it_reads_it_not_the_parts_it_ignores() {
         !keys.contains(&Some("experiment.rates_dps[2]".into())),
         "{e}"
     );
+    // A Coriolis config keeps rate 0 as selfcal reads it: its own index stands, for its own
+    // rules and its rotating sweep's alike.
+    far.experiment.kind = gyroemu::config::ExperimentKind::Coriolis;
+    let e = validate_selfcal(&far).unwrap_err();
+    let keys: Vec<Option<String>> = e.problems().into_iter().map(|p| p.key).collect();
+    assert!(
+        keys.contains(&Some("experiment.rates_dps[3]".into())),
+        "{e}"
+    );
+    assert!(
+        !keys.contains(&Some("experiment.rates_dps[4]".into())),
+        "{e}"
+    );
     // What selfcal does read is judged still: the same parts beside a too short average.
     for c in [&with_zero, &dumped, &table] {
         let mut short = c.clone();

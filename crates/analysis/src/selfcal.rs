@@ -192,10 +192,12 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
     // Every config with the rotating sweep's rates (rate 0 left out) has its problems keyed
     // by the index in the user's list.
     let users = |r: Result<Vec<String>, ConfigError>| r.map_err(|e| at_users_rate(cfg, e));
-    let base = match cfg.experiment.kind {
-        ExperimentKind::Rotating => users(as_read(cfg).validate()),
-        ExperimentKind::Coriolis => as_read(cfg).validate(),
+    // A config as selfcal reads it has the rotating sweep's rates only when it is rotating.
+    let read = |c: &Config| match cfg.experiment.kind {
+        ExperimentKind::Rotating => users(c.validate()),
+        ExperimentKind::Coriolis => c.validate(),
     };
+    let base = read(&as_read(cfg));
     // A slope needs two distinct rates besides zero, and its 95 % interval a third (the
     // residual scatter has points - 2 degrees of freedom).
     let mut distinct: Vec<f64> = Vec::new();
@@ -267,7 +269,7 @@ pub fn validate_selfcal(cfg: &Config) -> Result<Vec<String>, ConfigError> {
         if !s.drift_delta_t_k.is_empty() && cfg.pll.is_none() {
             // The PLL-tracked half of the drift scenario locks with the default loop; where
             // none fits the board, that half is left out (null), and said so.
-            if let Err(e) = users(drift_pll_design(cfg).validate()) {
+            if let Err(e) = read(&drift_pll_design(cfg)) {
                 add("drift scenario", Ok(vec![format!(
                     "selfcal.drift_delta_t_k: the drift scenario's PLL-tracked half is left out (null): the default carrier PLL does not fit this board ({}); add a [pll] section that fits to get it",
                     e.problems().iter().map(|p| p.to_string()).collect::<Vec<_>>().join("; ")
