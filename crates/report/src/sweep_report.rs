@@ -4,7 +4,7 @@
 use crate::error::{create_dir, ReportError};
 use gyroemu_board::{Health, Shape};
 use gyroemu_config::Config;
-use gyroemu_experiment::fit::LineFit;
+use gyroemu_experiment::fit::{unwrapped_along, LineFit};
 use gyroemu_experiment::{theory_deg, SweepResult};
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
 use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
@@ -340,7 +340,20 @@ pub fn sweep_figure(cfg: &Config, r: &SweepResult, title: &str) -> Figure {
     } else {
         fig = fig.with(line(format!("{theory}, modes 1 and 2"), t1));
     }
-    if let Some(s) = fit_series("mode 1", &r.fit[0], &xs, &phases(r, 0), (lo, hi)) {
+    // The line is fitted to the readings unwrapped along rate; where that moved one (psi
+    // across its branch cut), the points sit a half turn off it, and the legend says why.
+    let ys = phases(r, 0);
+    let period = if r.shape.is_rotating() { 180.0 } else { 360.0 };
+    let moved = unwrapped_along(&xs, &ys, period)
+        .iter()
+        .zip(&ys)
+        .any(|(u, y)| u.to_bits() != y.to_bits() && !y.is_nan());
+    let who = if moved {
+        format!("mode 1, readings unwrapped by {period} deg along rate")
+    } else {
+        "mode 1".to_string()
+    };
+    if let Some(s) = fit_series(&who, &r.fit[0], &xs, &ys, (lo, hi)) {
         fig = fig.with(s);
     }
     fig

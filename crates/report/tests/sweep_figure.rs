@@ -326,3 +326,33 @@ fn fig6_leaves_out_the_fit_of_refused_points_and_prints_no_nan() {
     assert!(d[0].name.starts_with("best linear fit, Coriolis mode 1: "));
     assert!(fig.series.iter().all(|s| !s.name.contains("NaN")));
 }
+
+#[test]
+fn a_fit_across_psis_branch_cut_says_its_readings_were_unwrapped() {
+    // Readings folded into (-90, 90] (psi of a strongly coupled device crossing -90 deg):
+    // the line is fitted to them unwrapped by half turns, so it misses the folded points by a
+    // half turn, and its legend says why; a sweep that never wraps keeps the plain legend.
+    let cfg = rotating(&[-500.0, 25.0, 175.0, 1000.0]);
+    let folded = |x: f64| {
+        let y: f64 = 0.0244 * x - 89.0;
+        let y = y - 180.0 * (y / 180.0).round();
+        [y, y]
+    };
+    let r = result(&cfg, folded);
+    assert!(r.points[0].phase_deg[0] > 45.0, "{:?}", r.points[0]);
+    let fig = sweep_figure(&cfg, &r, &run_title(&cfg));
+    let label = |fig: &Figure| {
+        fig.series
+            .iter()
+            .find(|s| s.name.starts_with("best linear fit"))
+            .map(|s| s.name.clone())
+            .unwrap()
+    };
+    assert!(
+        label(&fig).contains("readings unwrapped by 180 deg along rate"),
+        "{}",
+        label(&fig)
+    );
+    let plain = sweep_figure(&cfg, &result(&cfg, |x| theory_deg(&cfg, x)), "t");
+    assert!(!label(&plain).contains("unwrapped"), "{}", label(&plain));
+}
