@@ -12,7 +12,7 @@ mod common;
 use common::*;
 use gyroemu::analysis::allan::overlapping_adev;
 use gyroemu::analysis::selfcal_analyses::allan_analysis;
-use gyroemu::board::{Board, Point, Probe, RunOptions};
+use gyroemu::board::{Board, Point, RunOptions};
 use gyroemu::config::{Config, NoiseConfig};
 use gyroemu::lpf::Window;
 
@@ -33,36 +33,6 @@ fn flicker_cfg(f: impl Fn(&mut NoiseConfig)) -> Config {
     c.resolve();
     c.validate().unwrap();
     c
-}
-
-/// The full-rate dump of `nodes` over `dur_s` from `start_s`, recorded by a one-point zero-rate
-/// board run just past the window, written and read back as a user would.
-fn full_rate_dump(c: &Config, nodes: &[&str], start_s: f64, dur_s: f64) -> gyroemu_io::Dump {
-    let nodes: Vec<String> = nodes.iter().map(|n| n.to_string()).collect();
-    let mut probe = Probe::new(&nodes, c.fs_hz(), c.decimation(), start_s, dur_s, 0);
-    let n_out = ((start_s + dur_s) * c.fs_out_hz()).ceil() as u64 + 2;
-    let point = Point {
-        rate_rad_s: 0.0,
-        window: Window::Boxcar {
-            n: n_out,
-            frac: 0.0,
-        },
-    };
-    Board::<f64>::new(&c.board_params(), &[0.0], &[0])
-        .unwrap()
-        .run(
-            0,
-            &[point],
-            RunOptions {
-                probe: Some(&mut probe),
-                ..Default::default()
-            },
-            &|_| {},
-        )
-        .unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    probe.write(dir.path(), "d").unwrap();
-    gyroemu_io::read_dump(&dir.path().join("d_fullrate")).unwrap()
 }
 
 /// The Allan deviation of the zero-rate mode-1 phase, rad, at taus in `[lo, hi]` s.

@@ -4,8 +4,9 @@
 //! the TIA's input noise and for the Brownian force. Each closed form is written out here.
 
 mod common;
+use common::full_rate_dump;
 
-use gyroemu::board::{Board, Point, Probe, RunOptions};
+use gyroemu::board::{Board, Point, RunOptions};
 use gyroemu::config::presets::preset;
 use gyroemu::config::{Config, NoiseConfig, WindowKind};
 use gyroemu::core::f64x4;
@@ -47,32 +48,7 @@ fn brownian_motion_obeys_equipartition() {
     let (m, t) = (1e-12, 300.0);
     cfg.noise = Some(noise(Some(m), 0.0, 0.0));
     cfg.validate().unwrap();
-    let (start_s, dur_s) = (1.0, 60.0);
-    let nodes = vec!["displacement".to_string(), "velocity".to_string()];
-    let mut probe = Probe::new(&nodes, 16_000.0, 10, start_s, dur_s, 0);
-    let fs_out = cfg.fs_out_hz();
-    let p = Point {
-        rate_rad_s: 0.0,
-        window: Window::Boxcar {
-            n: ((start_s + dur_s) * fs_out) as u64,
-            frac: 0.0,
-        },
-    };
-    let opts = RunOptions {
-        probe: Some(&mut probe),
-        ..Default::default()
-    };
-    Board::<f64>::new(&cfg.board_params(), &[0.0], &[0])
-        .unwrap()
-        .run(0, &[p], opts, &|_| {})
-        .unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    probe.write(dir.path(), "eq").unwrap();
-    let bytes = std::fs::read(dir.path().join("eq_fullrate.sigmf-data")).unwrap();
-    let x: Vec<f64> = bytes
-        .chunks_exact(8)
-        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
-        .collect();
+    let d = full_rate_dump(&cfg, &["displacement", "velocity"], 1.0, 60.0);
     let w0 = 2.0 * PI * 1000.0;
     let expected = [
         K_B * t / (m * w0 * w0),
@@ -81,7 +57,7 @@ fn brownian_motion_obeys_equipartition() {
         K_B * t / m,
     ];
     for (c, e) in expected.iter().enumerate() {
-        let v: Vec<f64> = x.iter().skip(c).step_by(4).copied().collect();
+        let v = &d.data[c];
         let ms = v.iter().map(|a| a * a).sum::<f64>() / v.len() as f64;
         assert!(
             (ms / e - 1.0).abs() < 0.05,
@@ -91,8 +67,8 @@ fn brownian_motion_obeys_equipartition() {
 }
 
 /// The TIA output's samples of a run with the TIA's input current noise alone, at `fs_hz`
-/// (f0 = 1 kHz, a negligible drive), `seconds` long, both modes interleaved.
-fn tia_noise_samples(fs_hz: f64, pole_hz: Option<f64>, seconds: f64) -> Vec<f64> {
+/// (f0 = 1 kHz, a negligible drive), `seconds` long, one vector per mode.
+fn tia_noise_samples(fs_hz: f64, pole_hz: Option<f64>, seconds: f64) -> Vec<Vec<f64>> {
     let mut cfg: Config = preset("m2tfg-coriolis").unwrap();
     cfg.device.f0_hz = 1000.0;
     cfg.device.q = 100.0;
@@ -109,33 +85,7 @@ fn tia_noise_samples(fs_hz: f64, pole_hz: Option<f64>, seconds: f64) -> Vec<f64>
     cfg.noise = Some(noise(None, 1e-12, 0.0));
     cfg.resolve();
     cfg.validate().unwrap();
-    let m = cfg.decimation();
-    let nodes = vec!["tia".to_string()];
-    let start_s = 0.1;
-    let mut probe = Probe::new(&nodes, fs_hz, m, start_s, seconds, 0);
-    let fs_out = cfg.fs_out_hz();
-    let p = Point {
-        rate_rad_s: 0.0,
-        window: Window::Boxcar {
-            n: ((start_s + seconds) * fs_out) as u64,
-            frac: 0.0,
-        },
-    };
-    let opts = RunOptions {
-        probe: Some(&mut probe),
-        ..Default::default()
-    };
-    Board::<f64>::new(&cfg.board_params(), &[0.0], &[0])
-        .unwrap()
-        .run(0, &[p], opts, &|_| {})
-        .unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    probe.write(dir.path(), "tia").unwrap();
-    let bytes = std::fs::read(dir.path().join("tia_fullrate.sigmf-data")).unwrap();
-    bytes
-        .chunks_exact(8)
-        .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
-        .collect()
+    full_rate_dump(&cfg, &["tia"], 0.1, seconds).data
 }
 
 #[test]
@@ -150,8 +100,7 @@ fn tia_input_noise_has_its_density_however_few_samples_a_period() {
         let a = pole.map_or(0.0, |p: f64| (-2.0 * PI * p / fs).exp());
         let gain2 = (1.0 - a) * (1.0 - a) * r * r / (1.0 - a * a);
         let want = s * fs / 2.0 * gain2;
-        for mode in 0..2 {
-            let v: Vec<f64> = x.iter().skip(mode).step_by(2).copied().collect();
+        for (mode, v) in x.iter().enumerate() {
             let ms = v.iter().map(|y| y * y).sum::<f64>() / v.len() as f64;
             // 4e5 samples: the mean square is within about 0.5 % (1 sigma) of its expectation.
             assert!(

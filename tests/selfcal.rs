@@ -466,31 +466,23 @@ fn selfcal_judges_the_config_as_it_reads_it_not_the_parts_it_ignores() {
     }
     // A refused rate is named by its index in the user's list, rate 0 counted (the rotating
     // sweep's list leaves it out: index 2, the 50 in the file, was named for the 1e8).
+    // The rate keys a refusal names: it must name `named` and not `not`.
+    let names = |c: &Config, named: usize, not: usize| {
+        let e = validate_selfcal(c).unwrap_err();
+        let keys: Vec<Option<String>> = e.problems().into_iter().map(|p| p.key).collect();
+        let key = |i: usize| Some(format!("experiment.rates_dps[{i}]"));
+        assert!(
+            keys.contains(&key(named)) && !keys.contains(&key(not)),
+            "{e}"
+        );
+    };
     let mut far = with_zero.clone();
     far.experiment.rates_dps = vec![0.0, 50.0, 100.0, 1e8, 150.0];
-    let e = validate_selfcal(&far).unwrap_err();
-    let keys: Vec<Option<String>> = e.problems().into_iter().map(|p| p.key).collect();
-    assert!(
-        keys.contains(&Some("experiment.rates_dps[3]".into())),
-        "{e}"
-    );
-    assert!(
-        !keys.contains(&Some("experiment.rates_dps[2]".into())),
-        "{e}"
-    );
+    names(&far, 3, 2);
     // A Coriolis config keeps rate 0 as selfcal reads it: its own index stands, for its own
     // rules and its rotating sweep's alike.
     far.experiment.kind = gyroemu::config::ExperimentKind::Coriolis;
-    let e = validate_selfcal(&far).unwrap_err();
-    let keys: Vec<Option<String>> = e.problems().into_iter().map(|p| p.key).collect();
-    assert!(
-        keys.contains(&Some("experiment.rates_dps[3]".into())),
-        "{e}"
-    );
-    assert!(
-        !keys.contains(&Some("experiment.rates_dps[4]".into())),
-        "{e}"
-    );
+    names(&far, 3, 4);
     // What selfcal does read is judged still: the same parts beside a too short average.
     for c in [&with_zero, &dumped, &table] {
         let mut short = c.clone();

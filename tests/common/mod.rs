@@ -2,8 +2,10 @@
 //! independently of `gyroemu::experiment::theory`, and small config builders.
 #![allow(dead_code)]
 
+use gyroemu::board::{Board, Point, Probe, RunOptions};
 use gyroemu::config::{parse_config, Config};
 use gyroemu::experiment::{run_sweep, SweepResult};
+use gyroemu::lpf::Window;
 use std::f64::consts::PI;
 
 pub const DEG: f64 = PI / 180.0;
@@ -82,4 +84,34 @@ average_s = {average_s}
 /// Runs a sweep with no progress output.
 pub fn run(cfg: &Config) -> SweepResult {
     run_sweep(cfg, &|_, _| {}, None).expect("sweep runs")
+}
+
+/// The full-rate dump of `nodes` over `dur_s` from `start_s`, recorded by a one-point zero-rate
+/// board run just past the window, written and read back as a user would.
+pub fn full_rate_dump(c: &Config, nodes: &[&str], start_s: f64, dur_s: f64) -> gyroemu_io::Dump {
+    let nodes: Vec<String> = nodes.iter().map(|n| n.to_string()).collect();
+    let mut probe = Probe::new(&nodes, c.fs_hz(), c.decimation(), start_s, dur_s, 0);
+    let n_out = ((start_s + dur_s) * c.fs_out_hz()).ceil() as u64 + 2;
+    let point = Point {
+        rate_rad_s: 0.0,
+        window: Window::Boxcar {
+            n: n_out,
+            frac: 0.0,
+        },
+    };
+    Board::<f64>::new(&c.board_params(), &[0.0], &[0])
+        .unwrap()
+        .run(
+            0,
+            &[point],
+            RunOptions {
+                probe: Some(&mut probe),
+                ..Default::default()
+            },
+            &|_| {},
+        )
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    probe.write(dir.path(), "d").unwrap();
+    gyroemu_io::read_dump(&dir.path().join("d_fullrate")).unwrap()
 }
