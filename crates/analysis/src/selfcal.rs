@@ -64,9 +64,10 @@ pub fn mode_selfcal(cfg: &Config, rot: &SweepResult, cor: &SweepResult, k: usize
     let relative_error_theory = lambda * theory(rot) / theory(cor) - 1.0;
     let predicted = lambda * rotating.slope_deg_per_dps;
     let measured = coriolis.slope_deg_per_dps;
-    let rel = |s: &SlopeFit| s.std_err_deg_per_dps / s.slope_deg_per_dps;
     let ratio = predicted / measured;
-    let ci = t95(rotating.dof.min(coriolis.dof)) * ratio * rel(&rotating).hypot(rel(&coriolis));
+    let ci = t95(rotating.dof.min(coriolis.dof))
+        * ratio
+        * rotating.rel_std_err().hypot(coriolis.rel_std_err());
     let predicted_paper = lambda * rotating_paper_i.slope_deg_per_dps;
     let d = &cfg.device;
     let q2 = d.q_mode2.unwrap_or(d.q);

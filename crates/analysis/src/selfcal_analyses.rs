@@ -379,8 +379,9 @@ pub fn tau_analysis(
                 * comb.rel_std_err.hypot(combined_coriolis.rel_std_err);
             let predicted = lambda * s.slope_deg_per_dps;
             let ratio = predicted / measured_deg_per_dps;
-            let rel = |f: &SlopeFit| f.std_err_deg_per_dps / f.slope_deg_per_dps;
-            let ci = t95(s.dof.min(coriolis.dof)) * ratio * rel(&s).hypot(rel(coriolis));
+            let ci = t95(s.dof.min(coriolis.dof))
+                * ratio
+                * s.rel_std_err().hypot(coriolis.rel_std_err());
             // The rotating sweep's own exact theory, read the same way: what a noiseless,
             // untruncated reading gives.
             let theory: Vec<f64> = res.points.iter().map(|p| p.theory_deg[0]).collect();

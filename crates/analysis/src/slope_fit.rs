@@ -20,6 +20,13 @@ pub struct SlopeFit {
     pub plain_fit: LineFit,
 }
 
+impl SlopeFit {
+    /// The slope's standard error over the slope (signed as the slope).
+    pub fn rel_std_err(&self) -> f64 {
+        self.std_err_deg_per_dps / self.slope_deg_per_dps
+    }
+}
+
 /// The linearised slope of `phase_deg` against `rates_dps`.
 pub fn linearised_slope(rates_dps: &[f64], phase_deg: &[f64]) -> SlopeFit {
     let t: Vec<f64> = phase_deg.iter().map(|p| p.to_radians().tan()).collect();

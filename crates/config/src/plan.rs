@@ -64,12 +64,23 @@ impl Config {
     /// the factor gives every order the fourth order's e^-15.3.
     pub fn lowpass_settle_s(&self) -> f64 {
         use core::f64::consts::PI;
-        // Clamped to the orders the rules allow: a refused order must not make the derived
-        // settling, and so the run's span, a second refusal.
+        let slower = ((PI / 8.0).sin() / self.lowpass_slowest_sin()).max(1.0);
+        40.0 * slower / (2.0 * PI * self.lpf_cutoff_hz())
+    }
+
+    /// One e-fold of the stage-1 low-pass's start-up, s: its slowest pole decays at 2 pi
+    /// lpf_cutoff_hz sin(pi/(2 order)).
+    pub fn lowpass_efold_s(&self) -> f64 {
+        1.0 / (core::f64::consts::TAU * self.lpf_cutoff_hz() * self.lowpass_slowest_sin())
+    }
+
+    /// sin(pi/(2 order)) of the Butterworth low-pass, the order clamped to the orders the
+    /// rules allow: a refused order must not make the derived settling, and so the run's
+    /// span, a second refusal.
+    fn lowpass_slowest_sin(&self) -> f64 {
         let r = crate::schema::LPF_ORDER;
         let order = (self.board.lpf_order as u64).clamp(r.lo, r.hi) as f64;
-        let slower = ((PI / 8.0).sin() / (PI / (2.0 * order)).sin()).max(1.0);
-        40.0 * slower / (2.0 * PI * self.lpf_cutoff_hz())
+        (core::f64::consts::PI / (2.0 * order)).sin()
     }
 
     /// Settling in decimated samples (the whole output periods that cover `settle_s`).

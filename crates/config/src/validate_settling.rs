@@ -288,11 +288,8 @@ impl Config {
                 self.default_settle_s()
             )
         } else {
-            // Each low-pass e-fold, 1/(2 pi fc sin(pi/(2 order))) for a Butterworth's slowest
-            // pole, and each plant tau, divides what is left by e.
-            let order = self.board.lpf_order.max(1) as f64;
-            let fold =
-                1.0 / (core::f64::consts::TAU * fc * (core::f64::consts::PI / (2.0 * order)).sin());
+            // Each low-pass e-fold and each plant tau divides what is left by e.
+            let fold = self.lowpass_efold_s();
             format!(
                 "set experiment.settle_s longer than this default: each {fold:.4} s more (an e-fold of the low-pass's slowest pole, 1/(2 pi lpf_cutoff_hz sin(pi/(2 lpf_order)))) divides the low-pass's part by e, each tau = {tau:.4} s the plant's"
             )

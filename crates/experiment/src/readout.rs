@@ -228,6 +228,16 @@ fn clipping_warnings(h: &Health, points: &[(f64, bool, Health)], coriolis: bool)
     w
 }
 
+/// The period of a sweep's readings' branch, degrees: psi is read on a half turn's, a phase
+/// on a turn's.
+pub fn reading_period_deg(shape: Shape) -> f64 {
+    if matches!(shape, Shape::Rotating) {
+        180.0
+    } else {
+        360.0
+    }
+}
+
 /// `x` moved by a whole number of half turns into `(centre - pi/2, centre + pi/2]`, and
 /// whether that number was odd. `x` itself is moved (not `x - centre`), so a reading already on
 /// its branch keeps its bits.
@@ -527,12 +537,7 @@ pub fn post_process_with(
         .collect();
     let warnings = clipping_warnings(&health, &per_point, matches!(shape, Shape::Coriolis));
     let xs: Vec<f64> = out.iter().map(|p| p.rate_dps).collect();
-    // psi is read on a half turn's branch, a phase on a turn's.
-    let period = if matches!(shape, Shape::Rotating) {
-        180.0
-    } else {
-        360.0
-    };
+    let period = reading_period_deg(shape);
     let fit = [0, 1].map(|k| {
         let ys: Vec<f64> = out.iter().map(|p| p.phase_deg[k]).collect();
         fit_line(&xs, &unwrapped_along(&xs, &ys, period))

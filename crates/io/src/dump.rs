@@ -110,10 +110,11 @@ pub fn read_dump(path: &Path) -> Result<Dump, IoError> {
 /// tell a clipped window from a clean one.
 fn take_sibling_meta(d: &mut Dump) {
     let name = d.path.file_name().unwrap_or_default().to_string_lossy();
-    let meta = d.path.with_file_name(format!(
-        "{}.sigmf-meta",
-        name.strip_suffix(".csv").unwrap_or(&name)
-    ));
+    let stem = name.strip_suffix(".csv").unwrap_or(&name);
+    let (meta, data) = (
+        d.path.with_file_name(format!("{stem}.sigmf-meta")),
+        d.path.with_file_name(format!("{stem}.sigmf-data")),
+    );
     let cannot = "so the converter events of its window (a clipped DAC, TIA or ADC) are unknown \
                   and a clipped window reads clean here";
     if !meta.exists() {
@@ -125,10 +126,6 @@ fn take_sibling_meta(d: &mut Dump) {
         return;
     }
     // Its data's size first: a recording of another length is told without reading it.
-    let data = meta.with_file_name(format!(
-        "{}.sigmf-data",
-        name.strip_suffix(".csv").unwrap_or(&name)
-    ));
     let want = (d.frames() * d.channels.len() * 8) as u64;
     if let Ok(got) = std::fs::metadata(&data).map(|m| m.len()) {
         if got != want {

@@ -5,7 +5,7 @@ use crate::error::{create_dir, ReportError};
 use gyroemu_board::{Health, Shape};
 use gyroemu_config::Config;
 use gyroemu_experiment::fit::{unwrapped_along, LineFit};
-use gyroemu_experiment::{theory_deg, SweepResult};
+use gyroemu_experiment::{reading_period_deg, theory_deg, SweepResult};
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
 use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
 use serde_json::json;
@@ -343,7 +343,7 @@ pub fn sweep_figure(cfg: &Config, r: &SweepResult, title: &str) -> Figure {
     // The line is fitted to the readings unwrapped along rate; where that moved one (psi
     // across its branch cut), the points sit a half turn off it, and the legend says why.
     let ys = phases(r, 0);
-    let period = if r.shape.is_rotating() { 180.0 } else { 360.0 };
+    let period = reading_period_deg(r.shape);
     let moved = unwrapped_along(&xs, &ys, period)
         .iter()
         .zip(&ys)
