@@ -23,7 +23,7 @@ pub fn wav_f32_rate_problem(fs_hz: f64, channels: u64) -> Option<String> {
     let rate = fs_hz.round();
     if !(rate >= 1.0 && rate <= f64::from(u32::MAX)) {
         return Some(format!(
-            "fs_hz = {fs_hz} does not round to a WAV sample rate in 1..=2^32-1 Hz"
+            "the sample rate {fs_hz} Hz does not round to a WAV sample rate in 1..=2^32-1 Hz"
         ));
     }
     // A whole-Hz rate far from the true one scales every frequency and time read from the
@@ -31,7 +31,7 @@ pub fn wav_f32_rate_problem(fs_hz: f64, channels: u64) -> Option<String> {
     let off = (rate - fs_hz).abs() / fs_hz;
     if off > WAV_RATE_REL_TOL {
         return Some(format!(
-            "fs_hz = {fs_hz} rounds to the WAV sample rate {rate} Hz, {off:.1e} off (more than {WAV_RATE_REL_TOL:e}): a whole-Hz rate cannot describe it"
+            "the sample rate {fs_hz} Hz rounds to the WAV sample rate {rate} Hz, {off:.1e} off (more than {WAV_RATE_REL_TOL:e}): a whole-Hz rate cannot describe it"
         ));
     }
     if rate * channels as f64 * 4.0 > f64::from(u32::MAX) {

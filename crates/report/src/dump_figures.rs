@@ -232,8 +232,15 @@ fn lowpass_marks(set: &DumpSet, psd: &Psd) -> (Vec<Mark>, Option<String>) {
             what: "2 fc residual (aliased)".into(),
             freq_hz: alias,
         });
-    } else {
+    } else if alias < 0.5 * psd.bin_hz() {
         notes.push("the 2 fc residual aliases onto DC".into());
+    } else {
+        // Within two bins of DC but not on it: in a spectrum of a few bins that can be fs/2.
+        notes.push(format!(
+            "the 2 fc residual (aliased to {} Hz) unresolved in {} Hz bins",
+            sig3(alias),
+            sig3(psd.bin_hz())
+        ));
     }
     (marks, (!notes.is_empty()).then(|| notes.join("; ")))
 }

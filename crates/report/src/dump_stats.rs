@@ -10,6 +10,10 @@ pub const TONES_LISTED: usize = 4;
 /// A tone must stand this far above the median of its neighbouring bins to be listed, dB.
 pub const TONE_MIN_SNR_DB: f64 = 20.0;
 
+/// Below this many bins (segments under 32 samples) a tone's own main lobe is a third of the
+/// bins whose median it must clear: 24 samples of a clean level or tone found none.
+pub const SHORT_SPECTRUM_BINS: usize = 17;
+
 /// The numbers of one channel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ChannelStats {
@@ -28,6 +32,8 @@ pub struct ChannelStats {
     pub unresolved: Vec<Option<String>>,
     /// Why there are no tones, when the spectrum was refused (e.g. non-finite samples).
     pub spectrum_error: Option<String>,
+    /// Bins of the spectrum the tones were sought in (0 when it was refused).
+    pub bins: usize,
 }
 
 /// The statistics of every channel of `d`.
@@ -55,6 +61,7 @@ pub fn channel_stats(d: &gyroemu_io::Dump) -> Vec<ChannelStats> {
                 .iter()
                 .map(|t| psd.as_ref().and_then(|p| unresolved(p, t)))
                 .collect();
+            let bins = psd.as_ref().map_or(0, |p| p.power.len());
             ChannelStats {
                 name: c.name.clone(),
                 unit: channel_unit(&c.name, &c.unit).to_string(),
@@ -63,6 +70,7 @@ pub fn channel_stats(d: &gyroemu_io::Dump) -> Vec<ChannelStats> {
                 tones,
                 unresolved,
                 spectrum_error,
+                bins,
             }
         })
         .collect()
@@ -137,6 +145,10 @@ pub fn inspect_text(set: &DumpSet) -> String {
         for s in channel_stats(d) {
             let tones = match (&s.spectrum_error, s.tones.is_empty()) {
                 (Some(e), _) => format!("no spectrum: {e}"),
+                (None, true) if s.bins < SHORT_SPECTRUM_BINS => format!(
+                    "none read: a spectrum of {} bins is too short to tell a tone from its window's own leakage, which sets the median there; record a longer window",
+                    s.bins
+                ),
                 (None, true) => {
                     format!("none {TONE_MIN_SNR_DB} dB above the median of its neighbouring bins")
                 }

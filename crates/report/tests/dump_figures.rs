@@ -257,3 +257,66 @@ fn a_mark_at_fs_over_2_reads_unresolved() {
         dc.label
     );
 }
+
+#[test]
+fn a_residual_near_fs_over_2_in_a_coarse_spectrum_is_not_said_to_land_on_dc() {
+    // 24 decimated samples at 2400 Hz: 4-sample segments, 600 Hz bins; 2 fc = 30 kHz lands at
+    // 1200 Hz (fs/2), which is within two bins of DC there but is not DC.
+    let dir = tempfile::tempdir().unwrap();
+    let extra = BTreeMap::from([
+        ("carrier_hz".to_string(), 15_000.0),
+        ("decimation".into(), 100.0),
+    ]);
+    let mut dec = SignalRecorder::new(vec!["lp_i1".into()], 2400.0, 0, 24).with_extra(extra);
+    for k in 0..24u64 {
+        dec.record(k, &[-0.019]);
+    }
+    dec.write(dir.path(), "dump_decimated").unwrap();
+    let set = read_dump_set(&dir.path().join("dump_decimated.sigmf-meta")).unwrap();
+    let (_, panels) = spectrum_panels(&set);
+    let lp = panels
+        .iter()
+        .find(|f| f.title.starts_with("Low-pass"))
+        .unwrap();
+    assert!(!lp.title.contains("onto DC"), "{}", lp.title);
+    assert!(
+        lp.title.contains("aliased to 1200 Hz") && lp.title.contains("unresolved in 600 Hz bins"),
+        "{}",
+        lp.title
+    );
+}
+
+#[test]
+fn a_rotating_drive_with_its_sidebands_in_one_bin_pair_reads_no_level() {
+    // cos(Omega t) cos(wc t) over four modulation periods, the default dump window: the
+    // default segments are one modulation period, so the sidebands at fc +- Omega are one bin
+    // either side of fc and share their bins. Nothing is at fc; inspect read two tones 1 dB
+    // high 17 Hz off and the fc mark read a level.
+    let dir = tempfile::tempdir().unwrap();
+    let (fs, fc, om) = (240_000.0, 15_000.0, 240_000.0 / 1024.0);
+    let extra = BTreeMap::from([
+        ("carrier_hz".to_string(), fc),
+        ("omega_hz".into(), om),
+        ("decimation".into(), 100.0),
+    ]);
+    let n = 4096u64;
+    let mut full = SignalRecorder::new(vec!["drive1".into()], fs, 0, n).with_extra(extra);
+    for i in 0..n {
+        let t = i as f64 / fs;
+        full.record(i, &[(2.0 * PI * om * t).cos() * (2.0 * PI * fc * t).cos()]);
+    }
+    full.write(dir.path(), "dump_fullrate").unwrap();
+    let set = read_dump_set(&dir.path().join("dump_fullrate.sigmf-meta")).unwrap();
+    let s = &channel_stats(set.full.as_ref().unwrap())[0];
+    assert!(!s.tones.is_empty());
+    for (t, why) in s.tones.iter().zip(&s.unresolved) {
+        assert!(why.is_some(), "read {t:?}");
+    }
+    let (_, panels) = spectrum_panels(&set);
+    let fc_mark = panels
+        .iter()
+        .flat_map(|f| &f.markers)
+        .find(|m| m.label.starts_with("fc:"))
+        .unwrap();
+    assert!(fc_mark.label.contains("unresolved"), "{}", fc_mark.label);
+}

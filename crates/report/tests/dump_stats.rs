@@ -3,8 +3,10 @@
 //! samples keep the bits of the plain mean of squares; a spectrum beyond f64's range is said,
 //! with no tones listed; a NaN sample makes the peak NaN (it read 0 on an all-NaN channel).
 
+use gyroemu_io::SignalRecorder;
 use gyroemu_io::{Dump, SigmfChannel};
 use gyroemu_report::dump_stats::channel_stats;
+use gyroemu_report::{inspect_text, read_dump_set};
 use std::collections::BTreeMap;
 
 fn dump(x: Vec<f64>) -> Dump {
@@ -129,4 +131,33 @@ fn the_window_is_printed_to_a_sample_period_at_any_rate() {
         (ends[1] - ends[0] - 3.0 * period).abs() < 0.1 * period,
         "{window}"
     );
+}
+
+#[test]
+fn a_record_too_short_for_tones_says_so_not_that_none_stands_out() {
+    // 24 samples of a clean level: 4-sample segments, 3 bins, and the Hann window's own
+    // leakage (bin 1 = c^2/2) is the median a tone must clear by 20 dB. It printed "none 20
+    // dB above the median", as if the channel held no tone; 256 samples read the level.
+    for (n, short) in [(24u64, true), (256, false)] {
+        let dir = tempfile::tempdir().unwrap();
+        let mut r = SignalRecorder::new(vec!["lp_i1".into()], 2400.0, 0, n);
+        for k in 0..n {
+            r.record(k, &[-0.019]);
+        }
+        r.write(dir.path(), "dump_decimated").unwrap();
+        let set = read_dump_set(&dir.path().join("dump_decimated.sigmf-meta")).unwrap();
+        let text = inspect_text(&set);
+        let line = text.lines().find(|l| l.contains("lp_i1")).unwrap();
+        if short {
+            assert!(
+                line.contains("none read: a spectrum of 3 bins is too short"),
+                "{line}"
+            );
+        } else {
+            assert!(
+                line.contains(&format!("0.0: {:.1} dBV", 20.0 * 0.019f64.log10())),
+                "{line}"
+            );
+        }
+    }
 }

@@ -14,6 +14,8 @@ mod welch;
 mod window;
 
 pub use error::SpectrumError;
-pub use tones::{find_tones, tone_near, unresolved, Tone, EDGE_BINS};
+pub use tones::{
+    find_tones, tone_near, unresolved, Tone, EDGE_BINS, SPREAD_MAX, SPREAD_MIN_SEGMENTS,
+};
 pub use welch::{default_segment_len, power_of_two_scale, scale_exponent, welch, Psd};
 pub use window::{hann, hann_response, HANN_ENBW_BINS};

@@ -19,6 +19,11 @@ pub struct Psd {
     pub power: Vec<f64>,
     /// Equivalent noise bandwidth of the window, Hz: `fs sum(w^2) / sum(w)^2` (1.5 fs/L).
     pub enbw_hz: f64,
+    /// Per bin, the standard deviation of the segments' power over their mean (over the
+    /// segments, not their number less one): 0 for a steady tone or level, about 1 for
+    /// Gaussian noise (a bin's power is then exponential in each segment), between for a tone
+    /// whose level moves across the record. NaN with one segment, or where the mean is 0.
+    pub spread: Vec<f64>,
 }
 
 impl Psd {
@@ -102,6 +107,17 @@ pub fn welch(x: &[f64], fs_hz: f64, segment_len: Option<usize>) -> Result<Psd, S
     let mut scratch = vec![Complex64::default(); fft.get_inplace_scratch_len()];
     let bins = l / 2 + 1;
     let mut acc = vec![0.0; bins];
+    // The squares of the powers, normalised so that the largest a segment can hold (a
+    // constant at the peak: (L peak)^2) is 1, so that its square cannot overflow.
+    let mut acc2 = vec![0.0; bins];
+    let norm = {
+        let top = l as f64 * peak * down;
+        if top > 0.0 {
+            1.0 / (top * top)
+        } else {
+            1.0
+        }
+    };
     let mut segments = 0;
     let mut start = 0;
     while start + l <= x.len() {
@@ -109,8 +125,10 @@ pub fn welch(x: &[f64], fs_hz: f64, segment_len: Option<usize>) -> Result<Psd, S
             *b = Complex64::new(xi * down * wi, 0.0);
         }
         fft.process_with_scratch(&mut buf, &mut scratch);
-        for (a, b) in acc.iter_mut().zip(&buf) {
-            *a += b.norm_sqr();
+        for ((a, a2), b) in acc.iter_mut().zip(&mut acc2).zip(&buf) {
+            let p = b.norm_sqr();
+            *a += p;
+            *a2 += (p * norm) * (p * norm);
         }
         segments += 1;
         start += hop;
@@ -133,12 +151,26 @@ pub fn welch(x: &[f64], fs_hz: f64, segment_len: Option<usize>) -> Result<Psd, S
     if power.iter().any(|p| !p.is_finite()) || (held && strongest < f64::MIN_POSITIVE) {
         return Err(SpectrumError::OutOfRange { peak });
     }
+    let k = segments as f64;
+    let spread = acc
+        .iter()
+        .zip(&acc2)
+        .map(|(&a, &a2)| {
+            let mean = a * norm / k;
+            if segments < 2 || mean == 0.0 {
+                return f64::NAN;
+            }
+            // Rounding can leave a steady bin's variance a hair below 0.
+            ((a2 / k - mean * mean).max(0.0)).sqrt() / mean
+        })
+        .collect();
     Ok(Psd {
         fs_hz,
         segment_len: l,
         segments,
         power,
         enbw_hz: fs_hz * s2 / (s1 * s1),
+        spread,
     })
 }
 

@@ -11,12 +11,14 @@ use std::f64::consts::PI;
 /// A spectrum with the given per-bin powers (L = 2 (bins - 1), fs = 1000 Hz).
 fn psd_of(power: Vec<f64>) -> Psd {
     let segment_len = 2 * (power.len() - 1);
+    let spread = vec![f64::NAN; power.len()];
     Psd {
         fs_hz: 1000.0,
         segment_len,
         segments: 1,
         power,
         enbw_hz: 1.5 * 1000.0 / segment_len as f64,
+        spread,
     }
 }
 
