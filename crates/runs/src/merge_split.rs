@@ -125,14 +125,55 @@ pub(crate) fn read_split(dir: &Path) -> Result<Split, RunError> {
     // `count` comes from a file: the absent shards are listed without walking 0..count.
     let present: BTreeSet<usize> = by_index.keys().copied().collect();
     if let Some(absent) = absent_shards(&present, count) {
+        // One missing shard is named as the flag that runs it.
+        let how = if absent.contains([',', ' ']) {
+            format!("run each with --shard I/{count} (I as listed)")
+        } else {
+            format!("run it with --shard {absent}")
+        };
         return Err(bad(format!(
-            "shard {absent} of `{}` missing (no shard-I-of-{count}.json): run it with --shard \
-             I/{count} --out {}",
+            "shard {absent} of `{}` missing (no shard manifest for it): {how} --out {}",
             dir.display(),
             dir.display()
         )));
     }
     let item = item_name(first.kind);
+    // A whole run (or lot) written into the folder after its shards holds newer results than
+    // they do: merging them put back the shards' [dump], lot size or spec with exit 0.
+    let whole = dir.join(RUN_MANIFEST);
+    if whole.exists() {
+        let m = read_manifest(&whole).map_err(|e| bad(format!("`{}`: {e}", whole.display())))?;
+        let same = m.kind == first.kind
+            && m.config_sha256 == hash
+            && m.config_toml == first.config_toml
+            && m.points_total == first.points_total;
+        if m.shard.is_none() && !same {
+            let short = |h: &str| h[..h.len().min(12)].to_string();
+            let differs = if m.kind != first.kind {
+                format!("it is {}", m.kind.describe())
+            } else if m.points_total != first.points_total {
+                format!(
+                    "{} {item}s against the shards' {} {item}s",
+                    m.points_total, first.points_total
+                )
+            } else if m.config_sha256 != hash {
+                format!(
+                    "config sha256 {} against the shards' {}",
+                    short(&m.config_sha256),
+                    short(&hash)
+                )
+            } else {
+                "the same results but another [dump] or other sections the hash leaves out"
+                    .to_string()
+            };
+            return Err(bad(format!(
+                "`{}` describes a run without --shard written over the shards ({differs}): \
+                 merging them would put back older results. Rerun the shards into this folder \
+                 with --force, or merge them in a folder of their own",
+                whole.display(),
+            )));
+        }
+    }
     for (i, (_, m)) in &by_index {
         if m.status != "complete" {
             return Err(bad(format!(

@@ -361,3 +361,21 @@ fn untrusted_devices_leave_the_manifest_failed_in_a_lot_and_in_its_merge() {
     assert!(split.join("devices.csv").is_file());
     assert_failed(&split, &["every shard with --force"]);
 }
+
+#[test]
+fn merge_refuses_shards_a_grown_lot_was_written_over() {
+    // Two shards of 4 devices merged, then the lot grown to 6 on the merged folder without
+    // --shard: merging again rewrote the 4-device lot over it with exit 0.
+    let cfg = lot();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().join("grown");
+    for s in ["0/2", "1/2"] {
+        run_into(&cfg, &d, 4, Some(s), false, None).outcome.unwrap();
+    }
+    merge(&d, &Quiet).unwrap();
+    run_into(&cfg, &d, 6, None, false, None).outcome.unwrap();
+    let csv = std::fs::read(d.join("devices.csv")).unwrap();
+    let m = merge(&d, &Quiet).unwrap_err().to_string();
+    assert!(m.contains("6 devices") && m.contains("4 devices"), "{m}");
+    assert_eq!(std::fs::read(d.join("devices.csv")).unwrap(), csv);
+}

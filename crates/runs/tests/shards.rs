@@ -386,3 +386,33 @@ fn merge_refuses_shards_of_different_dumps() {
     assert!(run_shard(&with_dump(25.0), &out, shard(1)).0.is_ok());
     merge(&out, &Quiet).unwrap();
 }
+
+#[test]
+fn merge_refuses_shards_a_whole_run_of_another_dump_was_written_over() {
+    // Shards merged, then a whole run of the same sweep with another [dump] (which rewrites
+    // the dump): merging again put the shards' [dump] back into manifest.json and
+    // summary.json with exit 0, and a later run of the first [dump] then reused the wrong dump
+    // files.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("over");
+    let with_dump = |rate: f64| {
+        let text = format!(
+            "{NOISY}\n[dump]\nrate_dps = {rate}\nstart_s = 0.1\nduration_s = 0.002\nnodes = [\"tia\"]\n"
+        );
+        parse_config(&text).unwrap()
+    };
+    for i in 0..2 {
+        let s = Some(parse_shard(&format!("{i}/2")).unwrap());
+        assert!(run_shard(&with_dump(25.0), &out, s).0.is_ok());
+    }
+    merge(&out, &Quiet).unwrap();
+    // Merging again, with nothing newer in the folder, is allowed (the same result).
+    merge(&out, &Quiet).unwrap();
+    assert!(run_shard(&with_dump(50.0), &out, None).0.is_ok());
+    let why = merge_refusal(&out);
+    assert!(
+        why.contains("manifest.json") && why.contains("without --shard"),
+        "{why}"
+    );
+    assert!(!why.contains("  "), "{why}");
+}
