@@ -20,6 +20,13 @@ pub(crate) fn half_turn_mdeg(a: f64, b: f64) -> f64 {
     (d / DEG * 1e3).abs()
 }
 
+/// |a - b| in mdeg within a whole turn (a Coriolis phase's difference). NaN stays NaN.
+pub(crate) fn turn_mdeg(a: f64, b: f64) -> f64 {
+    let d = a - b;
+    let d = d - core::f64::consts::TAU * (d / core::f64::consts::TAU).round();
+    (d / DEG * 1e3).abs()
+}
+
 /// Every node's amplitude must lie in this band (in its own unit): products of two stay finite
 /// and normal, and no signal is rounded away in subnormals.
 pub const NODE_RANGE: (f64, f64) = (1e-100, 1e100);
@@ -398,10 +405,17 @@ impl Config {
                     .map(|h| h as f64 * freq_hz)
                     .collect(),
             };
-            let (e, f) = if self.shape() == Shape::Rotating {
-                self.rotating_mixer_product_bound_rad(&chain, &window, rate)
-            } else {
-                mixer_product_bound_rad(&chain, fc, fs_out, &window, &refs)
+            let (e, f) = match self.shape() {
+                Shape::Rotating => self.rotating_mixer_product_bound_rad(&chain, &window, rate),
+                // A Coriolis phase is read against the zero-rate reference, whose own product
+                // error adds to it: a 2714 mdeg bound was passed by 3071 mdeg.
+                Shape::Coriolis => {
+                    let (e, f) = mixer_product_bound_rad(&chain, fc, fs_out, &window, &refs);
+                    (2.0 * e, f)
+                }
+                Shape::RateTable { .. } => {
+                    mixer_product_bound_rad(&chain, fc, fs_out, &window, &refs)
+                }
             };
             if e > worst {
                 (worst, at) = (e, f);
@@ -409,12 +423,28 @@ impl Config {
         }
         let worst_mdeg = worst.to_degrees() * 1e3;
         if worst_mdeg > WARN_HOLD_ERROR_MDEG {
+            // Where 2 f_c already aliases into the low-pass's band at the sample rate, no
+            // decimation nor order removes it.
+            let fs = self.fs_hz();
+            let at_fs = (2.0 * fc - fs * (2.0 * fc / fs).round()).abs();
+            let advice = if at_fs < 2.0 * self.lpf_cutoff_hz() {
+                format!(
+                    "raise board.fs_hz: at {fs} Hz the product itself aliases to {at_fs:.6e} Hz, within twice the low-pass cutoff, whatever the decimation"
+                )
+            } else {
+                "choose a decimation whose output rate does not divide 2 f_c (remove the key for the derived one), or raise board.lpf_order".to_string()
+            };
             warnings.push(format!(
-                "board.decimation = {}: the stage-1 mixer's 2 f_c product ({} Hz), {:.1e} of it left by the low-pass, aliases to {:.6e} Hz at the output rate {fs_out} Hz, too close to the {at} Hz the read-out demodulates for its averaging to remove it: it can move the measured phase by up to {worst_mdeg:.3e} mdeg; choose a decimation whose output rate does not divide 2 f_c (remove the key for the derived one), or raise board.lpf_order",
+                "board.decimation = {}: the stage-1 mixer's 2 f_c product ({} Hz), {:.1e} of it left by the low-pass, aliases to {:.6e} Hz at the output rate {fs_out} Hz, too close to the {at} Hz the read-out demodulates for its averaging to remove it: it can move the measured phase by up to {worst_mdeg:.3e} mdeg{}; {advice}",
                 self.decimation(),
                 2.0 * fc,
                 leak,
-                alias.abs()
+                alias.abs(),
+                if self.shape() == Shape::Coriolis {
+                    " (its own error and the zero-rate reference's)"
+                } else {
+                    ""
+                }
             ));
         }
     }
@@ -532,7 +562,12 @@ impl Config {
                 ),
             };
             for k in 0..2 {
-                let e = half_turn_mdeg(held[k], exact[k]);
+                // Psi is known within a half turn; a Coriolis phase within a whole one (its
+                // half-turn fold read a 180 deg error as 32 mdeg at 1e9 deg/s).
+                let e = match self.shape() {
+                    Shape::Rotating => half_turn_mdeg(held[k], exact[k]),
+                    _ => turn_mdeg(held[k], exact[k]),
+                };
                 // A NaN (an unbuildable plant) is reported by the other rules.
                 if e.is_finite() {
                     worst = worst.max(e);

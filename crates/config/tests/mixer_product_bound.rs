@@ -66,3 +66,73 @@ fn the_rotating_fold_bound_covers_the_error_without_the_dc_term() {
         eprintln!("{device:?}: measured {worst:.3e} mdeg, stated {bound:.3e} mdeg");
     }
 }
+
+#[test]
+fn the_coriolis_fold_bound_counts_the_zero_rate_reference_too() {
+    // A first-order low-pass at 1500 Hz and M = 12 (output 20 kHz, the 2 f_c product's alias
+    // at 10 kHz) over a one-block window: the product moves each phasor, the rate's and the
+    // zero-rate reference's, and the Coriolis phase is their difference. The bound of one
+    // phasor (2714 mdeg) was passed by 3071 mdeg; both together bound it.
+    let c = parse_config(
+        "[device]\nf0_hz = 15000.0\nq = 2000.0\nangular_gain = 1.0\n\
+         [drive]\nf1 = 1.0\nf2 = 1.0\n\
+         [board]\nfs_hz = 240000.0\ntia_gain_ohm = 1e6\ntia_pole_hz = 60000.0\nlpf_order = 1\n\
+         lpf_cutoff_hz = 1500.0\ndecimation = 12\n\
+         [experiment]\nkind = \"coriolis\"\nrates_dps = [100.0, 1000.0]\naverage_s = 5e-5\n",
+    )
+    .unwrap();
+    let w = c.validate().unwrap();
+    let s = w
+        .iter()
+        .find(|s| s.starts_with("board.decimation = 12"))
+        .unwrap_or_else(|| panic!("{w:?}"));
+    assert!(s.contains("zero-rate reference"), "{s}");
+    let rest = &s[s.find("by up to ").unwrap() + 9..];
+    let bound: f64 = rest.split_once(" mdeg").unwrap().0.parse().unwrap();
+    // The emulated phase shift against the held board's exact steady state (the hold is not
+    // the product's): -arg z(rate) / z(0) per mode (stage 1 takes z = LPF{2 y e^{-j w t}}).
+    let (rates, lanes) = common::run(&c);
+    let dev = c.driven_device();
+    let zero = rates.iter().position(|&r| r == 0.0).unwrap();
+    let mut worst: f64 = 0.0;
+    for (r, l) in rates.iter().zip(&lanes) {
+        if *r == 0.0 {
+            continue;
+        }
+        let held = dev.held_coriolis_phase_rad(r.to_radians());
+        for (k, held) in held.iter().enumerate() {
+            let d = -(l.z[k] / lanes[zero].z[k]).arg() - held;
+            let d = (d - 2.0 * PI * (d / (2.0 * PI)).round()).to_degrees() * 1e3;
+            worst = worst.max(d.abs());
+        }
+    }
+    assert!(
+        worst <= bound,
+        "measured {worst} mdeg > stated {bound} mdeg"
+    );
+    // And the case is one where one phasor's bound alone did not hold.
+    assert!(worst > bound / 2.0, "measured {worst}, stated {bound} mdeg");
+}
+
+#[test]
+fn a_product_inside_the_pass_band_at_the_sample_rate_asks_for_a_higher_rate() {
+    // fs = 30030 Hz: 2 f_c = 30 kHz aliases to 30 Hz at the sample rate itself, inside the
+    // 200 Hz low-pass: no decimation nor order removes it.
+    let c = parse_config(
+        "[device]\nf0_hz = 15000.0\nq = 2000.0\nangular_gain = 1.0\n\
+         [drive]\nf1 = 1.0\nf2 = 1.0\n\
+         [board]\nfs_hz = 30030.0\ntia_gain_ohm = 1e6\ntia_pole_hz = 15000.0\nlpf_order = 4\n\
+         lpf_cutoff_hz = 200.0\ndecimation = 10\n\
+         [experiment]\nkind = \"coriolis\"\nrates_dps = [100.0, 1000.0]\naverage_s = 0.2\n",
+    )
+    .unwrap();
+    let w = c.validate().unwrap();
+    let s = w
+        .iter()
+        .find(|s| s.contains("2 f_c product"))
+        .unwrap_or_else(|| panic!("{w:?}"));
+    assert!(
+        s.contains("raise board.fs_hz") && !s.contains("choose a decimation"),
+        "{s}"
+    );
+}
