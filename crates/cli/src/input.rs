@@ -98,13 +98,19 @@ pub fn list_written(out: &Path, files: &[std::path::PathBuf]) {
 }
 
 /// `r`, having listed the files a run wrote before refusing numbers in them
-/// ([`gyroemu_runs::RunError::Refused`]): its list, as a run that completes ends with.
+/// ([`gyroemu_runs::RunError::Refused`]): its list, as a run that completes ends with, and a
+/// lot's figures on stdout.
 pub fn listing_refused<T>(
     r: Result<T, gyroemu_runs::RunError>,
     out: &Path,
     items: Option<ItemFiles>,
 ) -> Result<T, gyroemu_runs::RunError> {
-    if let Err(gyroemu_runs::RunError::Refused { files, .. }) = &r {
+    if let Err(gyroemu_runs::RunError::Refused { files, lot, .. }) = &r {
+        // A lot's figures over its trusted devices, as a completed lot prints them; the
+        // command fails with its error next, so a closed stdout changes nothing here.
+        if let Some(lot) = lot {
+            let _ = print_out(&crate::cmd::montecarlo::summary_text(lot));
+        }
         list_written_with(out, files, items);
     }
     r

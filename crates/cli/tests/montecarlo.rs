@@ -338,3 +338,27 @@ fn merge_refuses_a_manifest_claiming_an_oversized_lot() {
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("at most 1000000 devices"), "{err}");
 }
+
+#[test]
+fn a_lot_with_untrusted_devices_still_prints_its_figures() {
+    // A 2-bit ADC over 0.1 V reads every device as zeros: the lot fails (exit 1) after
+    // writing its files, and its figures (every device untrusted: none counted) are printed
+    // on stdout as a completed lot's are; stdout had been empty.
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("lot.toml");
+    let text = tiny()
+        .replacen("adc_bits = 16 ", "adc_bits = 2 ", 1)
+        .replacen("adc_full_scale_v = 0.05 ", "adc_full_scale_v = 0.1 ", 1);
+    std::fs::write(&cfg, text).unwrap();
+    let out = dir.path().join("out");
+    let o = lot(&cfg, &out, "2", &["--devices", "2"], &[]);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("lot of 2 devices"), "{stdout}");
+    assert!(stdout.contains("yield within"), "{stdout}");
+}

@@ -33,6 +33,9 @@ pub enum RunError {
         /// Boxed: the error type stays small on every other path.
         error: Box<ReportError>,
         files: Vec<std::path::PathBuf>,
+        /// A lot's figures over its trusted devices, which `montecarlo.json` holds: printed
+        /// as a completed lot prints them (an 85 % reliable lot had shown only its errors).
+        lot: Option<Box<gyroemu_analysis::montecarlo::LotSummary>>,
     },
     /// A failure (`cause`) after which the manifest could not be updated either: it still
     /// says `running`.
@@ -71,8 +74,17 @@ impl RunError {
             Err(error) => Err(RunError::Refused {
                 error: Box::new(error),
                 files,
+                lot: None,
             }),
         }
+    }
+
+    /// This error with a lot's summary attached when it is a [`RunError::Refused`].
+    pub(crate) fn with_lot(mut self, summary: &gyroemu_analysis::montecarlo::LotSummary) -> Self {
+        if let RunError::Refused { lot, .. } = &mut self {
+            *lot = Some(Box::new(summary.clone()));
+        }
+        self
     }
 
     /// A file-system failure while doing `context`.

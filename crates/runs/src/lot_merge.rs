@@ -77,8 +77,9 @@ pub(crate) fn merge_lot(
         .map_err(RunError::from)
         .and_then(|(files, summary)| {
             let check = check_unreliable(&dir.display().to_string(), &summary, &devices);
+            let r = RunError::refused_unless(check, files).map_err(|e| e.with_lot(&summary));
             lot = Some(summary);
-            RunError::refused_unless(check, files)
+            r
         });
     let (mut files, path) = split.finish(dir, n, written)?;
     files.push(path);

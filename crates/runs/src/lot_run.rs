@@ -213,7 +213,8 @@ pub fn run_lot(
     files.push(ledger.path().to_path_buf());
     // Untrusted devices fail the lot after its files are written: the manifest says so too.
     let check = check_unreliable(&out.display().to_string(), &summary, &devices);
-    let files = RunError::refused_unless(check, files).map_err(|e| ledger.fail(e, &done))?;
+    let files = RunError::refused_unless(check, files)
+        .map_err(|e| ledger.fail(e.with_lot(&summary), &done))?;
     ledger.complete(&done)?;
     Ok(LotOutcome::Complete { files, summary })
 }

@@ -342,10 +342,16 @@ fn untrusted_devices_leave_the_manifest_failed_in_a_lot_and_in_its_merge() {
     let r = run_into(&cfg, &one, 2, None, false, None);
     let e = r.outcome.unwrap_err();
     assert!(e.to_string().contains("cannot be trusted"), "{e}");
-    let RunError::Refused { files, .. } = &e else {
+    let RunError::Refused { files, lot, .. } = &e else {
         panic!("{e:?}")
     };
     assert!(files.contains(&one.join("devices.csv")) && files.contains(&one.join("manifest.json")));
+    // The lot's figures come with the refusal (the command prints them as a completed lot
+    // does; it had printed nothing on stdout): the two devices, as montecarlo.json holds.
+    let json: Value = json(&one.join("montecarlo.json"));
+    let lot = lot.as_ref().expect("the lot's summary");
+    assert_eq!(lot.devices, 2);
+    assert_eq!(json["devices"].as_u64(), Some(2));
     assert_failed(&one, &["devices_unreliable", "--force"]);
 
     let split = dir.path().join("split");
@@ -358,6 +364,10 @@ fn untrusted_devices_leave_the_manifest_failed_in_a_lot_and_in_its_merge() {
     }
     let e = merge(&split, &Quiet).unwrap_err();
     assert!(e.to_string().contains("cannot be trusted"), "{e}");
+    assert!(
+        matches!(&e, RunError::Refused { lot: Some(_), .. }),
+        "{e:?}"
+    );
     assert!(split.join("devices.csv").is_file());
     assert_failed(&split, &["every shard with --force"]);
 }

@@ -37,10 +37,10 @@ pub fn wilson_interval(k: usize, n: usize) -> (f64, f64) {
     let centre = p + z2 / (2.0 * n);
     let half = Z95 * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt();
     let d = 1.0 + z2 / n;
-    (
-        ((centre - half) / d).max(0.0),
-        ((centre + half) / d).min(1.0),
-    )
+    // At k = 0 (k = n) the lower (upper) end is exactly 0 (1); rounding left 3.3e-18.
+    let lo = if k == 0.0 { 0.0 } else { (centre - half) / d };
+    let hi = if k == n { 1.0 } else { (centre + half) / d };
+    (lo.max(0.0), hi.min(1.0))
 }
 
 /// How a set of values (the finite ones) is spread.
@@ -140,7 +140,12 @@ mod tests {
         let (lo, hi) = wilson_interval(10, 10);
         assert!((lo - 10.0 / (10.0 + Z95 * Z95)).abs() < 1e-12 && hi == 1.0);
         let (lo, hi) = wilson_interval(0, 10);
-        assert!(lo.abs() < 1e-15 && (hi - Z95 * Z95 / (10.0 + Z95 * Z95)).abs() < 1e-12);
+        assert!(lo == 0.0 && (hi - Z95 * Z95 / (10.0 + Z95 * Z95)).abs() < 1e-12);
+        // Exactly 0 at every size (80 had read 3.3e-18, printed as 3.310e-16 %).
+        for n in [1, 7, 80, 1000, 123_457] {
+            assert_eq!(wilson_interval(0, n).0, 0.0, "{n}");
+            assert_eq!(wilson_interval(n, n).1, 1.0, "{n}");
+        }
         assert!(wilson_interval(0, 0).0.is_nan());
         // Z95 is the normal quantile: the upper tail 1 - Phi(Z95) = 0.025 by the
         // Abramowitz-Stegun 26.2.17 approximation (|error| < 7.5e-8).

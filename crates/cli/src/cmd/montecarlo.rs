@@ -121,11 +121,16 @@ pub(crate) fn summary_text(s: &LotSummary) -> String {
                 .join(", ")
         };
         t += &format!("  |error|: {}\n", list(&sp.abs_percentiles));
+        // One device has no spread (montecarlo.json holds null).
+        let std = if sp.std.is_finite() {
+            pct(sp.std)
+        } else {
+            "n/a".to_string()
+        };
         t += &format!(
-            "  signed:  {}; mean {}, std {} ({} devices)\n",
+            "  signed:  {}; mean {}, std {std} ({} devices)\n",
             list(&sp.percentiles),
             pct(sp.mean),
-            pct(sp.std),
             sp.n
         );
     }
