@@ -568,3 +568,36 @@ fn the_allan_fit_is_widened_by_the_rate_table_slopes_own_error() {
         a.scale_rel_ci95
     );
 }
+
+#[test]
+fn a_null_two_mode_estimate_says_why() {
+    // TIA noise far above the signal: each sweep's two slopes take random signs, and where a
+    // sweep's differ the geometric mean is null. It was null with no word; now a warning
+    // names the sweep and both slopes, and there is none when the estimate stands.
+    let mut nulls = 0;
+    for seed in 0..6 {
+        let mut c = fast_cfg(&[100.0, 125.0, 150.0, 175.0], 3.6);
+        c.noise = tia_noise(seed, 3e-9);
+        let core = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
+        let comb = core.combined;
+        let null =
+            comb.rotating.slope_deg_per_dps.is_nan() || comb.coriolis.slope_deg_per_dps.is_nan();
+        let w = core.combined_warning();
+        assert_eq!(w.is_some(), null, "seed {seed}: {w:?}, {comb:?}");
+        if let Some(w) = w {
+            nulls += 1;
+            let m = core.modes;
+            let sweep = if comb.coriolis.slope_deg_per_dps.is_nan() {
+                (m[0].coriolis, m[1].coriolis)
+            } else {
+                (m[0].rotating, m[1].rotating)
+            };
+            assert!(
+                w.contains(&format!("mode 1 {:.6e}", sweep.0.slope_deg_per_dps))
+                    && w.contains(&format!("mode 2 {:.6e}", sweep.1.slope_deg_per_dps)),
+                "{w}"
+            );
+        }
+    }
+    assert!(nulls > 0, "no seed made a null estimate");
+}

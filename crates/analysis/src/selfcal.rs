@@ -329,6 +329,42 @@ pub struct SelfcalCore {
     pub coriolis: SweepResult,
 }
 
+impl SelfcalCore {
+    /// Why the two-mode estimate is null, when it is: a sweep whose two modes' slopes differ
+    /// in sign (or one is not finite) has no common scale factor. It was null with no word
+    /// (noise burying the rate table's slopes read -0.061 and +0.04).
+    pub fn combined_warning(&self) -> Option<String> {
+        let sweeps = [
+            (
+                "rotating",
+                &self.combined.rotating,
+                self.modes.map(|m| m.rotating),
+            ),
+            (
+                "rate-table",
+                &self.combined.coriolis,
+                self.modes.map(|m| m.coriolis),
+            ),
+        ];
+        let null: Vec<String> = sweeps
+            .iter()
+            .filter(|(_, c, _)| c.slope_deg_per_dps.is_nan())
+            .map(|(what, _, m)| {
+                format!(
+                    "the {what} sweep's (mode 1 {:.6e}, mode 2 {:.6e} deg per deg/s)",
+                    m[0].slope_deg_per_dps, m[1].slope_deg_per_dps
+                )
+            })
+            .collect();
+        (!null.is_empty()).then(|| {
+            format!(
+                "the two-mode estimate (combined_relative_error and the combined slopes) is null: the two modes' slopes of {} differ in sign or are not finite, so they share no scale factor; read each mode's own",
+                null.join(" and of ")
+            )
+        })
+    }
+}
+
 /// Runs the rotating sweep and the rate-table sweep of `cfg` and compares them, their lane
 /// groups sized for `group_threads` ([`SweepOptions::group_threads`]).
 pub fn run_selfcal_core(

@@ -42,6 +42,7 @@ impl SelfcalReport {
             .iter()
             .chain(&self.core.coriolis.warnings)
             .cloned()
+            .chain(self.core.combined_warning())
             .chain(allan)
             .chain(drift)
             .collect()
