@@ -82,7 +82,20 @@ pub struct Manifest {
     pub gyroemu_version: String,
     /// The canonical config (`gyroemu merge` rebuilds the results from it).
     pub config_toml: String,
+    /// [`BUILD`] of the binary that wrote it (empty in manifests of older versions).
+    #[serde(default)]
+    pub build: String,
 }
+
+/// What a result's bits depend on beyond the source, the config and the seed: whether the
+/// build fuses multiply-adds (the default x86-64-v3 build does; the portable one does not, and
+/// its phases differ by about 1e-13 relative). Every lane count and thread count of one build
+/// gives the same bits; two builds do not, so a folder keeps to one.
+pub const BUILD: &str = if cfg!(target_feature = "fma") {
+    "fused multiply-add"
+} else {
+    "unfused multiply-add"
+};
 
 impl Manifest {
     /// A manifest for `points` of a sweep or lot, those in `done` being finished (`next`
@@ -112,6 +125,7 @@ impl Manifest {
             next: String::new(),
             gyroemu_version: env!("CARGO_PKG_VERSION").to_string(),
             config_toml: config_toml.to_string(),
+            build: BUILD.to_string(),
         }
     }
 

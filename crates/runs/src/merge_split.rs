@@ -110,6 +110,14 @@ pub(crate) fn read_split(dir: &Path) -> Result<Split, RunError> {
                 &hash[..hash.len().min(12)]
             )));
         }
+        // Two builds give other bits (fused multiply-adds or not): a merge of both matches
+        // neither build's one-machine run.
+        if !m.build.is_empty() && !first.build.is_empty() && m.build != first.build {
+            return Err(bad(format!(
+                "`{name}` was computed by a gyroemu build with {}, `{first_name}` by one with {}: their bits differ (about 1e-13 relative), so a merge would match neither build's run; rerun the shards with one build",
+                m.build, first.build
+            )));
+        }
         // `[dump]` leaves the hash alone (it changes no result), but the folder holds one
         // dump: shards of different dumps would leave files the merged manifest misdescribes.
         if dump_table(&m.config_toml) != dump_table(&first.config_toml) {

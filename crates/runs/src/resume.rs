@@ -7,7 +7,7 @@ use crate::config_diff::{config_diff_for, describe_diff};
 use crate::device_file::{lot_hash, DeviceFile, DEVICES_DIR};
 use crate::dumps::{dump_files, remove_files};
 use crate::error::RunError;
-use crate::manifest::{read_manifest, shard_manifest_paths, RunKind, RUN_MANIFEST};
+use crate::manifest::{read_manifest, shard_manifest_paths, RunKind, BUILD, RUN_MANIFEST};
 use crate::points::{config_hash, scan_points, PointFile, POINTS_DIR};
 use crate::records::{scan_records, RecordFile};
 use gyroemu_analysis::montecarlo::DeviceResult;
@@ -163,10 +163,31 @@ fn check_foreign(
     }
     let mut manifests = shard_manifest_paths(out)?;
     manifests.push(out.join(RUN_MANIFEST));
+    // Results of this config by another build (fused multiply-adds or not) differ in their
+    // last bits: resumed or merged beside this build's, they matched neither build's run.
+    let mut other_build: Option<(PathBuf, String)> = None;
     for p in manifests.iter().filter(|p| p.exists()) {
         if let Ok(m) = read_manifest(p) {
+            if m.config_sha256 == id.hash && !m.build.is_empty() && m.build != BUILD {
+                other_build.get_or_insert((p.clone(), m.build.clone()));
+            }
             add(&m.config_sha256, m.kind, p, Some(m.config_toml));
         }
+    }
+    if let (Some((p, build)), false) = (&other_build, force) {
+        return Err(RunError::BadInput(format!(
+            "output folder `{}` holds results of this config computed by a gyroemu build with {build} (`{}`); this build has {BUILD}, and their bits differ (about 1e-13 relative), so a folder of both would match neither build's run: run the build that began it, choose another --out, or add --force to delete them",
+            out.display(),
+            p.display()
+        )));
+    }
+    if other_build.is_some() && foreign.is_empty() {
+        reporter.note(&format!(
+            "--force: deleting the results of another gyroemu build in `{}`",
+            out.display()
+        ));
+        clear_out(out)?;
+        return Ok(true);
     }
     let Some((other, f)) = foreign.iter().next() else {
         return Ok(false);

@@ -416,3 +416,48 @@ fn merge_refuses_shards_a_whole_run_of_another_dump_was_written_over() {
     );
     assert!(!why.contains("  "), "{why}");
 }
+
+/// Rewrites the `build` of the manifest at `path` as another build's.
+fn as_other_build(path: &Path) {
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let other = if gyroemu_runs::manifest::BUILD.starts_with("fused") {
+        "unfused multiply-add"
+    } else {
+        "fused multiply-add"
+    };
+    v["build"] = other.into();
+    std::fs::write(path, serde_json::to_string(&v).unwrap()).unwrap();
+}
+
+#[test]
+fn results_of_another_build_are_neither_resumed_nor_merged() {
+    // The portable build (no fused multiply-adds) gives other bits, about 1e-13 relative: a
+    // shard of each merged with exit 0 into results that matched neither build's run.
+    let cfg = config();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("split");
+    for s in ["0/2", "1/2"] {
+        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
+            .0
+            .unwrap();
+    }
+    as_other_build(&out.join("shard-1-of-2.json"));
+    let why = merge_refusal(&out);
+    assert!(
+        why.contains("build") && why.contains("shard-1-of-2.json"),
+        "{why}"
+    );
+    // Resuming a shard beside another build's is refused too, naming the build.
+    let why = refusal(run_shard(&cfg, &out, Some(parse_shard("0/2").unwrap())).0);
+    assert!(
+        why.contains("multiply-add") && why.contains("--force"),
+        "{why}"
+    );
+    // And a whole run's folder.
+    let whole = dir.path().join("whole");
+    run_shard(&cfg, &whole, None).0.unwrap();
+    as_other_build(&whole.join("manifest.json"));
+    let why = refusal(run_shard(&cfg, &whole, None).0);
+    assert!(why.contains("computed by a gyroemu build"), "{why}");
+}
