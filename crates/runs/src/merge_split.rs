@@ -114,7 +114,7 @@ pub(crate) fn read_split(dir: &Path) -> Result<Split, RunError> {
         // neither build's one-machine run.
         if !m.build.is_empty() && !first.build.is_empty() && m.build != first.build {
             return Err(bad(format!(
-                "`{name}` was computed by a gyroemu build with {}, `{first_name}` by one with {}: their bits differ (about 1e-13 relative), so a merge would match neither build's run; rerun the shards with one build",
+                "`{name}` was computed by a gyroemu build with {}, `{first_name}` by one with {}: their bits differ (1e-13 to 2.8e-8 relative), so a merge would match neither build's run; rerun the shards with one build",
                 m.build, first.build
             )));
         }

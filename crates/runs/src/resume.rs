@@ -176,7 +176,7 @@ fn check_foreign(
     }
     if let (Some((p, build)), false) = (&other_build, force) {
         return Err(RunError::BadInput(format!(
-            "output folder `{}` holds results of this config computed by a gyroemu build with {build} (`{}`); this build has {BUILD}, and their bits differ (about 1e-13 relative), so a folder of both would match neither build's run: run the build that began it, choose another --out, or add --force to delete them",
+            "output folder `{}` holds results of this config computed by a gyroemu build with {build} (`{}`); this build has {BUILD}, and their bits differ (1e-13 to 2.8e-8 relative), so a folder of both would match neither build's run: run the build that began it, choose another --out, or add --force to delete them",
             out.display(),
             p.display()
         )));
