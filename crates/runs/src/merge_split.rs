@@ -258,8 +258,23 @@ impl Split {
         let owner = self.owners(n)?;
         let scan = scan_records::<R>(dir).map_err(bad)?;
         if let Some((p, why)) = scan.bad.first() {
+            // Its index from its name (`<stem>-<i>.json`), to name the shard that computes it.
+            let rerun = p
+                .file_name()
+                .and_then(|n| n.to_str())
+                .and_then(|n| n.strip_prefix(&format!("{}-", R::STEM)))
+                .and_then(|n| n.strip_suffix(".json"))
+                .and_then(|i| i.parse::<usize>().ok())
+                .and_then(|i| owner.get(&i).map(|s| (i, s)))
+                .map_or(String::new(), |(i, s)| {
+                    format!(
+                        " and rerun its shard with --shard {s}/{} to compute {} {i} again",
+                        self.count,
+                        R::STEM
+                    )
+                });
             return Err(bad(format!(
-                "`{}` is not a gyroemu {} file ({why}): remove it",
+                "`{}` is not a gyroemu {} file ({why}): remove it{rerun}",
                 p.display(),
                 R::STEM
             )));

@@ -107,7 +107,8 @@ pub fn scan_records<R: RecordFile>(out: &Path) -> Result<Scan<R>, String> {
         let parsed = std::fs::read_to_string(&p)
             .map_err(|e| e.to_string())
             .and_then(|t| {
-                serde_json::from_str::<R>(&t)
+                let v = checked_value(&t)?;
+                serde_json::from_value::<R>(v)
                     .map_err(|e| gyroemu_config::plain_words(&e.to_string()))
             })
             .and_then(|f| {
@@ -125,11 +126,48 @@ pub fn scan_records<R: RecordFile>(out: &Path) -> Result<Scan<R>, String> {
     Ok(scan)
 }
 
-/// Atomically writes `rec` into `out/<R::DIR>/` (the folder is created).
+/// The key of a record's checksum: SHA-256 of the compact JSON of the rest of the record.
+pub const CHECKSUM_KEY: &str = "sha256";
+
+/// SHA-256 (hex) of `v`'s compact JSON (its keys sorted: serde_json's map is ordered).
+fn checksum(v: &serde_json::Value) -> String {
+    use sha2::{Digest, Sha256};
+    let text = serde_json::to_string(v).unwrap_or_default();
+    Sha256::digest(text.as_bytes())
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// A record's JSON with its checksum verified and taken out. A file with no checksum (an
+/// older version's) is taken as it is; one whose checksum disagrees was edited or damaged
+/// after it was written: a flipped hex bit had moved a merged phase with exit 0.
+fn checked_value(text: &str) -> Result<serde_json::Value, String> {
+    let mut v: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| gyroemu_config::plain_words(&e.to_string()))?;
+    let stored = v
+        .as_object_mut()
+        .and_then(|o| o.remove(CHECKSUM_KEY))
+        .and_then(|c| c.as_str().map(str::to_string));
+    match stored {
+        Some(c) if c != checksum(&v) => Err(
+            "its contents do not match its sha256 (the file was edited or damaged after it was written)"
+                .to_string(),
+        ),
+        _ => Ok(v),
+    }
+}
+
+/// Atomically writes `rec` into `out/<R::DIR>/` (the folder is created), with its checksum.
 pub fn write_record<R: RecordFile>(out: &Path, rec: &R) -> Result<(), String> {
     let dir = out.join(R::DIR);
     std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
-    gyroemu_io::write_json(&dir.join(R::file_name(rec.index())), rec).map_err(|e| e.to_string())
+    let mut v = serde_json::to_value(rec).map_err(|e| e.to_string())?;
+    let sum = checksum(&v);
+    if let Some(o) = v.as_object_mut() {
+        o.insert(CHECKSUM_KEY.to_string(), sum.into());
+    }
+    gyroemu_io::write_json(&dir.join(R::file_name(rec.index())), &v).map_err(|e| e.to_string())
 }
 
 /// An f64 as 16 hex digits of its IEEE bits (decimal text round-trips only with a correctly

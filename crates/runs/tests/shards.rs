@@ -312,8 +312,9 @@ fn a_damaged_point_file_is_recomputed_by_its_shard_and_blocks_no_other() {
     // Shard 0 does not own point 3: before, it was refused over it.
     let (r, notes) = run_shard(&cfg, &out, Some(parse_shard("0/2").unwrap()));
     r.unwrap();
+    // Its checksum no longer matches (before checksums, the bad hex itself was named).
     assert!(
-        notes.contains("point-3.json") && notes.contains("xyz"),
+        notes.contains("point-3.json") && notes.contains("do not match its sha256"),
         "{notes}"
     );
     assert_eq!(
@@ -460,4 +461,35 @@ fn results_of_another_build_are_neither_resumed_nor_merged() {
     as_other_build(&whole.join("manifest.json"));
     let why = refusal(run_shard(&cfg, &whole, None).0);
     assert!(why.contains("computed by a gyroemu build"), "{why}");
+}
+
+#[test]
+fn a_point_file_edited_by_one_bit_is_caught_by_its_checksum() {
+    // One hex digit of a lane average changed: it decodes, so before checksums the merge used
+    // it (a phase moved in its ninth digit, exit 0) and a resume kept it.
+    let cfg = config();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bit");
+    for s in ["0/2", "1/2"] {
+        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
+            .0
+            .unwrap();
+    }
+    let p4 = out.join("points/point-4.json");
+    let mut f = json(&p4);
+    let z = f["z"][0].as_str().unwrap().to_string();
+    let last = if z.ends_with('0') { '1' } else { '0' };
+    f["z"][0] = format!("{}{last}", &z[..15]).into();
+    std::fs::write(&p4, serde_json::to_string_pretty(&f).unwrap()).unwrap();
+    let e = merge_refusal(&out);
+    assert!(
+        e.contains("point-4.json") && e.contains("sha256") && e.contains("--shard 0/2"),
+        "{e}"
+    );
+    // Its shard computes it again, and the merge then goes through.
+    let (r, notes) = run_shard(&cfg, &out, Some(parse_shard("0/2").unwrap()));
+    r.unwrap();
+    assert!(notes.contains("point-4.json"), "{notes}");
+    assert_eq!(json(&p4)["z"][0].as_str().unwrap(), z);
+    merge(&out, &Quiet).unwrap();
 }
