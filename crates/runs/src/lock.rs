@@ -53,6 +53,10 @@ pub struct LockInfo {
     pub since_unix_s: u64,
     /// The same, `YYYY-MM-DD HH:MM:SS UTC`.
     pub since_utc: String,
+    /// The holder's pid namespace (`/proc/self/ns/pid`'s link, e.g. `pid:[4026531836]`;
+    /// empty when unknown or in locks of older versions): a pid is only looked up in its own.
+    #[serde(default)]
+    pub pid_ns: String,
 }
 
 impl LockInfo {
@@ -64,6 +68,7 @@ impl LockInfo {
             command: command.to_string(),
             since_unix_s: t,
             since_utc: utc_text(t),
+            pid_ns: pid_namespace(),
         }
     }
 
@@ -217,6 +222,13 @@ fn holder_alive(info: &LockInfo, text: &str) -> bool {
     if !info.host.is_empty() && info.host != host_name() {
         return true;
     }
+    // Another pid namespace on the same host name: its pid means nothing in our /proc (a
+    // live holder there had been taken over as gone), unless it is our own pid too, which is
+    // a restarted container's retry (a Kubernetes pod keeps its host name and runs gyroemu as
+    // pid 1 in a fresh namespace): that one is taken for the same container, gone.
+    if !info.pid_ns.is_empty() && info.pid_ns != pid_namespace() {
+        return info.pid != std::process::id();
+    }
     if info.pid == std::process::id() {
         return abort::holds(text);
     }
@@ -262,6 +274,39 @@ fn unix_now() -> u64 {
     SystemTime::now()
         .duration_since(UNIX_EPOCH)
         .map_or(0, |d| d.as_secs())
+}
+
+/// This process's pid namespace, as `/proc/self/ns/pid` names it (empty without it).
+fn pid_namespace() -> String {
+    std::fs::read_link("/proc/self/ns/pid")
+        .map(|p| p.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// Another process's live lock in `out` (the folder's or any shard's), if one is held: what
+/// `--force` must not delete under it (a shard's --force had deleted a running shard's
+/// files). Stale locks are taken over as [`lock_out`] does; this process's own are skipped.
+pub(crate) fn live_other_lock(
+    out: &Path,
+    reporter: &dyn Reporter,
+) -> Result<Option<(PathBuf, LockInfo)>, RunError> {
+    let mut locks = files_like(out, "gyroemu-shard-", ".lock")?;
+    locks.push(out.join(LOCK_FILE));
+    for p in locks {
+        let Ok(text) = std::fs::read_to_string(&p) else {
+            continue;
+        };
+        let ours = serde_json::from_str::<LockInfo>(&text).is_ok_and(|i| {
+            i.pid == std::process::id() && i.pid_ns == pid_namespace() && abort::holds(&text)
+        });
+        if ours {
+            continue;
+        }
+        if let Some(holder) = live_holder(&p, reporter)? {
+            return Ok(Some((p, holder)));
+        }
+    }
+    Ok(None)
 }
 
 fn host_name() -> String {

@@ -186,7 +186,7 @@ fn check_foreign(
             "--force: deleting the results of another gyroemu build in `{}`",
             out.display()
         ));
-        clear_out(out)?;
+        clear_out(out, reporter)?;
         return Ok(true);
     }
     let Some((other, f)) = foreign.iter().next() else {
@@ -239,13 +239,21 @@ fn check_foreign(
         "--force: deleting the results of another config in `{}`",
         out.display()
     ));
-    clear_out(out)?;
+    clear_out(out, reporter)?;
     Ok(true)
 }
 
 /// Deletes the record files, manifests, final outputs and signal dumps of a previous run or
-/// lot in `out`.
-fn clear_out(out: &Path) -> Result<(), RunError> {
+/// lot in `out`, unless another gyroemu still runs there.
+fn clear_out(out: &Path, reporter: &dyn Reporter) -> Result<(), RunError> {
+    if let Some((lock, holder)) = crate::lock::live_other_lock(out, reporter)? {
+        return Err(RunError::Locked(format!(
+            "--force would delete the files of {} in `{}` (it holds `{}`): wait for it to finish or stop it first",
+            holder.describe(),
+            out.display(),
+            lock.display()
+        )));
+    }
     for dir in [POINTS_DIR, DEVICES_DIR] {
         let d = out.join(dir);
         if d.exists() {

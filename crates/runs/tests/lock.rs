@@ -31,8 +31,20 @@ fn locked(r: Result<gyroemu_runs::OutLock, RunError>) -> String {
     }
 }
 
+/// This process's pid namespace, as the lock records it.
+fn own_pid_ns() -> String {
+    std::fs::read_link("/proc/self/ns/pid")
+        .map(|p| p.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
 /// A lock file naming `pid` as its holder, written as another process would.
 fn plant(out: &Path, name: &str, pid: u32) {
+    plant_in(out, name, pid, &own_pid_ns());
+}
+
+/// The same, by a process of the pid namespace `pid_ns`.
+fn plant_in(out: &Path, name: &str, pid: u32, pid_ns: &str) {
     let info = LockInfo {
         pid,
         host: std::fs::read_to_string("/proc/sys/kernel/hostname")
@@ -41,6 +53,7 @@ fn plant(out: &Path, name: &str, pid: u32) {
         command: "gyroemu run other.toml --out o".into(),
         since_unix_s: 1_700_000_000,
         since_utc: utc_text(1_700_000_000),
+        pid_ns: pid_ns.to_string(),
     };
     std::fs::write(out.join(name), serde_json::to_string(&info).unwrap()).unwrap();
 }
@@ -160,4 +173,32 @@ fn a_folder_where_the_lock_goes_is_refused_as_input_naming_it() {
     ));
     assert!(m.contains(LOCK_FILE) && m.contains("remove it"), "{m}");
     assert!(out.join(LOCK_FILE).is_dir());
+}
+
+#[test]
+fn a_lock_of_another_pid_namespace_is_never_taken_for_gone() {
+    // A container on the same host name: its holder's pid is not this namespace's, so a
+    // missing /proc entry proves nothing (a live holder had been taken over and both ran).
+    let dir = tempfile::tempdir().unwrap();
+    let mut gone = Command::new("true").spawn().unwrap();
+    gone.wait().unwrap();
+    plant_in(dir.path(), LOCK_FILE, gone.id(), "pid:[1]");
+    let m = locked(lock_out(
+        dir.path(),
+        "gyroemu run",
+        LockScope::Folder,
+        &Quiet,
+    ));
+    assert!(m.contains(&format!("pid {} ", gone.id())), "{m}");
+    // A lock of this very pid from another namespace is a restarted container's own
+    // (Kubernetes' retry: same host name, pid 1 in a fresh namespace): taken over.
+    plant_in(dir.path(), LOCK_FILE, std::process::id(), "pid:[1]");
+    let rec = Record::default();
+    drop(lock_out(dir.path(), "gyroemu run", LockScope::Folder, &rec).unwrap());
+    assert_eq!(rec.0.lock().unwrap().len(), 1);
+    // The same lock from this namespace is stale and taken over.
+    plant(dir.path(), LOCK_FILE, gone.id());
+    let rec = Record::default();
+    drop(lock_out(dir.path(), "gyroemu run", LockScope::Folder, &rec).unwrap());
+    assert_eq!(rec.0.lock().unwrap().len(), 1);
 }

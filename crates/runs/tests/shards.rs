@@ -493,3 +493,57 @@ fn a_point_file_edited_by_one_bit_is_caught_by_its_checksum() {
     assert_eq!(json(&p4)["z"][0].as_str().unwrap(), z);
     merge(&out, &Quiet).unwrap();
 }
+
+#[test]
+fn force_on_one_shard_leaves_a_running_shards_folder_alone() {
+    // Shard 0 holds its lock (a live process) while shard 1 of another config runs with
+    // --force: it had deleted shard 0's files as it ran, leaving a folder of two seeds.
+    let cfg = config();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("busy");
+    run_shard(&cfg, &out, Some(parse_shard("0/2").unwrap()))
+        .0
+        .unwrap();
+    let mut holder = std::process::Command::new("sleep")
+        .arg("30")
+        .spawn()
+        .unwrap();
+    let info = gyroemu_runs::LockInfo {
+        pid: holder.id(),
+        host: std::fs::read_to_string("/proc/sys/kernel/hostname")
+            .map(|h| h.trim().to_string())
+            .unwrap_or_default(),
+        command: "gyroemu run a.toml --shard 0/2".into(),
+        since_unix_s: 0,
+        since_utc: String::new(),
+        pid_ns: std::fs::read_link("/proc/self/ns/pid")
+            .map(|p| p.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+    };
+    std::fs::write(
+        out.join("gyroemu-shard-0-of-2.lock"),
+        serde_json::to_string(&info).unwrap(),
+    )
+    .unwrap();
+    let mut other = cfg.clone();
+    other.experiment.average_s *= 2.0;
+    let req = RunRequest {
+        config: &other,
+        out: &out,
+        shard: Some(parse_shard("1/2").unwrap()),
+        force: true,
+        cancel: Arc::new(AtomicBool::new(false)),
+        on_saved: None,
+    };
+    let r = run(&req, &Quiet);
+    holder.kill().unwrap();
+    holder.wait().unwrap();
+    match r {
+        Err(RunError::Locked(m)) => assert!(m.contains("--force would delete"), "{m}"),
+        other => panic!("not refused: {other:?}"),
+    }
+    assert!(
+        out.join("shard-0-of-2.json").exists(),
+        "shard 0's manifest deleted"
+    );
+}
