@@ -125,6 +125,26 @@ pub(crate) fn read_split(dir: &Path) -> Result<Split, RunError> {
                 "`{name}` and `{first_name}` ran the same sweep with different [dump] sections: the folder holds one dump, so rerun the shards with one [dump] (a rerun only recomputes the dumped point)"
             )));
         }
+        // Sections the hash leaves out ([selfcal], [montecarlo] in a sweep): the results
+        // agree, but summary.json records one config, and it had silently been shard 0's.
+        if m.config_toml != first.config_toml {
+            let tables = |t: &str| toml::from_str::<toml::Table>(t).unwrap_or_default();
+            let (a, b) = (tables(&first.config_toml), tables(&m.config_toml));
+            let sections: Vec<String> = a
+                .keys()
+                .chain(b.keys().filter(|k| !a.contains_key(*k)))
+                .filter(|k| a.get(*k) != b.get(*k))
+                .map(|k| format!("[{k}]"))
+                .collect();
+            return Err(bad(format!(
+                "`{name}` and `{first_name}` ran the same results from configs that differ in {}, which the hash leaves out: the merged summary records one config, so rerun the shards with one",
+                if sections.is_empty() {
+                    "sections".to_string()
+                } else {
+                    sections.join(", ")
+                }
+            )));
+        }
     }
     let by_index: BTreeMap<usize, (String, Manifest)> = shards
         .into_iter()

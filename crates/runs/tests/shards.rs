@@ -547,3 +547,26 @@ fn force_on_one_shard_leaves_a_running_shards_folder_alone() {
         "shard 0's manifest deleted"
     );
 }
+
+#[test]
+fn merge_refuses_shards_whose_configs_differ_in_sections_the_hash_leaves_out() {
+    // A [selfcal] section changes no result of a sweep, hence not the hash; but summary.json
+    // records one config, and it had silently been shard 0's.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sections");
+    let plain = parse_config(NOISY).unwrap();
+    let with = parse_config(&format!("{NOISY}\n[selfcal]\nallan_record_s = 60.0\n")).unwrap();
+    run_shard(&plain, &out, Some(parse_shard("0/2").unwrap()))
+        .0
+        .unwrap();
+    run_shard(&with, &out, Some(parse_shard("1/2").unwrap()))
+        .0
+        .unwrap();
+    let why = merge_refusal(&out);
+    assert!(why.contains("differ in [selfcal]"), "{why}");
+    // One config for both: merged.
+    run_shard(&plain, &out, Some(parse_shard("1/2").unwrap()))
+        .0
+        .unwrap();
+    merge(&out, &Quiet).unwrap();
+}
