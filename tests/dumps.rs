@@ -173,7 +173,8 @@ nodes = ["lowpass"]
     let w = cfg.validate().unwrap();
     assert!(
         w.iter()
-            .any(|w| w.contains("decimated recording gets no WAV") && w.contains("fs_hz = 0.4")),
+            .any(|w| w.contains("decimated recording gets no WAV")
+                && w.contains("sample rate 0.4 Hz")),
         "{w:?}"
     );
     let dir = tempfile::tempdir().unwrap();

@@ -475,13 +475,7 @@ impl Config {
         let fc = self.carrier_hz();
         let i_v2 = (n.tia_voltage_noise_v_per_rthz / self.board.tia_gain_ohm).powi(2);
         let s1 = i_v2 * corner;
-        let params = gyroemu_core::flicker::FlickerParams {
-            fs_hz: fs,
-            psd_at_1hz: s1,
-            f_lo_hz: self.flicker_f_lo_hz(),
-            f_hi_hz: 0.5 * fs,
-        };
-        let Ok(design) = gyroemu_core::flicker::FlickerDesign::new(&params) else {
+        let Some(design) = self.tia_flicker_design() else {
             return;
         };
         let (realised, stated) = (design.psd(fc), s1 / fc);
@@ -489,7 +483,7 @@ impl Config {
         let excess = (realised - stated) / total;
         if excess.abs() > TIA_FLICKER_EXCESS {
             warnings.push(format!(
-                "noise.tia_voltage_flicker_corner_hz = {corner}: the TIA's voltage flicker is designed two poles a decade up to fs_hz/2 and follows its 1/f law within its ripple only below about fs_hz/20 = {} Hz; at the carrier ({fc} Hz) its density is {:.3} times the stated (e_n/tia_gain_ohm)^2 corner/f, which moves the TIA noise there by {:+.1} % in power from the stated i_n^2 + (e_n/tia_gain_ohm)^2 (1 + corner/f) (the noise rule states the white part only); raise board.fs_hz",
+                "noise.tia_voltage_flicker_corner_hz = {corner}: the TIA's voltage flicker is designed two poles a decade up to fs_hz/2 and follows its 1/f law within its ripple only below about fs_hz/20 = {} Hz; at the carrier ({fc} Hz) its density is {:.3} times the stated (e_n/tia_gain_ohm)^2 corner/f, which moves the TIA noise there by {:+.1} % in power from the stated i_n^2 + (e_n/tia_gain_ohm)^2 (1 + corner/f) (the noise rule counts the design's density); raise board.fs_hz",
                 fs / 20.0,
                 realised / stated,
                 100.0 * excess

@@ -57,7 +57,9 @@ impl Config {
     }
 
     /// Per mode, the one-sided density at the ADC input near the carrier (V^2/Hz) of the
-    /// white sources: the TIA's input noise (current and e_n / tia_gain_ohm), the Brownian
+    /// white sources, and of the TIA's voltage flicker at its design's density there (a
+    /// corner above the carrier made the readings scatter 3.27 times the white-only figure):
+    /// the TIA's input noise (current and e_n / tia_gain_ohm), the Brownian
     /// force through the mode's velocity response and transduction (uncoupled modes), both
     /// through the TIA at the carrier, and an ADC's rounding (step^2/12 a sample) where that
     /// noise dithers it (its RMS at the ADC input at least an LSB; an undithered ADC's error
@@ -77,6 +79,12 @@ impl Config {
         let w = core::f64::consts::TAU * fc;
         let t = self.device.transduction_a_s_per_m;
         let (fold_tia, fold_white) = self.decimation_fold(&chain);
+        // The TIA's voltage flicker near the carrier, as its design realises it (input
+        // referred, A^2/Hz), with what the decimation folds back at its own density there.
+        let flicker = self.tia_flicker_design().map_or(0.0, |d| {
+            let at = |f: f64| d.psd(f.abs()) * chain.tia(f).norm_sqr();
+            self.fold_sum(&chain, |f| at(fc + f))
+        });
         Some([plant.mode1, plant.mode2].map(|m| {
             let w0 = core::f64::consts::TAU * m.f0_hz;
             // Its density at the carrier and its RMS (equipartition, S_a Q / (4 w0)), as
@@ -100,8 +108,48 @@ impl Config {
                     0.0
                 }
             });
-            i_n * i_n * tia * fold_tia + brownian * tia + adc * fold_white
+            i_n * i_n * tia * fold_tia + flicker + brownian * tia + adc * fold_white
         }))
+    }
+
+    /// The TIA voltage flicker's design (input-referred: `(e_n / tia_gain_ohm)^2 corner / f`
+    /// from the flicker corner up to fs/2), when `[noise]` has one.
+    pub(crate) fn tia_flicker_design(&self) -> Option<gyroemu_core::flicker::FlickerDesign> {
+        let n = self.noise.as_ref()?;
+        let corner = n.tia_voltage_flicker_corner_hz;
+        if !(corner > 0.0 && n.tia_voltage_noise_v_per_rthz > 0.0) {
+            return None;
+        }
+        let i_v2 = (n.tia_voltage_noise_v_per_rthz / self.board.tia_gain_ohm).powi(2);
+        let fs = self.fs_hz();
+        gyroemu_core::flicker::FlickerDesign::new(&gyroemu_core::flicker::FlickerParams {
+            fs_hz: fs,
+            psd_at_1hz: i_v2 * corner,
+            f_lo_hz: self.flicker_f_lo_hz(),
+            f_hi_hz: 0.5 * fs,
+        })
+        .ok()
+    }
+
+    /// `sum_k |L(k fs_out)|^2 / |L(0)|^2 g(k fs_out)` over the multiples of the output rate of
+    /// both signs in the input band, k = 0 included (L the stage-1 low-pass): what a density
+    /// `g` at the carrier offset `f` (demodulated to `f`) puts on the decimated output's DC.
+    /// Stops as [`Config::decimation_fold`] does.
+    pub(crate) fn fold_sum(&self, chain: &ChainResponse, g: impl Fn(f64) -> f64) -> f64 {
+        let fs_out = self.fs_out_hz();
+        let k_max = (0.5 * self.fs_hz() / fs_out).floor() as u64;
+        let dc = chain.lowpass(0.0).norm_sqr();
+        let (mut sum, mut weight) = (g(0.0), 1.0);
+        for k in 1..=k_max {
+            let f = k as f64 * fs_out;
+            let l = [f, -f].map(|f| chain.lowpass(f).norm_sqr() / dc);
+            sum += l[0] * g(f) + l[1] * g(-f);
+            weight += l[0] + l[1];
+            if l[0] + l[1] < 1e-8 * weight {
+                break;
+            }
+        }
+        sum
     }
 
     /// What the decimation folds onto the decimated output's DC, against the low-pass's own
@@ -141,7 +189,8 @@ impl Config {
     /// weighs two harmonics). `None` without `[noise]` or when the chain cannot be built. The
     /// Brownian part is the resonance's, correlated over a mode's Q / (pi f0): an average
     /// shorter than a few of those sees less of it than stated (the warning errs towards
-    /// warning). Flicker is left out.
+    /// warning). Of flicker, the TIA's voltage flicker near the carrier is counted; the slow
+    /// sources (drive amplitude and phase, carrier phase) are left out.
     pub fn noise_phase(&self) -> Option<Vec<NoisePhase>> {
         // With a [pll], the reading's noise and phase at the carrier the lock holds.
         if let Some(held) = self.expected_lock() {
@@ -237,7 +286,7 @@ impl Config {
                 )
             };
             warnings.push(format!(
-                "the noise at the carrier (about {:.3e} V/sqrt(Hz) at the ADC input, the white sources together, with the noise the decimation folds onto the output), averaged over the point's span, against the TIA output of mode {} at {} deg/s (about {amplitude:.3e} V) {scatter}; average longer (experiment.average_s) or lower the noise",
+                "the noise at the carrier (about {:.3e} V/sqrt(Hz) at the ADC input, the white sources and the TIA's voltage flicker together, with the noise the decimation folds onto the output), averaged over the point's span, against the TIA output of mode {} at {} deg/s (about {amplitude:.3e} V) {scatter}; average longer (experiment.average_s) or lower the noise",
                 density.sqrt(),
                 k + 1,
                 p.rate_dps,
