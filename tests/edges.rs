@@ -191,7 +191,8 @@ fn a_decimation_that_folds_the_mixer_product_onto_dc_is_stated_and_bounded() {
     let (k, a) = (t / (1.0 + t), (t - 1.0) / (t + 1.0));
     let z = num_complex::Complex64::from_polar(1.0, -2.0 * PI * 30e3 / 240e3);
     let leak = (k * (1.0 + z) / (1.0 + a * z)).norm();
-    let bound_mdeg = leak.asin().to_degrees() * 1e3;
+    // Each phasor's bound, twice: the point's and the zero-rate reference's it is read against.
+    let bound_mdeg = 2.0 * leak.asin().to_degrees() * 1e3;
     let w = c.validate().unwrap();
     assert!(
         w.iter()
@@ -209,8 +210,8 @@ fn a_decimation_that_folds_the_mixer_product_onto_dc_is_stated_and_bounded() {
         errs.iter().all(|&e| e <= bound_mdeg),
         "{errs:?} > {bound_mdeg}"
     );
-    // The fold is real: the worst point moves by a sizeable share of the bound.
-    assert!(errs.iter().any(|&e| e >= 0.1 * bound_mdeg), "{errs:?}");
+    // The fold is real: the worst point moves by a sizeable share of one phasor's bound.
+    assert!(errs.iter().any(|&e| e >= 0.05 * bound_mdeg), "{errs:?}");
 }
 
 #[test]

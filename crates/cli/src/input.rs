@@ -109,7 +109,7 @@ pub fn listing_refused<T>(
         // A lot's figures over its trusted devices, as a completed lot prints them; the
         // command fails with its error next, so a closed stdout changes nothing here.
         if let Some(lot) = lot {
-            let _ = print_out(&crate::cmd::montecarlo::summary_text(lot));
+            let _ = print_out(&crate::lot_text::summary_text(lot));
         }
         list_written_with(out, files, items);
     }

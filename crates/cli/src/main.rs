@@ -21,6 +21,7 @@ macro_rules! say {
 
 mod cmd;
 mod input;
+mod lot_text;
 mod progress;
 mod signals;
 

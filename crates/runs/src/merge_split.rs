@@ -126,8 +126,9 @@ pub(crate) fn read_split(dir: &Path) -> Result<Split, RunError> {
             )));
         }
         // Sections the hash leaves out ([selfcal], [montecarlo] in a sweep): the results
-        // agree, but summary.json records one config, and it had silently been shard 0's.
-        if m.config_toml != first.config_toml {
+        // agree, but summary.json records one config, and it had silently been shard 0's. (A
+        // lot's merge compares its spec itself, naming the keys.)
+        if first.kind == RunKind::Run && m.config_toml != first.config_toml {
             let tables = |t: &str| toml::from_str::<toml::Table>(t).unwrap_or_default();
             let (a, b) = (tables(&first.config_toml), tables(&m.config_toml));
             let sections: Vec<String> = a

@@ -24,7 +24,7 @@ pub fn merge_command(dir: &Path) -> Result<()> {
     let merged = listing_refused(gyroemu_runs::merge(dir, &Terminal), dir, None)?;
     // A lot's figures, as `montecarlo` prints them on one machine.
     if let Some(lot) = &merged.lot {
-        print_out(&crate::cmd::montecarlo::summary_text(lot))?;
+        print_out(&crate::lot_text::summary_text(lot))?;
     }
     list_written(dir, &merged.files);
     Ok(())
