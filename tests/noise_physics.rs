@@ -245,6 +245,53 @@ fn the_stated_scatter_counts_the_tias_voltage_flicker_at_the_carrier() {
 }
 
 #[test]
+fn the_stated_scatter_counts_the_slow_phase_flicker() {
+    // The drive's and the carrier's phase flicker alone, over 64 seeds: a Coriolis reading
+    // (the mean phase over the span, against the zero-rate reference's) and a rate table's
+    // amplitude (the in-phase part of the phase's fundamental) scatter as the rule states.
+    // It had left them out (stated 0 for readings of several degrees of scatter). The
+    // carrier's flicker turns drives and demodulation alike and stays only above the envelope
+    // corner f0 / (2 Q) = 3.75 Hz.
+    use gyroemu::config::RateTable;
+    let (mut coriolis, _) = board_cfg();
+    coriolis.experiment.rates_dps = vec![100.0];
+    coriolis.experiment.average_s = 0.2;
+    let mut table = coriolis.clone();
+    table.experiment.rate_table = RateTable::Sinusoid;
+    table.experiment.table_freq_hz = Some(2.0);
+    table.experiment.average_s = 2.0;
+    for (base, drive, carrier) in [
+        (&coriolis, 3e-2, 0.0),
+        (&coriolis, 0.0, 0.3),
+        (&table, 3e-2, 0.0),
+    ] {
+        let mut cfg = base.clone();
+        cfg.noise = Some(NoiseConfig {
+            drive_phase_flicker_rad_per_rthz: drive,
+            carrier_phase_flicker_rad_per_rthz: carrier,
+            ..noise(None, 0.0, 0.0)
+        });
+        cfg.validate().unwrap();
+        let sigma = cfg.noise_phase().unwrap()[0].sigma_rad.map(f64::to_degrees);
+        assert!(sigma[0] > 0.0, "{sigma:?}");
+        let errors = seeded_errors(&cfg, 64);
+        // 128 draws (both modes alike): within 20 % at 3.2 standard errors (6.3 %).
+        let all: Vec<f64> = errors.iter().flatten().copied().collect();
+        let got = std_dev(&all);
+        eprintln!(
+            "{:?} drive {drive} carrier {carrier}: scatter {got:.4e} deg, stated {:.4e}",
+            cfg.shape(),
+            sigma[0]
+        );
+        assert!(
+            (got / sigma[0] - 1.0).abs() < 0.2,
+            "{:?}, drive {drive}, carrier {carrier}: scatter {got} deg, stated {sigma:?}",
+            cfg.shape()
+        );
+    }
+}
+
+#[test]
 fn brownian_force_gives_the_snr_phase_noise() {
     let (mut cfg, _) = board_cfg();
     let m = 1e-15;

@@ -131,6 +131,63 @@ impl Config {
         .ok()
     }
 
+    /// Per mode, the variance (rad^2) the slow phase flicker leaves on one reading
+    /// ([`SlowReading`], boxcar weights: the caller scales by the window's noise bandwidth).
+    /// Each drive's phase flicker turns its mode's response through the envelope low-pass
+    /// `|H|^2 = 1 / (1 + (f / f_env)^2)`, `f_env = f0 / (2 Q)`; the carrier's turns the drives
+    /// and the stage-1 reference alike, so only `1 - |H|^2` of it stays; the stage-1 low-pass
+    /// weighs both. A Coriolis phase is the mean of that over the span (0 Hz), a rate table's
+    /// amplitude the in-phase part of its fundamental. A rotating psi keeps neither to first
+    /// order (the slow part turns both sidebands alike, into alpha), so it is not asked. The
+    /// drive's amplitude flicker moves no phase to first order.
+    pub(crate) fn slow_flicker_variance(&self, reading: SlowReading) -> [f64; 2] {
+        let Some(n) = &self.noise else {
+            return [0.0; 2];
+        };
+        let fs_out = self.fs_out_hz();
+        // As the board draws them: once per decimation block, from f_lo up to fs_out / 2.
+        let design = |x: f64| {
+            (x > 0.0)
+                .then(|| {
+                    gyroemu_core::flicker::FlickerDesign::new(
+                        &gyroemu_core::flicker::FlickerParams {
+                            fs_hz: fs_out,
+                            psd_at_1hz: x * x,
+                            f_lo_hz: self.flicker_f_lo_hz(),
+                            f_hi_hz: 0.5 * fs_out,
+                        },
+                    )
+                    .ok()
+                })
+                .flatten()
+        };
+        let (drive, carrier) = (
+            design(n.drive_phase_flicker_rad_per_rthz),
+            design(n.carrier_phase_flicker_rad_per_rthz),
+        );
+        if drive.is_none() && carrier.is_none() {
+            return [0.0; 2];
+        }
+        let chain = ChainResponse::new(&self.board_params()).ok();
+        let low = |f: f64| {
+            chain
+                .as_ref()
+                .map_or(1.0, |c| (c.lowpass(f) / c.lowpass(0.0)).norm_sqr())
+        };
+        let plant = self.resonator_params();
+        let f_top = 0.5 * fs_out;
+        [plant.mode1, plant.mode2].map(|m| {
+            let f_env = m.f0_hz / (2.0 * m.q);
+            let density = |f: f64| {
+                let h = 1.0 / (1.0 + (f / f_env).powi(2));
+                let d = drive.as_ref().map_or(0.0, |d| d.psd(f)) * h;
+                let c = carrier.as_ref().map_or(0.0, |d| d.psd(f)) * (1.0 - h);
+                (d + c) * low(f)
+            };
+            reading.variance(&density, self.flicker_f_lo_hz(), f_top)
+        })
+    }
+
     /// `sum_k |L(k fs_out)|^2 / |L(0)|^2 g(k fs_out)` over the multiples of the output rate of
     /// both signs in the input band, k = 0 included (L the stage-1 low-pass): what a density
     /// `g` at the carrier offset `f` (demodulated to `f`) puts on the decimated output's DC.
@@ -189,8 +246,9 @@ impl Config {
     /// weighs two harmonics). `None` without `[noise]` or when the chain cannot be built. The
     /// Brownian part is the resonance's, correlated over a mode's Q / (pi f0): an average
     /// shorter than a few of those sees less of it than stated (the warning errs towards
-    /// warning). Of flicker, the TIA's voltage flicker near the carrier is counted; the slow
-    /// sources (drive amplitude and phase, carrier phase) are left out.
+    /// warning). Of flicker, the TIA's voltage flicker near the carrier is counted, and the
+    /// drive and carrier phase flicker ([`Config::slow_flicker_variance`]) on a Coriolis or
+    /// rate-table reading; a rotating psi keeps neither to first order.
     pub fn noise_phase(&self) -> Option<Vec<NoisePhase>> {
         // With a [pll], the reading's noise and phase at the carrier the lock holds.
         if let Some(held) = self.expected_lock() {
@@ -218,6 +276,18 @@ impl Config {
         let reference = [0, 1].map(|k| variance(0.0, k).unwrap_or(f64::NAN));
         let dev = self.driven_device();
         let shape = self.shape();
+        // The slow flicker sources' share of a reading over `span_s` (rad^2 per mode).
+        let slow = |rate: f64| {
+            let span_s = self.plan_point(rate).span_samples() / fs_out;
+            match shape {
+                Shape::Coriolis => self.slow_flicker_variance(SlowReading::Mean { span_s }),
+                Shape::RateTable { freq_hz } => {
+                    self.slow_flicker_variance(SlowReading::Tone { freq_hz, span_s })
+                }
+                Shape::Rotating => [0.0; 2],
+            }
+            .map(|v| v * enbw)
+        };
         let points = self
             .experiment
             .rates_dps
@@ -230,11 +300,15 @@ impl Config {
                     Shape::RateTable { freq_hz } => dev.rate_table_response(omega, freq_hz).0,
                     Shape::Rotating => dev.rotating_psi_rad(omega),
                 };
+                let flicker = slow(rate);
+                let reference_flicker = slow(0.0);
                 let sigma_rad = [0, 1].map(|k| {
                     let own = variance(rate, k).unwrap_or(f64::NAN);
                     match shape {
-                        Shape::Coriolis => (own + reference[k]).sqrt(),
-                        _ => (2.0 * own).sqrt(),
+                        Shape::Coriolis => {
+                            (own + reference[k] + flicker[k] + reference_flicker[k]).sqrt()
+                        }
+                        _ => (2.0 * own + flicker[k]).sqrt(),
                     }
                 });
                 let amplitude_v = [0, 1].map(|k| amps(rate).map_or(f64::NAN, |a| a[k].0));
@@ -285,12 +359,92 @@ impl Config {
                     p.theory_rad[k].abs() / DEG
                 )
             };
+            // The slow phase flicker is in the sigma, not in the carrier's density.
+            let slow = self.noise.as_ref().is_some_and(|n| {
+                n.drive_phase_flicker_rad_per_rthz > 0.0
+                    || n.carrier_phase_flicker_rad_per_rthz > 0.0
+            }) && self.shape() != Shape::Rotating;
             warnings.push(format!(
-                "the noise at the carrier (about {:.3e} V/sqrt(Hz) at the ADC input, the white sources and the TIA's voltage flicker together, with the noise the decimation folds onto the output), averaged over the point's span, against the TIA output of mode {} at {} deg/s (about {amplitude:.3e} V) {scatter}; average longer (experiment.average_s) or lower the noise",
+                "the noise at the carrier (about {:.3e} V/sqrt(Hz) at the ADC input, the white sources and the TIA's voltage flicker together, with the noise the decimation folds onto the output){}, averaged over the point's span, against the TIA output of mode {} at {} deg/s (about {amplitude:.3e} V) {scatter}; average longer (experiment.average_s) or lower the noise",
                 density.sqrt(),
+                if slow {
+                    ", and the drive and carrier phase flicker the reading sees"
+                } else {
+                    ""
+                },
                 k + 1,
                 p.rate_dps,
             ));
+        }
+    }
+}
+
+/// How a reading weighs a slow phase fluctuation over frequency.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum SlowReading {
+    /// The mean over `span_s` (a Coriolis phase): weight `sinc^2(pi f T)`.
+    Mean { span_s: f64 },
+    /// The in-phase part of the fundamental at `freq_hz` over `span_s` (a rate table's
+    /// amplitude): weight `sinc^2(pi (f - f_t) T) + sinc^2(pi (f + f_t) T)`.
+    Tone { freq_hz: f64, span_s: f64 },
+}
+
+/// `sinc^2(pi u)`, or its mean `1 / (2 pi^2 u^2)` from |u| = 4 on, where a quadrature grid
+/// would alias its oscillation.
+fn sinc2(u: f64) -> f64 {
+    let u = u.abs();
+    if u < 1e-9 {
+        1.0
+    } else if u < 4.0 {
+        let x = core::f64::consts::PI * u;
+        (x.sin() / x).powi(2)
+    } else {
+        1.0 / (2.0 * core::f64::consts::PI.powi(2) * u * u)
+    }
+}
+
+impl SlowReading {
+    /// `int_0^f_top density(f) weight(f) df`: on a grid of 64 points a decade in ln f from
+    /// f_lo / 1000 (the flat part below it taken as a rectangle) for a mean; on a linear grid
+    /// of 4001 points over f_t +- 40 / T for a tone (its weight's tails beyond hold under 1 %).
+    fn variance(self, density: &dyn Fn(f64) -> f64, f_lo: f64, f_top: f64) -> f64 {
+        match self {
+            SlowReading::Mean { span_s } => {
+                let a = (1e-3 * f_lo).min(0.01 / span_s);
+                if !(a > 0.0 && f_top > a) {
+                    return 0.0;
+                }
+                let g = |f: f64| density(f) * sinc2(f * span_s) * f;
+                let steps = ((f_top / a).log10() * 64.0).ceil().max(1.0) as usize;
+                let dl = (f_top / a).ln() / steps as f64;
+                let mut sum = density(a) * a;
+                let mut prev = g(a);
+                for i in 1..=steps {
+                    let cur = g(a * (dl * i as f64).exp());
+                    sum += 0.5 * (prev + cur) * dl;
+                    prev = cur;
+                }
+                sum
+            }
+            SlowReading::Tone { freq_hz, span_s } => {
+                let half = 40.0 / span_s;
+                let (lo, hi) = ((freq_hz - half).max(0.0), (freq_hz + half).min(f_top));
+                if hi <= lo || hi.is_nan() || lo.is_nan() {
+                    return 0.0;
+                }
+                let n = 4000;
+                let df = (hi - lo) / n as f64;
+                let g = |f: f64| {
+                    density(f) * (sinc2((f - freq_hz) * span_s) + sinc2((f + freq_hz) * span_s))
+                };
+                (0..=n)
+                    .map(|i| {
+                        let w = if i == 0 || i == n { 0.5 } else { 1.0 };
+                        w * g(lo + i as f64 * df)
+                    })
+                    .sum::<f64>()
+                    * df
+            }
         }
     }
 }
