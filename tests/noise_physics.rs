@@ -260,10 +260,17 @@ fn the_stated_scatter_counts_the_slow_phase_flicker() {
     table.experiment.rate_table = RateTable::Sinusoid;
     table.experiment.table_freq_hz = Some(2.0);
     table.experiment.average_s = 2.0;
+    // Under a Hann window the white bandwidth's 1.5 overstated the flicker's variance by a
+    // third: the window's own weight counts.
+    let mut hann = coriolis.clone();
+    hann.experiment.window = WindowKind::Hann;
+    hann.experiment.average_s = 0.3;
     for (base, drive, carrier) in [
         (&coriolis, 3e-2, 0.0),
         (&coriolis, 0.0, 0.3),
         (&table, 3e-2, 0.0),
+        (&hann, 3e-2, 0.0),
+        (&hann, 0.0, 0.3),
     ] {
         let mut cfg = base.clone();
         cfg.noise = Some(NoiseConfig {

@@ -276,17 +276,21 @@ impl Config {
         let reference = [0, 1].map(|k| variance(0.0, k).unwrap_or(f64::NAN));
         let dev = self.driven_device();
         let shape = self.shape();
-        // The slow flicker sources' share of a reading over `span_s` (rad^2 per mode).
+        // The slow flicker sources' share of a reading over `span_s` (rad^2 per mode), under
+        // the window's own weight (not its white-noise bandwidth: a Hann window takes 1.06 to
+        // 1.12 times the boxcar's of the drive's 1/f phase, not 1.5).
+        let hann = self.experiment.window == WindowKind::Hann;
         let slow = |rate: f64| {
             let span_s = self.plan_point(rate).span_samples() / fs_out;
             match shape {
-                Shape::Coriolis => self.slow_flicker_variance(SlowReading::Mean { span_s }),
-                Shape::RateTable { freq_hz } => {
-                    self.slow_flicker_variance(SlowReading::Tone { freq_hz, span_s })
-                }
+                Shape::Coriolis => self.slow_flicker_variance(SlowReading::Mean { span_s, hann }),
+                Shape::RateTable { freq_hz } => self.slow_flicker_variance(SlowReading::Tone {
+                    freq_hz,
+                    span_s,
+                    hann,
+                }),
                 Shape::Rotating => [0.0; 2],
             }
-            .map(|v| v * enbw)
         };
         let points = self
             .experiment
@@ -379,14 +383,42 @@ impl Config {
     }
 }
 
-/// How a reading weighs a slow phase fluctuation over frequency.
+/// How a reading weighs a slow phase fluctuation over frequency: `K(u)` at `u = f T` is the
+/// boxcar's `sinc^2(pi u)` or, with `hann`, the mean-normalised Hann window's
+/// `(sinc(u) + sinc(u - 1) / 2 + sinc(u + 1) / 2)^2`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum SlowReading {
-    /// The mean over `span_s` (a Coriolis phase): weight `sinc^2(pi f T)`.
-    Mean { span_s: f64 },
+    /// The mean over `span_s` (a Coriolis phase): weight `K(f T)`.
+    Mean { span_s: f64, hann: bool },
     /// The in-phase part of the fundamental at `freq_hz` over `span_s` (a rate table's
-    /// amplitude): weight `sinc^2(pi (f - f_t) T) + sinc^2(pi (f + f_t) T)`.
-    Tone { freq_hz: f64, span_s: f64 },
+    /// amplitude): weight `K((f - f_t) T) + K((f + f_t) T)`.
+    Tone {
+        freq_hz: f64,
+        span_s: f64,
+        hann: bool,
+    },
+}
+
+/// The window's weight `K(u)` (see [`SlowReading`]), or its mean from |u| = 4 on, where a
+/// quadrature grid would alias its oscillation: `1 / (2 pi^2 u^2)` for the boxcar,
+/// `1 / (2 pi^2 u^2 (u^2 - 1)^2)` for Hann.
+fn window_weight(u: f64, hann: bool) -> f64 {
+    if !hann {
+        return sinc2(u);
+    }
+    let u = u.abs();
+    if u >= 4.0 {
+        return 1.0 / (2.0 * core::f64::consts::PI.powi(2) * u * u * (u * u - 1.0).powi(2));
+    }
+    let s = |x: f64| {
+        if x.abs() < 1e-9 {
+            1.0
+        } else {
+            let y = core::f64::consts::PI * x;
+            y.sin() / y
+        }
+    };
+    (s(u) + 0.5 * s(u - 1.0) + 0.5 * s(u + 1.0)).powi(2)
 }
 
 /// `sinc^2(pi u)`, or its mean `1 / (2 pi^2 u^2)` from |u| = 4 on, where a quadrature grid
@@ -409,12 +441,12 @@ impl SlowReading {
     /// of 4001 points over f_t +- 40 / T for a tone (its weight's tails beyond hold under 1 %).
     fn variance(self, density: &dyn Fn(f64) -> f64, f_lo: f64, f_top: f64) -> f64 {
         match self {
-            SlowReading::Mean { span_s } => {
+            SlowReading::Mean { span_s, hann } => {
                 let a = (1e-3 * f_lo).min(0.01 / span_s);
                 if !(a > 0.0 && f_top > a) {
                     return 0.0;
                 }
-                let g = |f: f64| density(f) * sinc2(f * span_s) * f;
+                let g = |f: f64| density(f) * window_weight(f * span_s, hann) * f;
                 let steps = ((f_top / a).log10() * 64.0).ceil().max(1.0) as usize;
                 let dl = (f_top / a).ln() / steps as f64;
                 let mut sum = density(a) * a;
@@ -426,7 +458,11 @@ impl SlowReading {
                 }
                 sum
             }
-            SlowReading::Tone { freq_hz, span_s } => {
+            SlowReading::Tone {
+                freq_hz,
+                span_s,
+                hann,
+            } => {
                 let half = 40.0 / span_s;
                 let (lo, hi) = ((freq_hz - half).max(0.0), (freq_hz + half).min(f_top));
                 if hi <= lo || hi.is_nan() || lo.is_nan() {
@@ -435,7 +471,9 @@ impl SlowReading {
                 let n = 4000;
                 let df = (hi - lo) / n as f64;
                 let g = |f: f64| {
-                    density(f) * (sinc2((f - freq_hz) * span_s) + sinc2((f + freq_hz) * span_s))
+                    density(f)
+                        * (window_weight((f - freq_hz) * span_s, hann)
+                            + window_weight((f + freq_hz) * span_s, hann))
                 };
                 (0..=n)
                     .map(|i| {

@@ -580,7 +580,12 @@ impl Config {
             "board.fs_hz",
             self.fs_hz(),
             format!(
-                "at {per_period:.2} samples per carrier period the DAC's zero-order hold moves the measured phase by up to {worst:.3e} mdeg from the continuous-drive theory (its images beside the carrier dominate); raise fs_hz (16 samples per period keeps it near 0.01 mdeg)"
+                "at {per_period:.2} samples per carrier period the DAC's zero-order hold moves the measured phase by up to {worst:.3e} mdeg from the continuous-drive theory at these rates (the exact held-drive steady state: the board measures the hold more than the device); raise fs_hz{}",
+                if per_period < 16.0 {
+                    " (16 samples per period keeps it near 0.01 mdeg at ordinary rates)"
+                } else {
+                    ""
+                }
             ),
         );
         if worst > WARN_HOLD_ERROR_MDEG {

@@ -145,6 +145,7 @@ pub fn inspect_text(set: &DumpSet) -> String {
         for s in channel_stats(d) {
             let tones = match (&s.spectrum_error, s.tones.is_empty()) {
                 (Some(e), _) => format!("no spectrum: {e}"),
+                (None, true) if s.peak == 0.0 => "none: the channel is zero throughout".into(),
                 (None, true) if s.bins < SHORT_SPECTRUM_BINS => format!(
                     "none read: a spectrum of {} bins is too short to tell a tone from its window's own leakage, which sets the median there; record a longer window",
                     s.bins

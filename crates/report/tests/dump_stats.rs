@@ -161,3 +161,22 @@ fn a_record_too_short_for_tones_says_so_not_that_none_stands_out() {
         }
     }
 }
+
+#[test]
+fn a_channel_zero_throughout_says_so_not_that_its_record_is_short() {
+    // A Coriolis dump's stage-2 channels are zero: 24 of them had printed "too short", as if
+    // a longer window would show a tone.
+    let dir = tempfile::tempdir().unwrap();
+    let mut r = SignalRecorder::new(vec!["c1_i".into()], 2400.0, 0, 24);
+    for k in 0..24u64 {
+        r.record(k, &[0.0]);
+    }
+    r.write(dir.path(), "dump_decimated").unwrap();
+    let set = read_dump_set(&dir.path().join("dump_decimated.sigmf-meta")).unwrap();
+    let text = inspect_text(&set);
+    let line = text.lines().find(|l| l.contains("c1_i")).unwrap();
+    assert!(
+        line.contains("zero throughout") && !line.contains("too short"),
+        "{line}"
+    );
+}

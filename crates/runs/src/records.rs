@@ -159,15 +159,21 @@ fn checked_value(text: &str) -> Result<serde_json::Value, String> {
 }
 
 /// Atomically writes `rec` into `out/<R::DIR>/` (the folder is created), with its checksum.
+/// The checksum is taken over the record as a reader parses the written text: serde_json's
+/// parser can miss a decimal's nearest double by an ulp (a rate of 122.94026546559225 deg/s
+/// read back one off), and a checksum of the exact values then refused an untouched file.
 pub fn write_record<R: RecordFile>(out: &Path, rec: &R) -> Result<(), String> {
     let dir = out.join(R::DIR);
     std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
-    let mut v = serde_json::to_value(rec).map_err(|e| e.to_string())?;
-    let sum = checksum(&v);
-    if let Some(o) = v.as_object_mut() {
+    // The file keeps the exact values; the sum is of what a reader parses from them.
+    let mut exact = serde_json::to_value(rec).map_err(|e| e.to_string())?;
+    let text = serde_json::to_string(&exact).map_err(|e| e.to_string())?;
+    let read: serde_json::Value = serde_json::from_str(&text).map_err(|e| e.to_string())?;
+    let sum = checksum(&read);
+    if let Some(o) = exact.as_object_mut() {
         o.insert(CHECKSUM_KEY.to_string(), sum.into());
     }
-    gyroemu_io::write_json(&dir.join(R::file_name(rec.index())), &v).map_err(|e| e.to_string())
+    gyroemu_io::write_json(&dir.join(R::file_name(rec.index())), &exact).map_err(|e| e.to_string())
 }
 
 /// An f64 as 16 hex digits of its IEEE bits (decimal text round-trips only with a correctly

@@ -570,3 +570,33 @@ fn merge_refuses_shards_whose_configs_differ_in_sections_the_hash_leaves_out() {
         .unwrap();
     merge(&out, &Quiet).unwrap();
 }
+
+#[test]
+fn point_files_of_rates_the_json_parser_reads_an_ulp_off_keep_their_checksum() {
+    // serde_json (without float_roundtrip) reads some decimals one ulp from their nearest
+    // double: a checksum of the exact values refused such a point as edited on every rerun,
+    // and its shard's merge failed however often it was rerun. Rates drawn at random over
+    // 1..170 deg/s hit such a value within a few dozen.
+    let rates: Vec<f64> = (0..40u64)
+        .map(|i| {
+            1.0 + 169.0 * ((i * 2_654_435_761) % 1_000_003) as f64 / 1_000_003.0 + 1e-9 * i as f64
+        })
+        .collect();
+    let misread = rates.iter().any(|&r| {
+        let text = serde_json::to_string(&r).unwrap();
+        serde_json::from_str::<f64>(&text).unwrap().to_bits() != r.to_bits()
+    });
+    assert!(
+        misread,
+        "no rate of the list is misread: the test would not test"
+    );
+    let mut cfg = config();
+    cfg.experiment.rates_dps = rates;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ulp");
+    run_shard(&cfg, &out, None).0.unwrap();
+    let (r, notes) = run_shard(&cfg, &out, None);
+    r.unwrap();
+    assert!(!notes.contains("do not match"), "{notes}");
+    assert!(notes.contains("all already computed"), "{notes}");
+}
