@@ -149,7 +149,29 @@ fn a_lock_run_too_short_is_an_error_not_a_carrier() {
     c.validate().unwrap();
     let e = lock_config_carrier(&c, &c).unwrap_err();
     assert!(
-        e.to_string().contains("did not lock within pll.lock_s"),
+        e.to_string().contains("did not lock within") && e.to_string().contains("raise pll.lock_s"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_lock_the_phase_noise_spoils_says_so_not_that_it_needs_time() {
+    // TIA noise of 2e-5 V/sqrt(Hz): the loop settles within a few mHz of the resonance (0.5 %
+    // of a half-bandwidth) but its phase error never stays within the lock threshold for a
+    // natural period. It had been told to raise pll.lock_s, which (at 10 s) did not help.
+    let base = config("coriolis", 15e3, 2000.0, 1.0, 1.0, &[100.0], 0.2);
+    let mut c = with_pll(base, 10.0);
+    c.noise = Some(gyroemu::config::NoiseConfig {
+        seed: 1,
+        temperature_k: 300.0,
+        tia_voltage_noise_v_per_rthz: 2e-5,
+        ..Default::default()
+    });
+    let e = lock_config_carrier(&c, &c).unwrap_err().to_string();
+    assert!(
+        e.contains("phase noise")
+            && e.contains("lower the [noise]")
+            && !e.contains("raise pll.lock_s"),
         "{e}"
     );
 }

@@ -384,3 +384,27 @@ fn a_rate_table_on_a_drifting_dac_pattern_is_stated_and_holds() {
         assert!(change <= bound, "{bits} bits: {change} > {bound} mdeg");
     }
 }
+
+/// Within a cycle of the window of coinciding (but not refused), the read-out's leak solve is
+/// ill-conditioned: a 100.01 Hz table at a 400 Hz output rate behind a 150 Hz low-pass read
+/// 117.6 deg for a theory of 31.8 deg, exit 0, unwarned (a review's run at fs = 960 kHz). Now
+/// warned; the same board at decimation 2000 (output 480 Hz, read right to 0.004 mdeg) is not.
+#[test]
+fn a_table_near_an_alias_is_warned() {
+    let text = |decimation: usize| {
+        format!(
+            "[device]\nf0_hz = 15000.0\nq = 36000.0\nangular_gain = 1.0\n[drive]\nf1 = 1.0\nf2 = 1.0\n[board]\nfs_hz = 960000.0\ntia_pole_hz = 200000.0\nlpf_cutoff_hz = 150.0\ndecimation = {decimation}\n[experiment]\nkind = \"coriolis\"\nrate_table = \"sinusoid\"\ntable_freq_hz = 100.01\nrates_dps = [20000.0]\naverage_s = 0.2\n"
+        )
+    };
+    let near = parse_config(&text(2400)).unwrap().validate().unwrap();
+    assert!(
+        near.iter()
+            .any(|w| w.contains("board.decimation = 2400") && w.contains("ill-conditioned")),
+        "{near:?}"
+    );
+    let clear = parse_config(&text(2000)).unwrap().validate().unwrap();
+    assert!(
+        !clear.iter().any(|w| w.contains("ill-conditioned")),
+        "{clear:?}"
+    );
+}

@@ -517,13 +517,17 @@ pub fn drift_analysis(
             // advice, pll.lock_s, named a key the drift loop does not read).
             let lock = match lock_config_carrier(&open, design) {
                 Ok(lock) => lock.expect("the design has a [pll]"),
-                Err(SweepError::NotLocked(_)) => {
+                Err(SweepError::NotLocked { cause, .. }) => {
                     at(2, 1, 1);
                     at(3, 1, 1);
+                    // The lock's own cause (noise, or too far or too slow a loop for the
+                    // drifted device), with the drift: the loop is designed for the nominal
+                    // device, so a drifted Q makes it slow as well as the offset far.
                     return Ok((None, None, Some(format!(
-                        "selfcal.drift_delta_t_k: at dT = {dt:+} K the drift scenario's tracking PLL did not lock within its lock run ({:.4} s): the resonance moved to {} Hz, {:+.3} Hz from the carrier it starts at ({} Hz), beyond what the loop designed for the nominal device pulls in; this temperature's PLL-tracked half is null",
-                        design.pll_lock_s().unwrap_or(f64::NAN),
+                        "selfcal.drift_delta_t_k: at dT = {dt:+} K the drift scenario's tracking PLL (designed for the nominal device, Q {}) did not lock: the resonance moved to {} Hz with Q {}, {:+.3} Hz from the carrier it starts at ({} Hz); {cause}; this temperature's PLL-tracked half is null",
+                        cfg.device.q,
                         open.device.f0_hz,
+                        open.device.q,
                         open.device.f0_hz - open.carrier_hz(),
                         open.carrier_hz()
                     ))));

@@ -543,6 +543,38 @@ impl Config {
         Some((worst, at, lag, (exact, exact_at)))
     }
 
+    /// Rate-table runs whose harmonics `n` and `n + d` the output rate aliases to within one
+    /// cycle of the window of each other (but not so near that they are refused): the
+    /// read-out parts them by solving the window's leak, which is then ill-conditioned, and
+    /// divides each by the low-pass's response at its harmonic, so what the leak solve gets
+    /// wrong is amplified. A 100.01 Hz table at a 400 Hz output rate, 0.2 s, behind a 150 Hz
+    /// low-pass read 117.6 deg where the theory is 31.8 deg, exit 0 and unwarned (0.008
+    /// cycles apart; 4.1 deg at 0.024 cycles, 1.5e-3 deg at 0.04, 4e-6 deg at 0.08).
+    pub(crate) fn warn_table_near_alias(&self, warnings: &mut Vec<String>) {
+        let Shape::RateTable { freq_hz: ft } = self.shape() else {
+            return;
+        };
+        let n = self.table_harmonics();
+        let fs_out = self.fs_out_hz();
+        let Some(rate) = self.experiment.rates_dps.first() else {
+            return;
+        };
+        let t = self.plan_point(*rate).window.span() / fs_out;
+        for d in 1..=2 * n {
+            let f = d as f64 * ft;
+            let k = (f / fs_out).round();
+            let cycles = (f - k * fs_out).abs() * t;
+            if k >= 1.0 && (MIN_TABLE_ALIAS_CYCLES..1.0).contains(&cycles) {
+                warnings.push(format!(
+                    "board.decimation = {}: the output rate {fs_out} Hz aliases table harmonics n and n + {d} ({d} x {ft} Hz) to {cycles:.3e} cycles of the {t} s window from each other: the read-out parts them by solving the window's leak, which is then ill-conditioned, and what it gets wrong is divided by the low-pass's response at each harmonic, so the readings can be off by degrees with no other warning (a 100.01 Hz table at 400 Hz read 117.6 deg for 31.8 at 0.008 cycles); choose a decimation whose output rate is not near a multiple of table_freq_hz / k for k <= {}, or average longer",
+                    self.decimation(),
+                    2 * n
+                ));
+                return;
+            }
+        }
+    }
+
     /// Rate-table runs: two demodulated harmonics `n` and `n + d` (`d <= 2N`) whose frequency
     /// difference `d f_t` the output rate aliases to (near) DC read as one: the window-leak
     /// system the read-out solves is singular (NaN, or finite garbage with exit 0).

@@ -110,14 +110,42 @@ pub fn lock_config_carrier(
     let mode = pll_cfg.mode - 1;
     let run = board_lock(&cfg.board_params(), &mut pll, mode, blocks)??;
     if !run.locked {
-        return Err(SweepError::NotLocked(format!(
-            "the carrier PLL did not lock within pll.lock_s = {lock_s} s: it ended at {} Hz with a phase error of {:.3e} rad (started at {} Hz, mode {} resonates at {} Hz as configured); raise pll.lock_s, or start drive.carrier_hz nearer the resonance",
+        let (resonance, q) = if mode == 1 {
+            (
+                cfg.f0_mode2_hz(),
+                cfg.device.q_mode2.unwrap_or(cfg.device.q),
+            )
+        } else {
+            (cfg.device.f0_hz, cfg.device.q)
+        };
+        let cause = format!(
+            "the carrier PLL did not lock within {lock_s} s: it ended at {} Hz with a phase error of {:.3e} rad (started at {} Hz, mode {} resonates at {} Hz as configured)",
             run.carrier_hz,
             pll.phase_error_rad(),
             params.carrier_hz,
             pll_cfg.mode,
-            if mode == 1 { cfg.f0_mode2_hz() } else { cfg.device.f0_hz },
-        )));
+            resonance,
+        );
+        // Settled within 5 % of a half-bandwidth yet never held the phase within the lock
+        // threshold for a natural period: the phase noise at its input, not the time, keeps
+        // it from locking (a longer pll.lock_s did not help).
+        let near = (run.carrier_hz - resonance).abs() < 0.05 * resonance / (2.0 * q);
+        let noisy = cfg.noise.is_some();
+        let (cause, advice) = if near && noisy {
+            (
+                format!(
+                    "{cause}: its frequency settled near the resonance, but the phase noise at its input kept its phase error above the lock threshold ({} rad) for a whole natural period",
+                    params.lock_threshold_rad
+                ),
+                "lower the [noise] sources (a longer pll.lock_s does not help)".to_string(),
+            )
+        } else {
+            (
+                cause,
+                "raise pll.lock_s, or start drive.carrier_hz nearer the resonance".to_string(),
+            )
+        };
+        return Err(SweepError::NotLocked { cause, advice });
     }
     Ok(Some(CarrierLock {
         nominal_hz: params.carrier_hz,

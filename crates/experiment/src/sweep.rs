@@ -35,9 +35,10 @@ pub enum SweepError {
     /// Points without a result (indices in `emulated_rates_dps`).
     #[error("the sweep is missing the results of points {0:?}")]
     Missing(Vec<usize>),
-    /// The carrier PLL did not lock (the sweep would run at a carrier still moving).
-    #[error("{0}")]
-    NotLocked(String),
+    /// The carrier PLL did not lock (the sweep would run at a carrier still moving): what it
+    /// did, and what would help (which depends on who asked for the lock).
+    #[error("{cause}; {advice}")]
+    NotLocked { cause: String, advice: String },
 }
 
 /// The file stem of a sweep's signal dump in its output folder (see [`Probe::write`]).
