@@ -322,6 +322,39 @@ pub fn sweep_grid(
     f
 }
 
+impl Config {
+    /// Each flicker source's one-sided density at 1 Hz as the board draws it: the TIA's
+    /// (input-referred, A^2/Hz), then the drive amplitude's, the drive phase's and the
+    /// carrier phase's; zeros without `[noise]`.
+    pub(crate) fn flicker_psds_at_1hz(&self) -> [f64; 4] {
+        self.noise.as_ref().map_or([0.0; 4], |n| {
+            noise_params(n, self.flicker_f_lo_hz())
+                .flicker_psds_at_1hz(self.board.tia_gain_ohm)
+                .map(|(_, s1)| s1)
+        })
+    }
+
+    /// A flicker source of density `s1` at 1 Hz drawn at `rate_hz`, designed as the board
+    /// designs it (from the flicker corner f_lo up to rate/2); `None` when `s1` is 0 or the
+    /// design is refused.
+    pub(crate) fn flicker_design(
+        &self,
+        s1: f64,
+        rate_hz: f64,
+    ) -> Option<gyroemu_core::flicker::FlickerDesign> {
+        if s1 == 0.0 {
+            return None;
+        }
+        gyroemu_core::flicker::FlickerDesign::new(&gyroemu_core::flicker::FlickerParams {
+            fs_hz: rate_hz,
+            psd_at_1hz: s1,
+            f_lo_hz: self.flicker_f_lo_hz(),
+            f_hi_hz: 0.5 * rate_hz,
+        })
+        .ok()
+    }
+}
+
 /// The board's noise parameters from a `[noise]` section, with the flicker sources' low corner
 /// (resolved by [`Config::flicker_f_lo_hz`]).
 pub(crate) fn noise_params(n: &NoiseConfig, flicker_f_lo_hz: f64) -> NoiseParams {

@@ -67,14 +67,7 @@ impl Config {
             let held = self.expected_lock();
             let judged = held.as_ref().unwrap_or(self);
             judged.validate_regime(&mut p, &mut warnings, held.is_some());
-            judged.validate_table_alias(&mut p);
-            if p.clean(&[
-                "experiment.table_freq_hz",
-                "experiment.average_s",
-                "board.decimation",
-            ]) {
-                judged.warn_table_near_alias(&mut warnings);
-            }
+            judged.validate_table_alias(&mut p, &mut warnings);
             judged.validate_settling(&mut p, &mut warnings);
         }
         if for_sweep {

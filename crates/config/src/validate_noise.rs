@@ -6,7 +6,6 @@ use crate::rules::Rules;
 use crate::schema::{CONVERTER_BITS, PLL_MODE};
 use crate::validate::MAX_RUN_SAMPLES;
 use crate::validate_regime::NODE_RANGE;
-use gyroemu_core::flicker::{FlickerDesign, FlickerParams};
 use gyroemu_core::noise::{held_white_sigma, white_sigma};
 use gyroemu_core::Response;
 use gyroemu_tia::Tia;
@@ -373,21 +372,14 @@ impl Config {
         if !self.has_flicker() || !p.clean(&["noise.flicker_f_lo_hz"]) {
             return;
         }
-        let board_noise = crate::plan::noise_params(n, self.flicker_f_lo_hz());
-        let [(_, tia_s1), (_, amp_s1), (_, drive_phi_s1), (_, carrier_phi_s1)] =
-            board_noise.flicker_psds_at_1hz(r);
+        let [tia_s1, amp_s1, drive_phi_s1, carrier_phi_s1] = self.flicker_psds_at_1hz();
         let fs_out = self.fs_out_hz();
         let deviation = |s1: f64, rate: f64| {
             if s1 == 0.0 {
                 return 0.0;
             }
-            FlickerDesign::new(&FlickerParams {
-                fs_hz: rate,
-                psd_at_1hz: s1,
-                f_lo_hz: self.flicker_f_lo_hz(),
-                f_hi_hz: 0.5 * rate,
-            })
-            .map_or(f64::NAN, |d| d.variance().sqrt())
+            self.flicker_design(s1, rate)
+                .map_or(f64::NAN, |d| d.variance().sqrt())
         };
         let key_c = "noise.tia_voltage_flicker_corner_hz";
         if n.tia_voltage_flicker_corner_hz > 0.0 && p.clean(&[key_c, key_e]) {
@@ -474,7 +466,7 @@ impl Config {
         let fs = self.fs_hz();
         let fc = self.carrier_hz();
         let i_v2 = (n.tia_voltage_noise_v_per_rthz / self.board.tia_gain_ohm).powi(2);
-        let s1 = i_v2 * corner;
+        let s1 = self.flicker_psds_at_1hz()[0];
         let Some(design) = self.tia_flicker_design() else {
             return;
         };

@@ -83,7 +83,7 @@ impl Config {
         // referred, A^2/Hz), with what the decimation folds back at its own density there.
         let flicker = self.tia_flicker_design().map_or(0.0, |d| {
             let at = |f: f64| d.psd(f.abs()) * chain.tia(f).norm_sqr();
-            self.fold_sum(&chain, |f| at(fc + f))
+            self.fold_sums(&chain, |f| [at(fc + f)])[0]
         });
         Some([plant.mode1, plant.mode2].map(|m| {
             let w0 = core::f64::consts::TAU * m.f0_hz;
@@ -113,26 +113,13 @@ impl Config {
     }
 
     /// The TIA voltage flicker's design (input-referred: `(e_n / tia_gain_ohm)^2 corner / f`
-    /// from the flicker corner up to fs/2), when `[noise]` has one.
+    /// up to fs/2), when `[noise]` has one.
     pub(crate) fn tia_flicker_design(&self) -> Option<gyroemu_core::flicker::FlickerDesign> {
-        let n = self.noise.as_ref()?;
-        let corner = n.tia_voltage_flicker_corner_hz;
-        if !(corner > 0.0 && n.tia_voltage_noise_v_per_rthz > 0.0) {
-            return None;
-        }
-        let i_v2 = (n.tia_voltage_noise_v_per_rthz / self.board.tia_gain_ohm).powi(2);
-        let fs = self.fs_hz();
-        gyroemu_core::flicker::FlickerDesign::new(&gyroemu_core::flicker::FlickerParams {
-            fs_hz: fs,
-            psd_at_1hz: i_v2 * corner,
-            f_lo_hz: self.flicker_f_lo_hz(),
-            f_hi_hz: 0.5 * fs,
-        })
-        .ok()
+        self.flicker_design(self.flicker_psds_at_1hz()[0], self.fs_hz())
     }
 
     /// Per mode, the variance (rad^2) the slow phase flicker leaves on one reading
-    /// ([`SlowReading`], boxcar weights: the caller scales by the window's noise bandwidth).
+    /// ([`SlowReading`], under the reading's window).
     /// Each drive's phase flicker turns its mode's response through the envelope low-pass
     /// `|H|^2 = 1 / (1 + (f / f_env)^2)`, `f_env = f0 / (2 Q)`; the carrier's turns the drives
     /// and the stage-1 reference alike, so only `1 - |H|^2` of it stays; the stage-1 low-pass
@@ -141,29 +128,12 @@ impl Config {
     /// order (the slow part turns both sidebands alike, into alpha), so it is not asked. The
     /// drive's amplitude flicker moves no phase to first order.
     pub(crate) fn slow_flicker_variance(&self, reading: SlowReading) -> [f64; 2] {
-        let Some(n) = &self.noise else {
-            return [0.0; 2];
-        };
         let fs_out = self.fs_out_hz();
-        // As the board draws them: once per decimation block, from f_lo up to fs_out / 2.
-        let design = |x: f64| {
-            (x > 0.0)
-                .then(|| {
-                    gyroemu_core::flicker::FlickerDesign::new(
-                        &gyroemu_core::flicker::FlickerParams {
-                            fs_hz: fs_out,
-                            psd_at_1hz: x * x,
-                            f_lo_hz: self.flicker_f_lo_hz(),
-                            f_hi_hz: 0.5 * fs_out,
-                        },
-                    )
-                    .ok()
-                })
-                .flatten()
-        };
+        // As the board draws them: once per decimation block, up to fs_out / 2.
+        let [_, _, drive_s1, carrier_s1] = self.flicker_psds_at_1hz();
         let (drive, carrier) = (
-            design(n.drive_phase_flicker_rad_per_rthz),
-            design(n.carrier_phase_flicker_rad_per_rthz),
+            self.flicker_design(drive_s1, fs_out),
+            self.flicker_design(carrier_s1, fs_out),
         );
         if drive.is_none() && carrier.is_none() {
             return [0.0; 2];
@@ -174,10 +144,9 @@ impl Config {
                 .as_ref()
                 .map_or(1.0, |c| (c.lowpass(f) / c.lowpass(0.0)).norm_sqr())
         };
-        let plant = self.resonator_params();
         let f_top = 0.5 * fs_out;
-        [plant.mode1, plant.mode2].map(|m| {
-            let f_env = m.f0_hz / (2.0 * m.q);
+        // Each mode's envelope corner f0 / (2 Q) is its half-bandwidth.
+        self.mode_resonances_hz().map(|(_, f_env)| {
             let density = |f: f64| {
                 let h = 1.0 / (1.0 + (f / f_env).powi(2));
                 let d = drive.as_ref().map_or(0.0, |d| d.psd(f)) * h;
@@ -189,10 +158,16 @@ impl Config {
     }
 
     /// `sum_k |L(k fs_out)|^2 / |L(0)|^2 g(k fs_out)` over the multiples of the output rate of
-    /// both signs in the input band, k = 0 included (L the stage-1 low-pass): what a density
-    /// `g` at the carrier offset `f` (demodulated to `f`) puts on the decimated output's DC.
-    /// Stops as [`Config::decimation_fold`] does.
-    pub(crate) fn fold_sum(&self, chain: &ChainResponse, g: impl Fn(f64) -> f64) -> f64 {
+    /// both signs in the input band, k = 0 included (L the stage-1 low-pass), for each of the
+    /// `N` values `g` gives: what a density `g` at the carrier offset `f` (demodulated to `f`)
+    /// puts on the decimated output's DC. Outwards from DC, both signs at once, until the
+    /// low-pass's weight is below 1e-8 of the sum (a first-order filter's 1/k^2 tail then adds
+    /// under 1e-4 of it): a decimation of 2.4e6 had summed every term, 0.1 s per validation.
+    pub(crate) fn fold_sums<const N: usize>(
+        &self,
+        chain: &ChainResponse,
+        g: impl Fn(f64) -> [f64; N],
+    ) -> [f64; N] {
         let fs_out = self.fs_out_hz();
         let k_max = (0.5 * self.fs_hz() / fs_out).floor() as u64;
         let dc = chain.lowpass(0.0).norm_sqr();
@@ -200,7 +175,10 @@ impl Config {
         for k in 1..=k_max {
             let f = k as f64 * fs_out;
             let l = [f, -f].map(|f| chain.lowpass(f).norm_sqr() / dc);
-            sum += l[0] * g(f) + l[1] * g(-f);
+            let (up, down) = (g(f), g(-f));
+            for i in 0..N {
+                sum[i] += l[0] * up[i] + l[1] * down[i];
+            }
             weight += l[0] + l[1];
             if l[0] + l[1] < 1e-8 * weight {
                 break;
@@ -210,31 +188,15 @@ impl Config {
     }
 
     /// What the decimation folds onto the decimated output's DC, against the low-pass's own
-    /// DC: `(sum_k |L(k fs_out)|^2 |H(fc + k fs_out)|^2 / |H(fc)|^2, sum_k |L(k fs_out)|^2) /
-    /// |L(0)|^2` over the multiples of the output rate in the input band (L the stage-1
-    /// low-pass, H the TIA). Why: the demodulated noise at each multiple of fs_out lands on DC
-    /// when the output is taken every M samples; a low-pass that leaves it (first order near
-    /// the output Nyquist) made the read-out scatter 1.29 times the stated sigma.
+    /// DC ([`Config::fold_sums`]): `(sum_k |L(k fs_out)|^2 |H(fc + k fs_out)|^2 / |H(fc)|^2,
+    /// sum_k |L(k fs_out)|^2) / |L(0)|^2` (H the TIA). Why: the demodulated noise at each
+    /// multiple of fs_out lands on DC when the output is taken every M samples; a low-pass that
+    /// leaves it (first order near the output Nyquist) made the read-out scatter 1.29 times the
+    /// stated sigma.
     pub(crate) fn decimation_fold(&self, chain: &ChainResponse) -> (f64, f64) {
-        let fs_out = self.fs_out_hz();
         let fc = self.carrier_hz();
-        let k_max = (0.5 * self.fs_hz() / fs_out).floor() as u64;
-        let dc = chain.lowpass(0.0).norm_sqr();
         let tia_fc = chain.tia(fc).norm_sqr();
-        let (mut tia, mut white) = (1.0, 1.0);
-        // Outwards from DC, both signs at once, until the low-pass's weight is below 1e-8 of
-        // the sum (a first-order filter's 1/k^2 tail then adds under 1e-4 of it): a decimation
-        // of 2.4e6 had summed every term, 0.1 s per validation.
-        for k in 1..=k_max {
-            let f = k as f64 * fs_out;
-            let l = [f, -f].map(|f| chain.lowpass(f).norm_sqr() / dc);
-            tia += l[0] * chain.tia(fc + f).norm_sqr() / tia_fc
-                + l[1] * chain.tia(fc - f).norm_sqr() / tia_fc;
-            white += l[0] + l[1];
-            if l[0] + l[1] < 1e-8 * white {
-                break;
-            }
-        }
+        let [tia, white] = self.fold_sums(chain, |f| [chain.tia(fc + f).norm_sqr() / tia_fc, 1.0]);
         (tia, white)
     }
 
@@ -280,18 +242,27 @@ impl Config {
         // the window's own weight (not its white-noise bandwidth: a Hann window takes 1.06 to
         // 1.12 times the boxcar's of the drive's 1/f phase, not 1.5).
         let hann = self.experiment.window == WindowKind::Hann;
-        let slow = |rate: f64| {
-            let span_s = self.plan_point(rate).span_samples() / fs_out;
-            match shape {
-                Shape::Coriolis => self.slow_flicker_variance(SlowReading::Mean { span_s, hann }),
-                Shape::RateTable { freq_hz } => self.slow_flicker_variance(SlowReading::Tone {
-                    freq_hz,
-                    span_s,
-                    hann,
-                }),
-                Shape::Rotating => [0.0; 2],
-            }
+        let slow_of = |span_s: f64| match shape {
+            Shape::Coriolis => self.slow_flicker_variance(SlowReading::Mean { span_s, hann }),
+            Shape::RateTable { freq_hz } => self.slow_flicker_variance(SlowReading::Tone {
+                freq_hz,
+                span_s,
+                hann,
+            }),
+            Shape::Rotating => [0.0; 2],
         };
+        // Once per span, not per rate: a sweep may list 1e5 rates of one span, and each is a
+        // quadrature of hundreds of points (the zero-rate reference's span among them).
+        let span = |rate: f64| self.plan_point(rate).span_samples() / fs_out;
+        let mut slow_by_span: std::collections::HashMap<u64, [f64; 2]> = Default::default();
+        for &rate in self.experiment.rates_dps.iter().chain(&[0.0]) {
+            let s = span(rate);
+            slow_by_span
+                .entry(s.to_bits())
+                .or_insert_with(|| slow_of(s));
+        }
+        let slow = |rate: f64| slow_by_span[&span(rate).to_bits()];
+        let reference_flicker = slow(0.0);
         let points = self
             .experiment
             .rates_dps
@@ -305,7 +276,6 @@ impl Config {
                     Shape::Rotating => dev.rotating_psi_rad(omega),
                 };
                 let flicker = slow(rate);
-                let reference_flicker = slow(0.0);
                 let sigma_rad = [0, 1].map(|k| {
                     let own = variance(rate, k).unwrap_or(f64::NAN);
                     match shape {
@@ -403,35 +373,23 @@ pub(crate) enum SlowReading {
 /// quadrature grid would alias its oscillation: `1 / (2 pi^2 u^2)` for the boxcar,
 /// `1 / (2 pi^2 u^2 (u^2 - 1)^2)` for Hann.
 fn window_weight(u: f64, hann: bool) -> f64 {
-    if !hann {
-        return sinc2(u);
-    }
+    use core::f64::consts::PI;
     let u = u.abs();
-    if u >= 4.0 {
-        return 1.0 / (2.0 * core::f64::consts::PI.powi(2) * u * u * (u * u - 1.0).powi(2));
+    match (u >= 4.0, hann) {
+        (true, false) => 1.0 / (2.0 * PI.powi(2) * u * u),
+        (true, true) => 1.0 / (2.0 * PI.powi(2) * u * u * (u * u - 1.0).powi(2)),
+        (false, false) => sinc(u).powi(2),
+        (false, true) => (sinc(u) + 0.5 * sinc(u - 1.0) + 0.5 * sinc(u + 1.0)).powi(2),
     }
-    let s = |x: f64| {
-        if x.abs() < 1e-9 {
-            1.0
-        } else {
-            let y = core::f64::consts::PI * x;
-            y.sin() / y
-        }
-    };
-    (s(u) + 0.5 * s(u - 1.0) + 0.5 * s(u + 1.0)).powi(2)
 }
 
-/// `sinc^2(pi u)`, or its mean `1 / (2 pi^2 u^2)` from |u| = 4 on, where a quadrature grid
-/// would alias its oscillation.
-fn sinc2(u: f64) -> f64 {
-    let u = u.abs();
-    if u < 1e-9 {
+/// `sin(pi u) / (pi u)`, 1 at 0.
+fn sinc(u: f64) -> f64 {
+    if u.abs() < 1e-9 {
         1.0
-    } else if u < 4.0 {
-        let x = core::f64::consts::PI * u;
-        (x.sin() / x).powi(2)
     } else {
-        1.0 / (2.0 * core::f64::consts::PI.powi(2) * u * u)
+        let x = core::f64::consts::PI * u;
+        x.sin() / x
     }
 }
 

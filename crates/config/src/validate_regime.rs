@@ -15,15 +15,18 @@ use gyroemu_resonator::continuous_steady_state;
 /// sidebands' branch), so only the difference within a half turn is a converter's or the
 /// hold's. NaN stays NaN.
 pub(crate) fn half_turn_mdeg(a: f64, b: f64) -> f64 {
-    let d = a - b;
-    let d = d - core::f64::consts::PI * (d / core::f64::consts::PI).round();
-    (d / DEG * 1e3).abs()
+    mdeg_within(a, b, core::f64::consts::PI)
 }
 
 /// |a - b| in mdeg within a whole turn (a Coriolis phase's difference). NaN stays NaN.
 pub(crate) fn turn_mdeg(a: f64, b: f64) -> f64 {
+    mdeg_within(a, b, core::f64::consts::TAU)
+}
+
+/// |a - b| in mdeg, moved by whole `period`s (rad) to within half of one.
+fn mdeg_within(a: f64, b: f64, period: f64) -> f64 {
     let d = a - b;
-    let d = d - core::f64::consts::TAU * (d / core::f64::consts::TAU).round();
+    let d = d - period * (d / period).round();
     (d / DEG * 1e3).abs()
 }
 

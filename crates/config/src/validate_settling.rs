@@ -543,42 +543,16 @@ impl Config {
         Some((worst, at, lag, (exact, exact_at)))
     }
 
-    /// Rate-table runs whose harmonics `n` and `n + d` the output rate aliases to within one
-    /// cycle of the window of each other (but not so near that they are refused): the
-    /// read-out parts them by solving the window's leak, which is then ill-conditioned, and
-    /// divides each by the low-pass's response at its harmonic, so what the leak solve gets
-    /// wrong is amplified. A 100.01 Hz table at a 400 Hz output rate, 0.2 s, behind a 150 Hz
-    /// low-pass read 117.6 deg where the theory is 31.8 deg, exit 0 and unwarned (0.008
-    /// cycles apart; 4.1 deg at 0.024 cycles, 1.5e-3 deg at 0.04, 4e-6 deg at 0.08).
-    pub(crate) fn warn_table_near_alias(&self, warnings: &mut Vec<String>) {
-        let Shape::RateTable { freq_hz: ft } = self.shape() else {
-            return;
-        };
-        let n = self.table_harmonics();
-        let fs_out = self.fs_out_hz();
-        let Some(rate) = self.experiment.rates_dps.first() else {
-            return;
-        };
-        let t = self.plan_point(*rate).window.span() / fs_out;
-        for d in 1..=2 * n {
-            let f = d as f64 * ft;
-            let k = (f / fs_out).round();
-            let cycles = (f - k * fs_out).abs() * t;
-            if k >= 1.0 && (MIN_TABLE_ALIAS_CYCLES..1.0).contains(&cycles) {
-                warnings.push(format!(
-                    "board.decimation = {}: the output rate {fs_out} Hz aliases table harmonics n and n + {d} ({d} x {ft} Hz) to {cycles:.3e} cycles of the {t} s window from each other: the read-out parts them by solving the window's leak, which is then ill-conditioned, and what it gets wrong is divided by the low-pass's response at each harmonic, so the readings can be off by degrees with no other warning (a 100.01 Hz table at 400 Hz read 117.6 deg for 31.8 at 0.008 cycles); choose a decimation whose output rate is not near a multiple of table_freq_hz / k for k <= {}, or average longer",
-                    self.decimation(),
-                    2 * n
-                ));
-                return;
-            }
-        }
-    }
-
     /// Rate-table runs: two demodulated harmonics `n` and `n + d` (`d <= 2N`) whose frequency
-    /// difference `d f_t` the output rate aliases to (near) DC read as one: the window-leak
-    /// system the read-out solves is singular (NaN, or finite garbage with exit 0).
-    pub(crate) fn validate_table_alias(&self, p: &mut Rules) {
+    /// difference `d f_t` the output rate aliases to near DC. Within
+    /// [`MIN_TABLE_ALIAS_CYCLES`] of the window they read as one: the window-leak system the
+    /// read-out solves is singular (NaN, or finite garbage with exit 0), refused. Within one
+    /// cycle it is ill-conditioned, and the read-out divides each harmonic by the low-pass's
+    /// response there, so what the leak solve gets wrong is amplified: warned. A 100.01 Hz
+    /// table at a 400 Hz output rate, 0.2 s, behind a 150 Hz low-pass read 117.6 deg where the
+    /// theory is 31.8 deg, exit 0 and unwarned (0.008 cycles apart; 4.1 deg at 0.024 cycles,
+    /// 1.5e-3 deg at 0.04, 4e-6 deg at 0.08).
+    pub(crate) fn validate_table_alias(&self, p: &mut Rules, warnings: &mut Vec<String>) {
         let Shape::RateTable { freq_hz: ft } = self.shape() else {
             return;
         };
@@ -587,40 +561,55 @@ impl Config {
         }
         let n = self.table_harmonics();
         let fs_out = self.fs_out_hz();
-        // Removing the key helps only when the derived decimation is another one.
-        let derived = {
-            let mut c = self.clone();
-            c.board.decimation = None;
-            c.decimation()
+        // Every table point averages whole table periods of the same span.
+        let Some(rate) = self.experiment.rates_dps.first() else {
+            return;
         };
-        let derived_note = if derived == self.decimation() {
-            String::new()
-        } else {
-            format!(", or remove the key for the derived one ({derived})")
-        };
-        for rate in self.experiment.rates_dps.iter().take(1) {
-            // Every table point averages whole table periods of the same span.
-            let window = self.plan_point(*rate).window;
-            let t = window.span() / fs_out;
-            for d in 1..=2 * n {
+        let t = self.plan_point(*rate).window.span() / fs_out;
+        // Each pair's alias distance: the first one refused, else the first one warned.
+        let pairs: Vec<(usize, f64, f64)> = (1..=2 * n)
+            .filter_map(|d| {
                 let f = d as f64 * ft;
                 let k = (f / fs_out).round();
-                let delta = (f - k * fs_out).abs();
-                if k >= 1.0 && delta * t < MIN_TABLE_ALIAS_CYCLES {
-                    p.push(ConfigError::key(
-                        "board.decimation",
-                        self.decimation(),
-                        format!(
-                            "the output rate fs_hz/decimation = {fs_out} Hz is {} x {d} x experiment.table_freq_hz ({ft} Hz){}: at the output instants table harmonics n and n + {d} are the same frequency, and the read-out demodulates harmonics -{n} ..= {n}, so it cannot tell them apart (their alias distance {delta:.3e} Hz is below {MIN_TABLE_ALIAS_CYCLES:e} cycles of the {t} s window); choose a decimation whose output rate is not within that of a multiple of table_freq_hz / k for k <= {}{}, or change table_freq_hz",
-                            if k == 1.0 { "1".to_string() } else { format!("1/{k}") },
-                            if delta == 0.0 { "" } else { " (nearly)" },
-                            2 * n,
-                            derived_note
-                        ),
-                    ));
-                    return;
-                }
-            }
+                (k >= 1.0).then(|| (d, k, (f - k * fs_out).abs()))
+            })
+            .collect();
+        let first = |below: f64| {
+            pairs
+                .iter()
+                .copied()
+                .find(|&(_, _, delta)| delta * t < below)
+        };
+        if let Some((d, k, delta)) = first(MIN_TABLE_ALIAS_CYCLES) {
+            // Removing the key helps only when the derived decimation is another one.
+            let derived = {
+                let mut c = self.clone();
+                c.board.decimation = None;
+                c.decimation()
+            };
+            let derived_note = if derived == self.decimation() {
+                String::new()
+            } else {
+                format!(", or remove the key for the derived one ({derived})")
+            };
+            p.push(ConfigError::key(
+                "board.decimation",
+                self.decimation(),
+                format!(
+                    "the output rate fs_hz/decimation = {fs_out} Hz is {} x {d} x experiment.table_freq_hz ({ft} Hz){}: at the output instants table harmonics n and n + {d} are the same frequency, and the read-out demodulates harmonics -{n} ..= {n}, so it cannot tell them apart (their alias distance {delta:.3e} Hz is below {MIN_TABLE_ALIAS_CYCLES:e} cycles of the {t} s window); choose a decimation whose output rate is not within that of a multiple of table_freq_hz / k for k <= {}{}, or change table_freq_hz",
+                    if k == 1.0 { "1".to_string() } else { format!("1/{k}") },
+                    if delta == 0.0 { "" } else { " (nearly)" },
+                    2 * n,
+                    derived_note
+                ),
+            ));
+        } else if let Some((d, _, delta)) = first(1.0).filter(|_| p.clean(&["board.decimation"])) {
+            let cycles = delta * t;
+            warnings.push(format!(
+                "board.decimation = {}: the output rate {fs_out} Hz aliases table harmonics n and n + {d} ({d} x {ft} Hz) to {cycles:.3e} cycles of the {t} s window from each other: the read-out parts them by solving the window's leak, which is then ill-conditioned, and what it gets wrong is divided by the low-pass's response at each harmonic, so the readings can be off by degrees with no other warning (a 100.01 Hz table at 400 Hz read 117.6 deg for 31.8 at 0.008 cycles); choose a decimation whose output rate is not near a multiple of table_freq_hz / k for k <= {}, or average longer",
+                self.decimation(),
+                2 * n
+            ));
         }
     }
 }
