@@ -109,15 +109,9 @@ pub fn lock_config_carrier(
     let blocks = (lock_s * cfg.fs_out_hz()).ceil() as u64;
     let mode = pll_cfg.mode - 1;
     let run = board_lock(&cfg.board_params(), &mut pll, mode, blocks)??;
+    // The locked mode's configured resonance and half-bandwidth.
+    let (resonance, half_bw) = cfg.mode_resonances_hz()[mode];
     if !run.locked {
-        let (resonance, q) = if mode == 1 {
-            (
-                cfg.f0_mode2_hz(),
-                cfg.device.q_mode2.unwrap_or(cfg.device.q),
-            )
-        } else {
-            (cfg.device.f0_hz, cfg.device.q)
-        };
         let cause = format!(
             "the carrier PLL did not lock within {lock_s} s: it ended at {} Hz with a phase error of {:.3e} rad (started at {} Hz, mode {} resonates at {} Hz as configured)",
             run.carrier_hz,
@@ -129,7 +123,7 @@ pub fn lock_config_carrier(
         // Settled within 5 % of a half-bandwidth yet never held the phase within the lock
         // threshold for a natural period: the phase noise at its input, not the time, keeps
         // it from locking (a longer pll.lock_s did not help).
-        let near = (run.carrier_hz - resonance).abs() < 0.05 * resonance / (2.0 * q);
+        let near = (run.carrier_hz - resonance).abs() < 0.05 * half_bw;
         let noisy = cfg.noise.is_some();
         let (cause, advice) = if near && noisy {
             (
@@ -150,11 +144,7 @@ pub fn lock_config_carrier(
     Ok(Some(CarrierLock {
         nominal_hz: params.carrier_hz,
         carrier_hz: run.carrier_hz,
-        resonance_hz: if mode == 1 {
-            cfg.f0_mode2_hz()
-        } else {
-            cfg.device.f0_hz
-        },
+        resonance_hz: resonance,
         lock_time_s: run.lock_time_s,
         trace: run.trace,
     }))
