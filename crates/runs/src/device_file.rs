@@ -2,7 +2,8 @@
 //! records of it, every value bit for bit (the hex of its IEEE bits), so the lot's outputs
 //! rebuilt from the files (a resumed lot, `merge`) equal one machine's byte for byte.
 
-use crate::points::{canonical_toml, hex};
+use crate::points::canonical_toml;
+use crate::records::hex;
 use crate::records::{f64_hex, hex_f64, RecordFile};
 use gyroemu_analysis::montecarlo::{DeviceResult, COLUMNS};
 use gyroemu_analysis::selfcal::sweep_configs;

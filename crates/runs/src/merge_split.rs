@@ -7,6 +7,7 @@ use crate::config_diff::{config_diff_for, describe_diff};
 use crate::dumps::dump_table;
 use crate::error::RunError;
 use crate::manifest::{read_manifest, shard_manifest_paths, Manifest, RunKind, RUN_MANIFEST};
+use crate::points::short_sha;
 use crate::records::{scan_records, RecordFile};
 use crate::shard::absent_shards;
 use gyroemu_config::parse_config;
@@ -106,8 +107,8 @@ pub(crate) fn read_split(dir: &Path) -> Result<Split, RunError> {
             return Err(bad(format!(
                 "`{name}` ran another config than `{first_name}` (config sha256 {} vs \
                  {}){differs}: every shard must run the same config",
-                &m.config_sha256[..m.config_sha256.len().min(12)],
-                &hash[..hash.len().min(12)]
+                short_sha(&m.config_sha256),
+                short_sha(&hash)
             )));
         }
         // Two builds give other bits (fused multiply-adds or not): a merge of both matches
@@ -177,7 +178,6 @@ pub(crate) fn read_split(dir: &Path) -> Result<Split, RunError> {
             && m.config_toml == first.config_toml
             && m.points_total == first.points_total;
         if m.shard.is_none() && !same {
-            let short = |h: &str| h[..h.len().min(12)].to_string();
             let differs = if m.kind != first.kind {
                 format!("it is {}", m.kind.describe())
             } else if m.points_total != first.points_total {
@@ -188,8 +188,8 @@ pub(crate) fn read_split(dir: &Path) -> Result<Split, RunError> {
             } else if m.config_sha256 != hash {
                 format!(
                     "config sha256 {} against the shards' {}",
-                    short(&m.config_sha256),
-                    short(&hash)
+                    short_sha(&m.config_sha256),
+                    short_sha(&hash)
                 )
             } else {
                 "the same results but another [dump] or other sections the hash leaves out"
@@ -311,7 +311,7 @@ impl Split {
                 p.display(),
                 R::STEM,
                 f.index(),
-                &h[..h.len().min(12)]
+                short_sha(h)
             )));
         }
         let found = scan

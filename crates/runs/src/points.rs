@@ -4,7 +4,7 @@
 //! run, a shard, and `gyroemu merge` rebuild the sweep's results from these files; the lane
 //! grouping does not change any bits, so the outputs equal a one-machine run's.
 
-use crate::records::{f64_hex, hex_f64, scan_records, write_record, RecordFile, Scan};
+use crate::records::{f64_hex, hex, hex_f64, scan_records, write_record, RecordFile, Scan};
 use gyroemu_board::{Health, LaneResult};
 use gyroemu_config::Config;
 use gyroemu_core::Complex64;
@@ -48,8 +48,10 @@ pub fn config_hash(cfg: &Config) -> String {
     ))
 }
 
-pub(crate) fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
+/// A hash's first 12 characters, as messages name it (by characters: a hash read from an
+/// edited file need not be ASCII, and a byte slice could split a character).
+pub(crate) fn short_sha(h: &str) -> String {
+    h.chars().take(12).collect()
 }
 
 /// One finished operating point as stored on disk.

@@ -126,6 +126,11 @@ pub fn scan_records<R: RecordFile>(out: &Path) -> Result<Scan<R>, String> {
     Ok(scan)
 }
 
+/// Bytes as lowercase hex (the hashes' text).
+pub(crate) fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
 /// The key of a record's checksum: SHA-256 of the compact JSON of the rest of the record.
 pub const CHECKSUM_KEY: &str = "sha256";
 
@@ -133,10 +138,7 @@ pub const CHECKSUM_KEY: &str = "sha256";
 fn checksum(v: &serde_json::Value) -> String {
     use sha2::{Digest, Sha256};
     let text = serde_json::to_string(v).unwrap_or_default();
-    Sha256::digest(text.as_bytes())
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
+    hex(&Sha256::digest(text.as_bytes()))
 }
 
 /// A record's JSON with its checksum verified and taken out. A file with no checksum (an

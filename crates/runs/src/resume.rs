@@ -8,7 +8,7 @@ use crate::device_file::{lot_hash, DeviceFile, DEVICES_DIR};
 use crate::dumps::{dump_files, remove_files};
 use crate::error::RunError;
 use crate::manifest::{read_manifest, shard_manifest_paths, RunKind, BUILD, RUN_MANIFEST};
-use crate::points::{config_hash, scan_points, PointFile, POINTS_DIR};
+use crate::points::{config_hash, scan_points, short_sha, PointFile, POINTS_DIR};
 use crate::records::{scan_records, RecordFile};
 use gyroemu_analysis::montecarlo::DeviceResult;
 use gyroemu_board::LaneResult;
@@ -174,20 +174,17 @@ fn check_foreign(
             add(&m.config_sha256, m.kind, p, Some(m.config_toml));
         }
     }
-    if let (Some((p, build)), false) = (&other_build, force) {
-        return Err(RunError::BadInput(format!(
-            "output folder `{}` holds results of this config computed by a gyroemu build with {build} (`{}`); this build has {BUILD}, and their bits differ (1e-13 to 2.8e-8 relative), so a folder of both would match neither build's run: run the build that began it, choose another --out, or add --force to delete them",
-            out.display(),
-            p.display()
-        )));
-    }
-    if other_build.is_some() && foreign.is_empty() {
-        reporter.note(&format!(
-            "--force: deleting the results of another gyroemu build in `{}`",
-            out.display()
-        ));
-        clear_out(out, reporter)?;
-        return Ok(true);
+    if let Some((p, build)) = &other_build {
+        if !force {
+            return Err(RunError::BadInput(format!(
+                "output folder `{}` holds results of this config computed by a gyroemu build with {build} (`{}`); this build has {BUILD}, and their bits differ (1e-13 to 2.8e-8 relative), so a folder of both would match neither build's run: run the build that began it, choose another --out, or add --force to delete them",
+                out.display(),
+                p.display()
+            )));
+        }
+        if foreign.is_empty() {
+            return force_clear(out, "another gyroemu build", reporter);
+        }
     }
     let Some((other, f)) = foreign.iter().next() else {
         return Ok(false);
@@ -195,7 +192,7 @@ fn check_foreign(
     if !force {
         let found = format!(
             "sha256 {} in `{}`{}",
-            &other[..other.len().min(12)],
+            short_sha(other),
             f.paths[0].display(),
             if f.paths.len() > 1 {
                 format!(" and {} more files", f.paths.len() - 1)
@@ -232,11 +229,16 @@ fn check_foreign(
             "output folder `{}` holds results of another config ({found}), not of this one \
              (sha256 {}){differs}: choose another --out, or add --force to delete them",
             out.display(),
-            &id.hash[..id.hash.len().min(12)],
+            short_sha(&id.hash),
         )));
     }
+    force_clear(out, "another config", reporter)
+}
+
+/// `--force`'s deletion of the results of `what` in `out`, said; `true`.
+fn force_clear(out: &Path, what: &str, reporter: &dyn Reporter) -> Result<bool, RunError> {
     reporter.note(&format!(
-        "--force: deleting the results of another config in `{}`",
+        "--force: deleting the results of {what} in `{}`",
         out.display()
     ));
     clear_out(out, reporter)?;
