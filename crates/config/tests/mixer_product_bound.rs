@@ -38,8 +38,7 @@ fn the_rotating_fold_bound_covers_the_error_without_the_dc_term() {
             .iter()
             .find(|s| s.starts_with("board.decimation = 8"))
             .unwrap_or_else(|| panic!("{w:?}"));
-        let rest = &s[s.find("by up to ").unwrap() + 9..];
-        let bound: f64 = rest.split_once(" mdeg").unwrap().0.parse().unwrap();
+        let bound = stated_mdeg(s);
         // The old bound weighed DC in full: asin |L(2 f_c)| = 57 mdeg. The ideal device's
         // sidebands cancel it to a small remainder; the imperfect one's less so.
         let most = if device.is_empty() { 0.1 } else { 10.0 };
@@ -67,28 +66,42 @@ fn the_rotating_fold_bound_covers_the_error_without_the_dc_term() {
     }
 }
 
+/// The figure after "by up to " in a warning, mdeg.
+fn stated_mdeg(warning: &str) -> f64 {
+    let rest = &warning[warning.find("by up to ").unwrap() + 9..];
+    rest.split_once(" mdeg").unwrap().0.parse().unwrap()
+}
+
+/// A Coriolis run at 100 and 1000 deg/s on the M^2-TFG device (Q 2000, equal drives) with
+/// these `[board]` lines (a 1 Mohm TIA besides), averaged `average_s`.
+fn coriolis(board: &str, average_s: f64) -> Config {
+    parse_config(&format!(
+        "[device]\nf0_hz = 15000.0\nq = 2000.0\nangular_gain = 1.0\n\
+         [drive]\nf1 = 1.0\nf2 = 1.0\n\
+         [board]\ntia_gain_ohm = 1e6\n{board}\n\
+         [experiment]\nkind = \"coriolis\"\nrates_dps = [100.0, 1000.0]\naverage_s = {average_s:?}\n"
+    ))
+    .unwrap()
+}
+
 #[test]
 fn the_coriolis_fold_bound_counts_the_zero_rate_reference_too() {
     // A first-order low-pass at 1500 Hz and M = 12 (output 20 kHz, the 2 f_c product's alias
     // at 10 kHz) over a one-block window: the product moves each phasor, the rate's and the
     // zero-rate reference's, and the Coriolis phase is their difference. The bound of one
     // phasor (2714 mdeg) was passed by 3071 mdeg; both together bound it.
-    let c = parse_config(
-        "[device]\nf0_hz = 15000.0\nq = 2000.0\nangular_gain = 1.0\n\
-         [drive]\nf1 = 1.0\nf2 = 1.0\n\
-         [board]\nfs_hz = 240000.0\ntia_gain_ohm = 1e6\ntia_pole_hz = 60000.0\nlpf_order = 1\n\
-         lpf_cutoff_hz = 1500.0\ndecimation = 12\n\
-         [experiment]\nkind = \"coriolis\"\nrates_dps = [100.0, 1000.0]\naverage_s = 5e-5\n",
-    )
-    .unwrap();
+    let c = coriolis(
+        "fs_hz = 240000.0\ntia_pole_hz = 60000.0\nlpf_order = 1\nlpf_cutoff_hz = 1500.0\n\
+         decimation = 12",
+        5e-5,
+    );
     let w = c.validate().unwrap();
     let s = w
         .iter()
         .find(|s| s.starts_with("board.decimation = 12"))
         .unwrap_or_else(|| panic!("{w:?}"));
     assert!(s.contains("zero-rate reference"), "{s}");
-    let rest = &s[s.find("by up to ").unwrap() + 9..];
-    let bound: f64 = rest.split_once(" mdeg").unwrap().0.parse().unwrap();
+    let bound = stated_mdeg(s);
     // The emulated phase shift against the held board's exact steady state (the hold is not
     // the product's): -arg z(rate) / z(0) per mode (stage 1 takes z = LPF{2 y e^{-j w t}}).
     let (rates, lanes) = common::run(&c);
@@ -118,14 +131,11 @@ fn the_coriolis_fold_bound_counts_the_zero_rate_reference_too() {
 fn a_product_inside_the_pass_band_at_the_sample_rate_asks_for_a_higher_rate() {
     // fs = 30030 Hz: 2 f_c = 30 kHz aliases to 30 Hz at the sample rate itself, inside the
     // 200 Hz low-pass: no decimation nor order removes it.
-    let c = parse_config(
-        "[device]\nf0_hz = 15000.0\nq = 2000.0\nangular_gain = 1.0\n\
-         [drive]\nf1 = 1.0\nf2 = 1.0\n\
-         [board]\nfs_hz = 30030.0\ntia_gain_ohm = 1e6\ntia_pole_hz = 15000.0\nlpf_order = 4\n\
-         lpf_cutoff_hz = 200.0\ndecimation = 10\n\
-         [experiment]\nkind = \"coriolis\"\nrates_dps = [100.0, 1000.0]\naverage_s = 0.2\n",
-    )
-    .unwrap();
+    let c = coriolis(
+        "fs_hz = 30030.0\ntia_pole_hz = 15000.0\nlpf_order = 4\nlpf_cutoff_hz = 200.0\n\
+         decimation = 10",
+        0.2,
+    );
     let w = c.validate().unwrap();
     let s = w
         .iter()

@@ -217,27 +217,37 @@ fn the_marks_sit_at_the_carrier_not_at_the_resonance() {
     assert!(label.contains(&format!("{:.1} dBV", db(1e-3))), "{label}");
 }
 
+/// The low-pass panel of a decimated dump of `lp_i1` = `x(k)`, `n` samples at 2400 Hz from a
+/// board of carrier 15 kHz decimating by 100.
+fn low_pass_panel(n: u64, x: impl Fn(u64) -> f64) -> gyroemu_plot::Figure {
+    let dir = tempfile::tempdir().unwrap();
+    let extra = BTreeMap::from([
+        ("carrier_hz".to_string(), 15_000.0),
+        ("decimation".into(), 100.0),
+    ]);
+    let mut dec = SignalRecorder::new(vec!["lp_i1".into()], 2400.0, 0, n).with_extra(extra);
+    for k in 0..n {
+        dec.record(k, &[x(k)]);
+    }
+    dec.write(dir.path(), "dump_decimated").unwrap();
+    let set = read_dump_set(&dir.path().join("dump_decimated.sigmf-meta")).unwrap();
+    let (_, panels) = spectrum_panels(&set);
+    panels
+        .into_iter()
+        .find(|f| f.title.starts_with("Low-pass"))
+        .unwrap()
+}
+
 /// A mark on a tone within 3 bins of fs/2 reads `unresolved`, as `inspect` prints it: the
 /// 2 fc residual of the m2tfg presets lands exactly on the decimated fs/2 (2 x 15 kHz at
 /// 2.4 kHz), and a level there is the tone's and its mirror image's at once.
 #[test]
 fn a_mark_at_fs_over_2_reads_unresolved() {
-    let dir = tempfile::tempdir().unwrap();
-    let (fs, fc) = (240_000.0, 15_000.0);
-    let extra = BTreeMap::from([("carrier_hz".to_string(), fc), ("decimation".into(), 100.0)]);
-    let fs_out = fs / 100.0;
-    let mut dec = SignalRecorder::new(vec!["lp_i1".into()], fs_out, 0, 1024).with_extra(extra);
-    for k in 0..1024u64 {
+    let fs_out = 240_000.0 / 100.0;
+    let lp = low_pass_panel(1024, |k| {
         let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
-        dec.record(k, &[1e-3 + 1e-9 * sign]);
-    }
-    dec.write(dir.path(), "dump_decimated").unwrap();
-    let set = read_dump_set(&dir.path().join("dump_decimated.sigmf-meta")).unwrap();
-    let (_, panels) = spectrum_panels(&set);
-    let lp = panels
-        .iter()
-        .find(|f| f.title.starts_with("Low-pass"))
-        .unwrap();
+        1e-3 + 1e-9 * sign
+    });
     let residual = lp
         .markers
         .iter()
@@ -262,22 +272,7 @@ fn a_mark_at_fs_over_2_reads_unresolved() {
 fn a_residual_near_fs_over_2_in_a_coarse_spectrum_is_not_said_to_land_on_dc() {
     // 24 decimated samples at 2400 Hz: 4-sample segments, 600 Hz bins; 2 fc = 30 kHz lands at
     // 1200 Hz (fs/2), which is within two bins of DC there but is not DC.
-    let dir = tempfile::tempdir().unwrap();
-    let extra = BTreeMap::from([
-        ("carrier_hz".to_string(), 15_000.0),
-        ("decimation".into(), 100.0),
-    ]);
-    let mut dec = SignalRecorder::new(vec!["lp_i1".into()], 2400.0, 0, 24).with_extra(extra);
-    for k in 0..24u64 {
-        dec.record(k, &[-0.019]);
-    }
-    dec.write(dir.path(), "dump_decimated").unwrap();
-    let set = read_dump_set(&dir.path().join("dump_decimated.sigmf-meta")).unwrap();
-    let (_, panels) = spectrum_panels(&set);
-    let lp = panels
-        .iter()
-        .find(|f| f.title.starts_with("Low-pass"))
-        .unwrap();
+    let lp = low_pass_panel(24, |_| -0.019);
     assert!(!lp.title.contains("onto DC"), "{}", lp.title);
     assert!(
         lp.title.contains("aliased to 1200 Hz") && lp.title.contains("unresolved in 600 Hz bins"),

@@ -133,48 +133,41 @@ fn the_window_is_printed_to_a_sample_period_at_any_rate() {
     );
 }
 
+/// `inspect`'s line for channel `name` of a 2400 Hz decimated dump of `n` samples of `level`.
+fn inspect_line(name: &str, n: u64, level: f64) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let mut r = SignalRecorder::new(vec![name.into()], 2400.0, 0, n);
+    for k in 0..n {
+        r.record(k, &[level]);
+    }
+    r.write(dir.path(), "dump_decimated").unwrap();
+    let set = read_dump_set(&dir.path().join("dump_decimated.sigmf-meta")).unwrap();
+    let text = inspect_text(&set);
+    text.lines().find(|l| l.contains(name)).unwrap().to_string()
+}
+
 #[test]
 fn a_record_too_short_for_tones_says_so_not_that_none_stands_out() {
     // 24 samples of a clean level: 4-sample segments, 3 bins, and the Hann window's own
     // leakage (bin 1 = c^2/2) is the median a tone must clear by 20 dB. It printed "none 20
     // dB above the median", as if the channel held no tone; 256 samples read the level.
-    for (n, short) in [(24u64, true), (256, false)] {
-        let dir = tempfile::tempdir().unwrap();
-        let mut r = SignalRecorder::new(vec!["lp_i1".into()], 2400.0, 0, n);
-        for k in 0..n {
-            r.record(k, &[-0.019]);
-        }
-        r.write(dir.path(), "dump_decimated").unwrap();
-        let set = read_dump_set(&dir.path().join("dump_decimated.sigmf-meta")).unwrap();
-        let text = inspect_text(&set);
-        let line = text.lines().find(|l| l.contains("lp_i1")).unwrap();
-        if short {
-            assert!(
-                line.contains("none read: a spectrum of 3 bins is too short"),
-                "{line}"
-            );
-        } else {
-            assert!(
-                line.contains(&format!("0.0: {:.1} dBV", 20.0 * 0.019f64.log10())),
-                "{line}"
-            );
-        }
-    }
+    let line = inspect_line("lp_i1", 24, -0.019);
+    assert!(
+        line.contains("none read: a spectrum of 3 bins is too short"),
+        "{line}"
+    );
+    let line = inspect_line("lp_i1", 256, -0.019);
+    assert!(
+        line.contains(&format!("0.0: {:.1} dBV", 20.0 * 0.019f64.log10())),
+        "{line}"
+    );
 }
 
 #[test]
 fn a_channel_zero_throughout_says_so_not_that_its_record_is_short() {
     // A Coriolis dump's stage-2 channels are zero: 24 of them had printed "too short", as if
     // a longer window would show a tone.
-    let dir = tempfile::tempdir().unwrap();
-    let mut r = SignalRecorder::new(vec!["c1_i".into()], 2400.0, 0, 24);
-    for k in 0..24u64 {
-        r.record(k, &[0.0]);
-    }
-    r.write(dir.path(), "dump_decimated").unwrap();
-    let set = read_dump_set(&dir.path().join("dump_decimated.sigmf-meta")).unwrap();
-    let text = inspect_text(&set);
-    let line = text.lines().find(|l| l.contains("c1_i")).unwrap();
+    let line = inspect_line("c1_i", 24, 0.0);
     assert!(
         line.contains("zero throughout") && !line.contains("too short"),
         "{line}"
