@@ -600,3 +600,23 @@ fn point_files_of_rates_the_json_parser_reads_an_ulp_off_keep_their_checksum() {
     assert!(!notes.contains("do not match"), "{notes}");
     assert!(notes.contains("all already computed"), "{notes}");
 }
+
+#[test]
+fn a_hash_edited_into_non_ascii_is_refused_not_a_panic() {
+    // Messages name a hash by its first 12 characters; a byte slice of "a" followed by
+    // two-byte characters split one and panicked.
+    let cfg = config();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("utf8");
+    for s in ["0/2", "1/2"] {
+        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
+            .0
+            .unwrap();
+    }
+    let p = out.join("shard-1-of-2.json");
+    let mut m = json(&p);
+    m["config_sha256"] = "a\u{e9}\u{e9}\u{e9}\u{e9}\u{e9}\u{e9}\u{e9}\u{e9}\u{e9}\u{e9}".into();
+    std::fs::write(&p, serde_json::to_string(&m).unwrap()).unwrap();
+    let why = merge_refusal(&out);
+    assert!(why.contains("ran another config"), "{why}");
+}
