@@ -7,7 +7,7 @@ use crate::device_file::{lot_hash, DeviceFile, DEVICES_DIR};
 use crate::error::RunError;
 use crate::ledger::Ledger;
 use crate::manifest::RunKind;
-use crate::points::canonical_toml;
+use crate::points::{canonical_toml, short_sha};
 use crate::records::write_record;
 use crate::resume::previous_devices;
 use crate::run::RunRequest;
@@ -110,7 +110,7 @@ pub fn run_lot(
     } else if todo.is_empty() {
         format!(
             "{what}: all already computed for this lot (sha256 {}) in `{}`: reusing them",
-            &hash[..12],
+            short_sha(&hash),
             devices_dir.display()
         )
     } else {

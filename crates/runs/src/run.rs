@@ -8,7 +8,7 @@ use crate::error::RunError;
 use crate::ledger::Ledger;
 use crate::lock::{lock_out, LockScope, OutLock};
 use crate::manifest::RunKind;
-use crate::points::{canonical_toml, config_hash, scan_points, write_point, POINTS_DIR};
+use crate::points::{canonical_toml, config_hash, scan_points, short_sha, write_point, POINTS_DIR};
 use crate::resume::previous_points;
 use crate::shard::{check_split, manifest_path, Shard};
 use gyroemu_board::LaneResult;
@@ -185,7 +185,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     reporter.note(&if reused > 0 && reused == mine.len() {
         format!(
             "{what}: all already computed for this config (sha256 {}) in `{}`: reusing them",
-            &hash[..12],
+            short_sha(&hash),
             points_dir.display()
         )
     } else if reused > 0 {
