@@ -92,6 +92,10 @@ impl Config {
             p.push(e);
             return;
         }
+        if let Err(e) = self.validate_table_winding() {
+            p.push(e);
+            return;
+        }
         let largest = (0..2)
             .flat_map(|k| node_amplitudes(self, k))
             .fold(0.0, f64::max);
@@ -136,6 +140,33 @@ impl Config {
             n + 1,
             left.to_degrees() * 1e3
         ));
+    }
+
+    /// A rate table whose swing takes a mode's velocity envelope around zero within a table
+    /// period: its phase then turns a whole turn per period and has no lag to read, so the
+    /// run could only refuse that mode's reading after every sample (it did, blaming an
+    /// overflow: a 1.5 Hz mode split with drive.f2 = 0.5 at 100 deg/s). The exact periodic
+    /// steady state says so before the run; the first such rate and mode are named.
+    fn validate_table_winding(&self) -> Result<(), ConfigError> {
+        let Shape::RateTable { freq_hz } = self.shape() else {
+            return Ok(());
+        };
+        let dev = self.driven_device();
+        for &rate in &self.experiment.rates_dps {
+            let (amp, _) = dev.rate_table_response(rate.abs() * DEG, freq_hz);
+            if let Some(k) = amp.iter().position(|a| a.is_nan()) {
+                let drive = ["drive.f1", "drive.f2"][k];
+                return Err(ConfigError::key(
+                    "experiment.rates_dps",
+                    rate,
+                    format!(
+                        "at this rate-table amplitude mode {}'s velocity envelope (its phasor at the carrier, exact periodic steady state) passes around zero once per table period ({freq_hz} Hz): what the rate couples in from the other mode outweighs the mode's own driven response at the swing's peaks, so its phase turns a whole turn per period and has no lag or amplitude to read; lower the amplitude, raise {drive}, or bring the mode nearer the carrier",
+                        k + 1
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// A rate table's plant step expands the step matrix to second order in the rate about

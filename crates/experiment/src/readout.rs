@@ -300,7 +300,9 @@ fn small_rate_slope(cfg: &Config) -> [f64; 2] {
 /// The rate-table read-out of one point: each harmonic of `z` freed of the window's leak, the
 /// low-pass `L(n f_t)` and the TIA `H(f_c + n f_t)` divided out of it (the chain acts on `z`,
 /// not on its phase), then the fundamental of the phase lag of the envelope they make. Writes
-/// the amplitude into `phase_deg` and returns the lag, degrees per mode.
+/// the amplitude into `phase_deg` and returns the lag, degrees per mode, and whether each
+/// mode's envelope went around zero (finite harmonics, no continuous phase: NaN, and not
+/// an overflow).
 fn table_phase_readout(
     chain: &ChainResponse,
     lr: &LaneResult,
@@ -308,11 +310,12 @@ fn table_phase_readout(
     n_settle: u64,
     n: usize,
     phase_deg: &mut [f64; 2],
-) -> [f64; 2] {
+) -> ([f64; 2], [bool; 2]) {
     let ft = chain.table_hz();
     let fc = chain.carrier_hz();
     let leak = chain.table_leak(point, n_settle, n);
     let mut lag = [0.0; 2];
+    let mut wound = [false; 2];
     for k in 0..2 {
         let avg = &lr.table_z[k][MAX_TABLE_HARMONIC - n..=MAX_TABLE_HARMONIC + n];
         let v: Vec<Complex64> = unleak_table_harmonics(avg, &leak)
@@ -324,11 +327,12 @@ fn table_phase_readout(
             })
             .collect();
         let x = phase_fundamental(&v);
+        wound[k] = x.is_nan() && v.iter().all(|z| z.is_finite());
         phase_deg[k] = x.norm() / DEG;
         // A lag a sin(w_t t - l) has the complex amplitude -j a e^{-j l}.
         lag[k] = -(x * Complex64::new(0.0, 1.0)).arg() / DEG;
     }
-    lag
+    (lag, wound)
 }
 
 /// Turns each emulated point's lane averages into phases, compensation, theory and fits (the
@@ -358,6 +362,8 @@ pub fn post_process_with(
     let dev = cfg.driven_device();
     let table_harmonics = cfg.table_harmonics();
     let mut out = Vec::new();
+    // Per listed point: whether each mode's rate-table envelope went around zero.
+    let mut wound_at = Vec::new();
     let mut comp = Vec::new();
     let zero = rates.iter().position(|&r| r == 0.0);
     let averaged = |p: &Point| p.span_samples() / fs_out;
@@ -372,6 +378,7 @@ pub fn post_process_with(
             Shape::RateTable { freq_hz } => Some(dev.rate_table_response(omega, freq_hz)),
             _ => None,
         };
+        let mut wound = [false; 2];
         let mut r = PointResult {
             rate_dps: rate,
             phase_deg: [0.0; 2],
@@ -403,14 +410,16 @@ pub fn post_process_with(
             }
             Shape::RateTable { .. } => {
                 r.table_lag_theory_deg = table_theory.map(|(_, lag)| lag.map(|l| l / DEG));
-                r.table_lag_deg = Some(table_phase_readout(
+                let (lag, w) = table_phase_readout(
                     &chain,
                     lr,
                     &points[i],
                     cfg.n_settle_out(),
                     table_harmonics,
                     &mut r.phase_deg,
-                ));
+                );
+                r.table_lag_deg = Some(lag);
+                wound = w;
             }
             Shape::Rotating => {
                 let terms = chain.rotating_terms(omega / core::f64::consts::TAU);
@@ -472,6 +481,7 @@ pub fn post_process_with(
             }
         }
         out.push(r);
+        wound_at.push(wound);
     }
     // Refuse what no signal supports, and any read-out that is not a finite number.
     let mut problems = Vec::new();
@@ -480,13 +490,15 @@ pub fn post_process_with(
         (Shape::Coriolis, Some(z)) => dead_channels(cfg, &lanes[z]),
         _ => Vec::new(),
     };
-    let mut listed = out.iter_mut();
+    let mut listed = out.iter_mut().zip(&wound_at);
     for (i, &rate) in rates.iter().enumerate() {
         health.add(&lanes[i].health);
         if !cfg.experiment.rates_dps.contains(&rate) {
             continue;
         }
-        let Some(r) = listed.next() else { break };
+        let Some((r, wound)) = listed.next() else {
+            break;
+        };
         let mut dead = dead_channels(cfg, &lanes[i]);
         dead.extend(
             reference_dead
@@ -504,6 +516,13 @@ pub fn post_process_with(
             }
         }
         for k in 0..2 {
+            if !refused[k] && wound[k] {
+                refused[k] = true;
+                problems.push(format!(
+                    "point {rate} deg/s, mode {}: no phase: the mode's velocity envelope went around zero within a table period (its phase turns a whole turn per period and has no lag or amplitude to read); lower the rate-table amplitude, raise the mode's drive, or bring the mode nearer the carrier",
+                    k + 1
+                ));
+            }
             if !refused[k] && !r.phase_deg[k].is_finite() {
                 refused[k] = true;
                 problems.push(format!(
