@@ -4,7 +4,7 @@
 //! a few ulp per sample, so the output stays within ~1e-14 of the NCO's and never drifts.
 
 use crate::nco::step_of;
-use crate::trig::phasor_of_word;
+use crate::trig::{phasor_of_word, phasors_in_lanes, table};
 use crate::Nco;
 use gyroemu_core::{ParamError, ParamResult, Sample, Stage};
 
@@ -101,9 +101,7 @@ impl<S: Sample> RotatingNco<S> {
     #[cold]
     #[inline(never)]
     fn resync(&mut self) {
-        let p = self.phasors(self.phase);
-        self.re = S::from_fn(|i| p[i].re);
-        self.im = S::from_fn(|i| p[i].im);
+        (self.re, self.im) = phasors_in_lanes(table(), &self.phase);
         for i in 0..S::LANES {
             self.phase[i] = self.phase[i].wrapping_add(self.step[i].wrapping_mul(RESYNC as u64));
         }
