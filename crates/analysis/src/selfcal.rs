@@ -6,9 +6,9 @@
 use crate::selfcal_combined::{combined_selfcal, CombinedSelfcal};
 pub use crate::slope_fit::{linearised_slope, SlopeFit};
 use gyroemu_config::{Config, ConfigError, ExperimentKind, PllConfig, RateTable};
-use gyroemu_experiment::fit::t95;
+use gyroemu_experiment::fit::{fit_line, t95};
 use gyroemu_experiment::{
-    finish_sweep, run_sweep_with, Progress, SweepError, SweepOptions, SweepResult,
+    finish_sweep, fit_readings, run_sweep_with, Progress, SweepError, SweepOptions, SweepResult,
 };
 use serde::Serialize;
 
@@ -54,8 +54,13 @@ pub fn mode_selfcal(cfg: &Config, rot: &SweepResult, cor: &SweepResult, k: usize
         .collect();
     let cor_rates = rates_of(cor);
     let cor_phase: Vec<f64> = cor.points.iter().map(|p| p.phase_deg[k]).collect();
-    let rotating = linearised_slope(&rates, &rot_phase);
-    let rotating_paper_i = linearised_slope(&rates, &paper);
+    let mut rotating = linearised_slope(&rates, &rot_phase);
+    let mut rotating_paper_i = linearised_slope(&rates, &paper);
+    // The plain line's R² on the readings' own branch, as a sweep's summary fits them.
+    let rot_cfg = sweep_configs(cfg).0;
+    let on_branch = |ys: &[f64]| fit_line(&rates, &fit_readings(&rot_cfg, &rates, ys, k));
+    rotating.plain_fit = on_branch(&rot_phase);
+    rotating_paper_i.plain_fit = on_branch(&paper);
     let coriolis = linearised_slope(&cor_rates, &cor_phase);
     let theory = |r: &SweepResult| {
         let ph: Vec<f64> = r.points.iter().map(|p| p.theory_deg[k]).collect();

@@ -181,6 +181,21 @@ fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
         f0_tc_ppm_per_k: -30.0,
         q_tc_ppm_per_k: -3000.0,
     });
+    // A table swing that takes a mode's envelope around zero has no phase to read (refused),
+    // so such a draw is no valid config: its amplitudes are halved until none does.
+    if let Some(ft) = c.experiment.table_freq_hz {
+        let winds = |c: &Config| {
+            c.experiment.rates_dps.iter().any(|r| {
+                let (amp, _) = c
+                    .driven_device()
+                    .rate_table_response(r.abs().to_radians(), ft);
+                amp.iter().any(|a| a.is_nan())
+            })
+        };
+        while winds(&c) {
+            c.experiment.rates_dps.iter_mut().for_each(|r| *r *= 0.5);
+        }
+    }
     raise(&mut c);
     c
 }

@@ -28,8 +28,11 @@ pub fn fit_line(x: &[f64], y: &[f64]) -> LineFit {
     let intercept = my - slope * mx;
     // At most 1 by Cauchy-Schwarz (sxy^2 <= sxx syy); its rounding can pass 1 by an ulp on
     // a near-exact line, a value no results file should hold. NaN (a refused phase, or one
-    // x) stays NaN: `f64::min` would make it a perfect fit.
-    let r2 = if syy == 0.0 {
+    // x) stays NaN: `f64::min` would make it a perfect fit. Without a line (one rate, or a
+    // NaN among the readings) there is no fit to score: it had read 1 beside a null slope.
+    let r2 = if !slope.is_finite() {
+        f64::NAN
+    } else if syy == 0.0 {
         1.0
     } else {
         let r2 = sxy * sxy / (sxx * syy);
@@ -70,6 +73,87 @@ pub fn t95(dof: usize) -> f64 {
         d if d <= 30 => T[d - 1],
         _ => 1.96,
     }
+}
+
+/// `ys` (degrees, at `xs`), each moved by whole `period`s to within half a period of where
+/// the reading at the next smaller x plus the theory's continuous change between the two
+/// puts it, for the line fit. The change is the theory followed along x in steps it moves by
+/// under an eighth of a period (at least 32 of them), so a genuine step of more than a
+/// quarter turn between two rates stays: [`unwrapped_along`] alone moved psi's -53.1 ->
+/// +53.1 deg between -100 and 100 deg/s (Q = 36000) down a half turn, and the summary's
+/// slope read -0.19 for +0.42. Where the theory is not finite along the way, as
+/// [`unwrapped_along`].
+pub fn unwrapped_along_theory(
+    xs: &[f64],
+    ys: &[f64],
+    period: f64,
+    theory: &dyn Fn(f64) -> f64,
+) -> Vec<f64> {
+    let mut order: Vec<usize> = (0..xs.len().min(ys.len())).collect();
+    order.sort_by(|&a, &b| xs[a].total_cmp(&xs[b]));
+    let mut out = ys.to_vec();
+    let mut prev: Option<(f64, f64)> = None;
+    for i in order {
+        let y = ys[i];
+        if !y.is_finite() {
+            continue;
+        }
+        let moved = match prev {
+            Some((px, py)) => {
+                let step = theory_change(theory, px, xs[i], period).unwrap_or(0.0);
+                let k = ((py + step - y) / period).round();
+                if k == 0.0 {
+                    y
+                } else {
+                    y + k * period
+                }
+            }
+            None => y,
+        };
+        out[i] = moved;
+        prev = Some((xs[i], moved));
+    }
+    out
+}
+
+/// The continuous change of `theory` from `x0` to `x1` (a function known modulo `period`):
+/// the sum of its wrapped steps over a path fine enough that each is under an eighth of a
+/// period. `None` where it is not finite on the way.
+fn theory_change(theory: &dyn Fn(f64) -> f64, x0: f64, x1: f64, period: f64) -> Option<f64> {
+    fn walk(
+        theory: &dyn Fn(f64) -> f64,
+        (x0, t0): (f64, f64),
+        (x1, t1): (f64, f64),
+        period: f64,
+        depth: u32,
+    ) -> Option<f64> {
+        let d = (t1 - t0) - period * ((t1 - t0) / period).round();
+        if d.abs() <= period / 8.0 || depth == 0 {
+            return d.is_finite().then_some(d);
+        }
+        let xm = 0.5 * (x0 + x1);
+        let tm = theory(xm);
+        if !tm.is_finite() {
+            return None;
+        }
+        Some(
+            walk(theory, (x0, t0), (xm, tm), period, depth - 1)?
+                + walk(theory, (xm, tm), (x1, t1), period, depth - 1)?,
+        )
+    }
+    const PIECES: usize = 32;
+    let at = |j: usize| x0 + (x1 - x0) * j as f64 / PIECES as f64;
+    let mut t_prev = theory(x0);
+    let mut sum = 0.0;
+    for j in 1..=PIECES {
+        let t = theory(at(j));
+        if !t_prev.is_finite() || !t.is_finite() {
+            return None;
+        }
+        sum += walk(theory, (at(j - 1), t_prev), (at(j), t), period, 24)?;
+        t_prev = t;
+    }
+    Some(sum)
 }
 
 /// `ys` (degrees, at `xs`), each moved by whole `period`s to within half a period of the
@@ -137,6 +221,44 @@ mod tests {
         assert_eq!((v[2], v[3]), (3.5, -2.25));
     }
 
+    /// Unwrapping by the theory keeps a genuine step of more than a quarter turn between two
+    /// rates (plain unwrapping moves it a half turn), restores a reading folded across the
+    /// branch cut, and follows a theory that turns by more than a period between two rates.
+    #[test]
+    fn unwrapping_by_the_theory_keeps_steep_steps_and_restores_folds() {
+        let fold = |y: f64| y - 180.0 * ((y - 1e-9) / 180.0).round();
+        // psi = atan(x / 20): -83.5, -78.7, 78.7, 83.5 deg at +-100, +-250; the middle step
+        // is 157 deg.
+        let psi = |x: f64| (x / 20.0).atan().to_degrees();
+        let xs = [-250.0, -100.0, 100.0, 250.0];
+        let ys: Vec<f64> = xs.iter().map(|&x| psi(x)).collect();
+        assert_eq!(unwrapped_along_theory(&xs, &ys, 180.0, &psi), ys);
+        assert_ne!(unwrapped_along(&xs, &ys, 180.0), ys);
+        // A line of slope 0.5 from 60 deg crosses 90 deg: folded readings come back.
+        let line = |x: f64| 60.0 + 0.5 * x;
+        let xs: Vec<f64> = (0..6).map(|i| 20.0 * i as f64).collect();
+        let folded: Vec<f64> = xs.iter().map(|&x| fold(line(x))).collect();
+        let u = unwrapped_along_theory(&xs, &folded, 180.0, &line);
+        for (x, y) in xs.iter().zip(&u) {
+            assert!((y - line(*x)).abs() < 1e-12, "{x}: {y}");
+        }
+        // 200 tanh(x): 385 deg from -2 to 2, more than two periods, in one step.
+        let steep = |x: f64| 200.0 * x.tanh();
+        let xs = [-2.0, 2.0];
+        let folded: Vec<f64> = xs.iter().map(|&x| fold(steep(x))).collect();
+        let u = unwrapped_along_theory(&xs, &folded, 180.0, &steep);
+        assert!(
+            (u[1] - u[0] - (steep(2.0) - steep(-2.0))).abs() < 1e-9,
+            "{u:?}"
+        );
+        // No theory on the way: as the plain unwrapping.
+        let nan = |_: f64| f64::NAN;
+        assert_eq!(
+            unwrapped_along_theory(&xs, &folded, 180.0, &nan),
+            unwrapped_along(&xs, &folded, 180.0)
+        );
+    }
+
     #[test]
     fn recovers_an_exact_line_and_scores_noise() {
         let x: Vec<f64> = (0..8).map(|k| 25.0 * k as f64).collect();
@@ -150,6 +272,19 @@ mod tests {
             .map(|(i, v)| v + if i % 2 == 0 { 0.5 } else { -0.5 })
             .collect();
         assert!(fit_line(&x, &y2).r2 < 0.999);
+    }
+
+    #[test]
+    fn one_rate_has_no_line_and_no_r2() {
+        let f = fit_line(&[100.0], &[3.0]);
+        assert!(
+            f.slope.is_nan() && f.intercept.is_nan() && f.r2.is_nan(),
+            "{f:?}"
+        );
+        let f = fit_line(&[100.0, 100.0], &[3.0, 3.0]);
+        assert!(f.slope.is_nan() && f.r2.is_nan(), "{f:?}");
+        // A flat line through two rates is a perfect fit.
+        assert_eq!(fit_line(&[1.0, 2.0], &[3.0, 3.0]).r2, 1.0);
     }
 
     #[test]

@@ -24,8 +24,8 @@ pub use lock::{lock_config_carrier, pll_params, resolve_lock, CarrierLock};
 pub use prepared::{run_sweep, run_sweep_with};
 pub use progress::{Progress, Quiet, Reporter, Task, Written};
 pub use readout::{
-    post_process, post_process_with, reading_period_deg, theory_deg, Compensation, PointResult,
-    SweepResult,
+    fit_readings, post_process, post_process_with, reading_period_deg, theory_deg, Compensation,
+    PointResult, SweepResult,
 };
 pub use sweep::{
     dump_point, finish_sweep, finish_sweep_with, OnDump, OnGroup, SweepError, SweepOptions,

@@ -2,7 +2,7 @@
 //! compensated from the board's own stage responses, the exact theory beside every point, and
 //! the paper's best linear fit.
 
-use crate::fit::{fit_line, unwrapped_along, LineFit};
+use crate::fit::{fit_line, unwrapped_along, unwrapped_along_theory, LineFit};
 use crate::leaks::Stage2Leaks;
 use gyroemu_board::{
     unleak_sidebands, unleak_table_harmonics, ChainResponse, Health, LaneResult, Point, Shape,
@@ -235,6 +235,18 @@ pub fn reading_period_deg(shape: Shape) -> f64 {
         180.0
     } else {
         360.0
+    }
+}
+
+/// Mode `k`'s readings `ys` at rates `xs` as the sweep's line is fitted to them: unwrapped
+/// along rate by the exact theory's continuous change ([`unwrapped_along_theory`]; a rate
+/// table's amplitudes, whose theory is a harmonic balance per rate, along the readings alone).
+pub fn fit_readings(cfg: &Config, xs: &[f64], ys: &[f64], k: usize) -> Vec<f64> {
+    let shape = cfg.shape();
+    let period = reading_period_deg(shape);
+    match shape {
+        Shape::RateTable { .. } => unwrapped_along(xs, ys, period),
+        _ => unwrapped_along_theory(xs, ys, period, &|x| theory_deg(cfg, x)[k]),
     }
 }
 
@@ -556,10 +568,9 @@ pub fn post_process_with(
         .collect();
     let warnings = clipping_warnings(&health, &per_point, matches!(shape, Shape::Coriolis));
     let xs: Vec<f64> = out.iter().map(|p| p.rate_dps).collect();
-    let period = reading_period_deg(shape);
     let fit = [0, 1].map(|k| {
         let ys: Vec<f64> = out.iter().map(|p| p.phase_deg[k]).collect();
-        fit_line(&xs, &unwrapped_along(&xs, &ys, period))
+        fit_line(&xs, &fit_readings(cfg, &xs, &ys, k))
     });
     let slope = small_rate_slope(cfg);
     Ok(SweepResult {

@@ -4,8 +4,8 @@
 use crate::error::{create_dir, ReportError};
 use gyroemu_board::{Health, Shape};
 use gyroemu_config::Config;
-use gyroemu_experiment::fit::{unwrapped_along, LineFit};
-use gyroemu_experiment::{reading_period_deg, theory_deg, SweepResult};
+use gyroemu_experiment::fit::LineFit;
+use gyroemu_experiment::{fit_readings, reading_period_deg, theory_deg, SweepResult};
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
 use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
 use serde_json::json;
@@ -344,7 +344,7 @@ pub fn sweep_figure(cfg: &Config, r: &SweepResult, title: &str) -> Figure {
     // across its branch cut), the points sit a half turn off it, and the legend says why.
     let ys = phases(r, 0);
     let period = reading_period_deg(r.shape);
-    let moved = unwrapped_along(&xs, &ys, period)
+    let moved = fit_readings(cfg, &xs, &ys, 0)
         .iter()
         .zip(&ys)
         .any(|(u, y)| u.to_bits() != y.to_bits() && !y.is_nan());
