@@ -38,6 +38,10 @@ pub const NODE_RANGE: (f64, f64) = (1e-100, 1e100);
 /// refused.
 pub const MAX_HOLD_ERROR_MDEG: f64 = 1000.0;
 
+/// Below this `1 - |W(2 Omega)|^2` a rotating window cannot part its two sidebands: refused
+/// (a rounding of the window's sums, 1e-16, is then amplified past 1e-10).
+pub const MIN_SIDEBAND_DET: f64 = 1e-6;
+
 /// Above this hold error (mdeg) it is stated in a warning.
 pub const WARN_HOLD_ERROR_MDEG: f64 = 0.01;
 
@@ -96,6 +100,7 @@ impl Config {
             p.push(e);
             return;
         }
+        self.validate_sideband_solve(p, warnings);
         let largest = (0..2)
             .flat_map(|k| node_amplitudes(self, k))
             .fold(0.0, f64::max);
@@ -167,6 +172,54 @@ impl Config {
             }
         }
         Ok(())
+    }
+
+    /// A rotating point reads its two sidebands f_c +- Omega from the window's averages of the
+    /// stage-2 outputs, removing what the window keeps of the 2 Omega term, `W = W(2 Omega)`:
+    /// the solve divides by `1 - |W|^2`. A window of one output sample keeps all of it
+    /// (a Hann window of one sample was accepted and read NaN, "overflowed"): refused below
+    /// [`MIN_SIDEBAND_DET`]. Between that and 0.1 the solve multiplies every other error of
+    /// the reading (noise, converters, the hold) by up to `1 / (1 - |W|^2)`: warned.
+    fn validate_sideband_solve(&self, p: &mut Rules, warnings: &mut Vec<String>) {
+        if !matches!(self.shape(), Shape::Rotating) {
+            return;
+        }
+        let fs_out = self.fs_out_hz();
+        let mut worst: Option<(f64, f64, f64)> = None;
+        for &rate in self.experiment.rates_dps.iter().filter(|r| **r != 0.0) {
+            let window = self.plan_point(rate).window;
+            let fm = rate.abs() / 360.0;
+            let det = 1.0 - window.response(2.0 * fm / fs_out).norm_sqr();
+            if worst.is_none_or(|(d, _, _)| det < d) {
+                worst = Some((det, rate, window.span()));
+            }
+        }
+        let Some((det, rate, n)) = worst else {
+            return;
+        };
+        let window = match self.experiment.window {
+            crate::WindowKind::Hann => "Hann",
+            crate::WindowKind::Boxcar => "boxcar",
+        };
+        let what = format!(
+            "at {rate} deg/s the {window} window of {n} output samples keeps {:.6} of the stage-2 product at 2 Omega, and the read-out parts the sidebands f_c +- Omega by dividing by 1 - |W(2 Omega)|^2 = {det:.3e}",
+            (1.0 - det).max(0.0).sqrt()
+        );
+        if det < MIN_SIDEBAND_DET {
+            p.push(ConfigError::key(
+                "experiment.average_s",
+                self.experiment.average_s,
+                format!(
+                    "{what}: the two sidebands cannot be told apart; average over more output samples (a longer average_s, or a smaller board.decimation)"
+                ),
+            ));
+        } else if det < 0.1 {
+            warnings.push(format!(
+                "experiment.average_s = {}: {what}, which multiplies every other error of the reading (noise, converters, the DAC hold) by up to {:.3e}; the figures other warnings state do not include it; average over more output samples",
+                self.experiment.average_s,
+                1.0 / det
+            ));
+        }
     }
 
     /// A rate table's plant step expands the step matrix to second order in the rate about
@@ -338,7 +391,8 @@ impl Config {
                     drive_key,
                     a[0],
                     format!(
-                        "is below half an LSB of the DAC ({step:e} = board.dac_full_scale / 2^(board.dac_bits - 1)): every drive sample would be 0; raise it or board.dac_bits, or lower board.dac_full_scale"
+                        "is below half an LSB of the DAC ({:e}; one LSB is {step:e} = board.dac_full_scale / 2^(board.dac_bits - 1)): every drive sample would be 0; raise it or board.dac_bits, or lower board.dac_full_scale",
+                        0.5 * step
                     ),
                 );
                 if a[0] > b.dac_full_scale - 0.5 * step {

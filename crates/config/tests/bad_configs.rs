@@ -625,7 +625,9 @@ fn cases() -> Vec<Case> {
             &[
                 "drive.f1",
                 "0.001",
-                "half an LSB of the DAC",
+                // Half of 1.0 / 2^7, the full scale over half the codes (it had printed the
+                // whole LSB as half of one).
+                "half an LSB of the DAC (3.90625e-3;",
                 "board.dac_bits",
             ],
         ),

@@ -1,0 +1,66 @@
+//! A rotating window too short to part the two sidebands f_c +- Omega: refused before any
+//! sample where the emulated read-out has no phase (a Hann window of one output sample was
+//! accepted, then read NaN blaming an overflow), and warned, with the factor the sideband
+//! solve multiplies other errors by, where it is merely ill-conditioned.
+
+use gyroemu_config::{presets::preset, Config, WindowKind};
+use gyroemu_experiment::{finish_sweep, run_sweep_with, SweepOptions};
+
+/// The rotating preset read at 1 output sample per second behind a 0.49 Hz low-pass, a
+/// Hann window of `average_s`, at 175 deg/s (Omega / 2 pi = 0.486 Hz).
+fn slow(average_s: f64) -> Config {
+    let mut c = preset("m2tfg-rotating").unwrap();
+    c.board.lpf_cutoff_hz = Some(0.49);
+    c.board.decimation = Some(240_000);
+    c.experiment.window = WindowKind::Hann;
+    c.experiment.average_s = average_s;
+    c.experiment.rates_dps = vec![175.0];
+    c
+}
+
+#[test]
+fn a_one_sample_hann_window_is_refused_where_the_emulation_reads_nothing() {
+    let cfg = slow(1.03);
+    let err = cfg.validate().unwrap_err().to_string();
+    assert!(
+        err.contains("experiment.average_s") && err.contains("cannot be told apart"),
+        "{err}"
+    );
+    // Past the rule, the emulation has no phase to give for either mode.
+    let run = run_sweep_with(&cfg, &|_, _| {}, None, SweepOptions::default()).unwrap();
+    let res = finish_sweep(&cfg, &run.lanes).unwrap();
+    assert!(
+        res.points[0].phase_deg.iter().all(|p| p.is_nan()),
+        "{:?}",
+        res.points[0]
+    );
+}
+
+#[test]
+fn a_two_sample_hann_window_is_warned_with_the_solves_gain() {
+    // Two output samples of equal weight (sin^2 of pi/4 and 3 pi/4): the window keeps
+    // (1 + e^{-j 2 pi x}) / 2 of the 2 Omega term, x = 2 Omega / (2 pi fs_out) cycles per
+    // sample, so the solve's gain is 1 / (1 - cos^2(pi x)), written from the weights.
+    let cfg = slow(2.0);
+    let warnings = cfg.validate().unwrap();
+    let x = 2.0 * 175.0 / 360.0 / cfg.fs_out_hz();
+    let (re, im) = (
+        0.5 * (1.0 + (std::f64::consts::TAU * x).cos()),
+        -0.5 * (std::f64::consts::TAU * x).sin(),
+    );
+    let gain = 1.0 / (1.0 - (re * re + im * im));
+    assert!(gain > 10.0, "{gain}");
+    let w: Vec<_> = warnings.iter().filter(|w| w.contains("2 Omega")).collect();
+    assert_eq!(w.len(), 1, "{warnings:?}");
+    assert!(
+        w[0].contains(&format!("by up to {gain:.3e}")),
+        "{} (gain {gain:.3e})",
+        w[0]
+    );
+    // Long enough, nothing is said.
+    assert!(!slow(20.0)
+        .validate()
+        .unwrap()
+        .iter()
+        .any(|w| w.contains("2 Omega")));
+}
