@@ -138,6 +138,7 @@ impl Config {
         }
         self.validate_dac_rounding(warnings, locked);
         self.validate_mixer_product(warnings);
+        self.validate_lowpass_rounding(warnings);
         self.validate_table_harmonics(warnings);
         self.validate_table_step(warnings);
         self.validate_hold(p, warnings);
@@ -240,6 +241,32 @@ impl Config {
                 "experiment.average_s = {}: {what}, which multiplies every other error of the reading (noise, converters, the DAC hold) by up to {:.3e}; the figures other warnings state do not include it; average over more output samples",
                 self.experiment.average_s,
                 1.0 / det
+            ));
+        }
+    }
+
+    /// A low-pass whose cutoff is a tiny fraction of the sample rate: each direct-form section
+    /// holds its states near `1 / A(1)` times its input (`A(1)` about `(2 pi fc/fs)^2`), so
+    /// the rounding of every sample is that much larger than the signal's own resolution, and
+    /// it falls unevenly on I and Q. A Coriolis phase moved by 1.7 mdeg at fc/fs = 1.7e-7 and
+    /// by 77.5 mdeg at 2e-8 with no warning (neither settling nor averaging removes it). The
+    /// bound stated, `eps * sum_k 1/|A_k(1)|` in rad, is the rounding's reach; runs read 8 to
+    /// 41 times less. A rotating run reads psi from the sidebands' ratio in each channel and
+    /// measured far less (0.004 mdeg where the bound is 22), so it is not warned.
+    fn validate_lowpass_rounding(&self, warnings: &mut Vec<String>) {
+        if matches!(self.shape(), Shape::Rotating) {
+            return;
+        }
+        let Ok(lp) = gyroemu_lpf::LowPass::<f64>::new(self.lowpass_design(), self.fs_hz()) else {
+            return;
+        };
+        let reach_mdeg = (f64::EPSILON * lp.rounding_gain()).min(1.0).asin() / DEG * 1e3;
+        if reach_mdeg > WARN_HOLD_ERROR_MDEG {
+            warnings.push(format!(
+                "board.lpf_cutoff_hz = {} is {:.2e} of board.fs_hz: the low-pass's direct-form sections hold their states about {:.1e} times their input, so each sample's rounding is that much coarser than the signal and falls unevenly on I and Q; the measured phase can move by up to about {reach_mdeg:.3e} mdeg (the rounding's reach; runs have read 8 to 41 times less, and neither settling nor averaging removes it); raise lpf_cutoff_hz or lower fs_hz",
+                self.lpf_cutoff_hz(),
+                self.lpf_cutoff_hz() / self.fs_hz(),
+                lp.rounding_gain() / lp.sections() as f64
             ));
         }
     }

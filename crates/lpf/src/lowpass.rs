@@ -53,6 +53,18 @@ impl<S: Sample> LowPass<S> {
     pub fn fs_hz(&self) -> f64 {
         self.fs_hz
     }
+
+    /// `sum_k 1 / |A_k(1)|` over the sections: how much a rounding in a section's recursion,
+    /// relative to the signal's level, is multiplied at DC on its way out (a narrow section's
+    /// states sit near `1 / A(1)` times its input, and each sample rounds them). Times
+    /// `f64::EPSILON` it is the order of the relative error the filter's own arithmetic can
+    /// leave at DC, channel by channel: about `eps / (2 pi fc/fs)^2` per biquad.
+    pub fn rounding_gain(&self) -> f64 {
+        self.coefs[..self.sections()]
+            .iter()
+            .map(|c| 1.0 / c.a_sum().abs())
+            .sum()
+    }
 }
 
 impl<S: Sample> Stage for LowPass<S> {
@@ -86,5 +98,48 @@ impl<S: Sample> Response for LowPass<S> {
         self.coefs[..self.sections()]
             .iter()
             .fold(Complex64::new(1.0, 0.0), |h, c| h * c.response(u))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rounding gain of one Butterworth biquad is `1 / A(1)` of the bilinear design,
+    /// `(1 + sin w / sqrt 2) / (2 (1 - cos w))`, `w = 2 pi fc/fs`, written from the analogue
+    /// prototype (to the coefficients' own rounding, `eps / A(1)` relative); the third order's
+    /// pair (Q = 1) `(1 + sin w / 2) / (2 (1 - cos w))` and its first-order section
+    /// `(1 + tan(w/2)) / (2 tan(w/2))` add.
+    #[test]
+    fn rounding_gain_is_the_bilinear_designs_inverse_dc_denominator() {
+        let fs = 240_000.0;
+        for r in [1e-2, 1e-3, 1e-5, 1e-6] {
+            let w = core::f64::consts::TAU * r;
+            let biquad = (1.0 + w.sin() / core::f64::consts::SQRT_2) / (2.0 * (1.0 - w.cos()));
+            let tol = 1e-9 + 10.0 * f64::EPSILON * biquad;
+            let lp = |order| {
+                LowPass::<f64>::new(
+                    LowPassDesign::Butterworth {
+                        order,
+                        cutoff_hz: r * fs,
+                    },
+                    fs,
+                )
+                .unwrap()
+                .rounding_gain()
+            };
+            let g2 = lp(2);
+            assert!(
+                (g2 / biquad - 1.0).abs() < tol,
+                "fc/fs {r}: {g2} against {biquad}"
+            );
+            let k = (0.5 * w).tan();
+            let third = (1.0 + 0.5 * w.sin()) / (2.0 * (1.0 - w.cos())) + (1.0 + k) / (2.0 * k);
+            let g3 = lp(3);
+            assert!(
+                (g3 / third - 1.0).abs() < tol,
+                "fc/fs {r}: {g3} against {third}"
+            );
+        }
     }
 }
