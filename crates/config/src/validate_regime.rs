@@ -533,6 +533,7 @@ impl Config {
         let leak = chain.lowpass(2.0 * fc).norm();
         let alias = 2.0 * fc - fs_out * (2.0 * fc / fs_out).round();
         let (mut worst, mut at): (f64, f64) = (0.0, 0.0);
+        let mut worst_lag: (f64, f64) = (0.0, 0.0);
         for rate in self.emulated_rates_dps() {
             let window = self.plan_point(rate).window;
             let refs: Vec<f64> = match self.shape() {
@@ -550,8 +551,28 @@ impl Config {
                     let (e, f) = mixer_product_bound_rad(&chain, fc, fs_out, &window, &refs);
                     (2.0 * e, f)
                 }
-                Shape::RateTable { .. } => {
-                    mixer_product_bound_rad(&chain, fc, fs_out, &window, &refs)
+                Shape::RateTable { freq_hz } => {
+                    // The phase's fundamental is j (Z_1 - conj Z_-1) / Z_0 to first order in the
+                    // swing: the errors of the two harmonics add (12.7 mdeg read, 6.6 stated).
+                    let (e, f) = mixer_product_bound_rad(&chain, fc, fs_out, &window, &refs);
+                    let e = 2.0 * e;
+                    // The lag is the fundamental's angle: an error e against an amplitude A
+                    // turns it by up to asin(e / A) (453 mdeg at 300 deg/s where the phase
+                    // bound stated 6.6).
+                    let (amp, _) = self
+                        .driven_device()
+                        .rate_table_response(rate.abs() * DEG, freq_hz);
+                    for a in amp.into_iter().filter(|a| a.is_finite()) {
+                        let l = if e < a.abs() {
+                            (e / a.abs()).asin()
+                        } else {
+                            core::f64::consts::PI
+                        };
+                        if l > worst_lag.0 {
+                            worst_lag = (l, rate);
+                        }
+                    }
+                    (e, f)
                 }
             };
             if e > worst {
@@ -569,10 +590,32 @@ impl Config {
                     "raise board.fs_hz: at {fs} Hz the product itself aliases to {at_fs:.6e} Hz, within twice the low-pass cutoff, whatever the decimation"
                 )
             } else {
-                "choose a decimation whose output rate does not divide 2 f_c (remove the key for the derived one), or raise board.lpf_order".to_string()
+                // Removing the key helps only where the derived decimation is another one.
+                let derived = {
+                    let mut c = self.clone();
+                    c.board.decimation = None;
+                    c.decimation()
+                };
+                format!(
+                    "choose a decimation whose output rate does not divide 2 f_c{}, or raise board.lpf_order",
+                    if derived == self.decimation() {
+                        String::new()
+                    } else {
+                        format!(" (or remove the key for the derived one, {derived})")
+                    }
+                )
+            };
+            let lag = if worst_lag.0 > 0.0 {
+                format!(
+                    ", and the table lag by up to {:.3e} mdeg (that bound over the phase's amplitude at {} deg/s)",
+                    worst_lag.0.to_degrees() * 1e3,
+                    worst_lag.1
+                )
+            } else {
+                String::new()
             };
             warnings.push(format!(
-                "board.decimation = {}: the stage-1 mixer's 2 f_c product ({} Hz), {:.1e} of it left by the low-pass, aliases to {:.6e} Hz at the output rate {fs_out} Hz, too close to the {at} Hz the read-out demodulates for its averaging to remove it: it can move the measured phase by up to {worst_mdeg:.3e} mdeg{}; {advice}",
+                "board.decimation = {}: the stage-1 mixer's 2 f_c product ({} Hz), {:.1e} of it left by the low-pass, aliases to {:.6e} Hz at the output rate {fs_out} Hz, too close to the {at} Hz the read-out demodulates for its averaging to remove it: it can move the measured phase by up to {worst_mdeg:.3e} mdeg{}{lag}; {advice}",
                 self.decimation(),
                 2.0 * fc,
                 leak,
