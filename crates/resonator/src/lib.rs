@@ -17,12 +17,14 @@ mod hold;
 mod params;
 mod plant;
 mod steady;
+mod table_held;
 mod thermal;
 
 pub use hold::hold_response;
 pub use params::{ModeParams, ResonatorParams};
 pub use plant::{PlantOutput, Resonator};
 pub use steady::{continuous_steady_state, rate_table_steady_state};
+pub use table_held::held_table_steady_state;
 pub use thermal::{thermomechanical_accel_psd, thermomechanical_force_psd};
 
 /// Stage name used in every [`gyroemu_core::ParamError`] of this crate.

@@ -255,7 +255,6 @@ impl Resonator<f64> {
     }
 
     /// The three expansion blocks `[E0, E1, E2]` (4x6 each, physical units).
-    #[cfg(test)]
     pub(crate) fn expansion(&self) -> [Block; 3] {
         [self.e0, self.e1, self.e2]
     }

@@ -6,7 +6,8 @@ use crate::closed_form::{coriolis_theta_rad, rotating_psi_rad};
 use gyroemu_core::Complex64;
 use gyroemu_mixer::phase_fundamental;
 use gyroemu_resonator::{
-    continuous_steady_state, rate_table_steady_state, Resonator, ResonatorParams,
+    continuous_steady_state, held_table_steady_state, rate_table_steady_state, Resonator,
+    ResonatorParams,
 };
 
 const DEG: f64 = core::f64::consts::PI / 180.0;
@@ -199,25 +200,67 @@ impl DrivenDevice {
         (0..=max).find(|&m| (m + 1..=n).all(|k| beyond(k) <= rel * peak))
     }
 
+    /// What a noiseless board with ideal converters reads on the rate table `amplitude sin(2 pi
+    /// table_hz t)` (rad/s): [`DrivenDevice::rate_table_response`] of the periodic steady state
+    /// of its own recursion (the drive held over each sample at `self.plant.fs_hz`, the step
+    /// expanded to second order in the rate: [`held_table_steady_state`]) instead of the
+    /// continuous plant's. NaN if the plant cannot be built or the envelope winds.
+    pub fn held_rate_table_response(
+        &self,
+        amplitude_rad_s: f64,
+        table_hz: f64,
+    ) -> ([f64; 2], [f64; 2]) {
+        let nan = ([f64::NAN; 2], [f64::NAN; 2]);
+        let Ok(plant) = Resonator::<f64>::new(&self.plant, 0.0) else {
+            return nan;
+        };
+        let env = |n: usize| {
+            let x = held_table_steady_state(
+                &plant,
+                amplitude_rad_s,
+                table_hz,
+                self.carrier_hz,
+                self.coriolis_force(),
+                n,
+            );
+            [0, 1].map(|k| x.iter().map(|xn| xn[2 + k]).collect::<Vec<_>>())
+        };
+        fundamental_of(env, 24, 48)
+    }
+
     /// The exact phase response of each mode to the rate table `amplitude sin(2 pi table_hz
     /// t)` (rad/s) with the drive at the carrier: the fundamental of the phase lag of the velocity's
     /// periodic steady state (harmonic balance, at any swing), as `(amplitude rad, lag rad)`
     /// per mode, a lag `a sin(w_t t - l)` read as `(a, l)`. NaN when the envelope passes
     /// through 0 (no continuous phase).
     pub fn rate_table_response(&self, amplitude_rad_s: f64, table_hz: f64) -> ([f64; 2], [f64; 2]) {
-        // Enough harmonics that the rest is below f64's resolution of the envelope: 24 for
-        // swings up to tens of degrees, 48 beyond.
-        let mut env = self.rate_table_envelopes(amplitude_rad_s, table_hz, 24);
-        let peak = env.iter().flatten().map(|v| v.norm()).fold(0.0, f64::max);
-        if env
-            .iter()
-            .any(|h| h[2].norm().max(h[46].norm()) > 1e-17 * peak)
-        {
-            env = self.rate_table_envelopes(amplitude_rad_s, table_hz, 48);
-        }
-        let x = env.map(|h| phase_fundamental(&h));
-        let amp = x.map(|x| x.norm());
-        let lag = x.map(|x| -(x * Complex64::new(0.0, 1.0)).arg());
-        (amp, lag)
+        fundamental_of(
+            |n| self.rate_table_envelopes(amplitude_rad_s, table_hz, n),
+            24,
+            48,
+        )
     }
+}
+
+/// Each mode's phase fundamental `(amplitude rad, lag rad)` of the envelopes `env(n)`
+/// (harmonics `-n ..= n`): with `few` harmonics, or `many` where the outermost two of `few`
+/// still hold more than f64's resolution of the envelope (24 for swings up to tens of
+/// degrees, 48 beyond).
+fn fundamental_of(
+    env: impl Fn(usize) -> [Vec<Complex64>; 2],
+    few: usize,
+    many: usize,
+) -> ([f64; 2], [f64; 2]) {
+    let mut e = env(few);
+    let peak = e.iter().flatten().map(|v| v.norm()).fold(0.0, f64::max);
+    let last = 2 * few;
+    if e.iter()
+        .any(|h| h[2].norm().max(h[last - 2].norm()) > 1e-17 * peak)
+    {
+        e = env(many);
+    }
+    let x = e.map(|h| phase_fundamental(&h));
+    let amp = x.map(|x| x.norm());
+    let lag = x.map(|x| -(x * Complex64::new(0.0, 1.0)).arg());
+    (amp, lag)
 }
