@@ -118,7 +118,6 @@ impl Config {
         self.validate_mixer_product(warnings);
         self.validate_lowpass_rounding(warnings);
         self.validate_table_harmonics(warnings);
-        self.validate_table_step(warnings);
         self.validate_hold(p, warnings);
     }
 
@@ -245,25 +244,6 @@ impl Config {
                 self.lpf_cutoff_hz(),
                 self.lpf_cutoff_hz() / self.fs_hz(),
                 lp.rounding_gain() / lp.sections() as f64
-            ));
-        }
-    }
-
-    /// A rate table's plant step expands the step matrix to second order in the rate about
-    /// rest, so each step is off by about its first term left out, (2 lambda Omega Ts)^3 / 6
-    /// of the state, and the resonator sums about tau / Ts such steps before it forgets them
-    /// (an error of order Ts^2: 5.8 mdeg at Q = 5, 3e5 deg/s and 240 kHz, with no warning
-    /// before; the hold rule weighs the constant-rate plant, which is exact).
-    fn validate_table_step(&self, warnings: &mut Vec<String>) {
-        let Shape::RateTable { .. } = self.shape() else {
-            return;
-        };
-        let ts = 1.0 / self.fs_hz();
-        let x = 2.0 * self.device.angular_gain.abs() * self.max_rate_rad_s() * ts;
-        let est_mdeg = (x.powi(3) / 6.0 * self.slowest_tau_s() / ts).to_degrees() * 1e3;
-        if est_mdeg > WARN_HOLD_ERROR_MDEG {
-            warnings.push(format!(
-                "experiment.rates_dps: at the largest rate-table amplitude the plant's time-varying step (second order in the rate, 2 lambda Omega Ts = {x:.2e}) is off by about (2 lambda Omega Ts)^3/6 per step, summed over the resonator's tau/Ts steps: expect read-out errors of order {est_mdeg:.1e} mdeg; raise board.fs_hz (the error falls as fs^-2)"
             ));
         }
     }

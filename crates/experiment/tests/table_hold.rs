@@ -88,9 +88,34 @@ average_s = 0.5
     .unwrap()
 }
 
+/// Q = 5 under a 200 Hz table of up to 3e5 deg/s at 240 kHz: the plant's step, second order in
+/// the rate, is off by most of the figure (2 lambda Omega Ts = 0.044).
+fn fast() -> Config {
+    parse_config(
+        r#"
+[device]
+f0_hz = 15000.0
+q = 5.0
+angular_gain = 1.0
+[drive]
+f1 = 1.0
+f2 = 1.0
+[board]
+fs_hz = 240000.0
+[experiment]
+kind = "coriolis"
+rate_table = "sinusoid"
+table_freq_hz = 200.0
+rates_dps = [100000.0, 300000.0]
+average_s = 0.05
+"#,
+    )
+    .unwrap()
+}
+
 #[test]
 fn the_hold_warning_states_what_the_board_reads() {
-    for cfg in [asymmetric(), detuned()] {
+    for cfg in [asymmetric(), detuned(), fast()] {
         let warnings = cfg.validate().unwrap();
         let (amp, lag) = moved(&cfg);
         // The emulated board reads the hold well above the warning threshold (0.01 mdeg) ...
