@@ -140,11 +140,11 @@ fn a_swing_beyond_the_demodulated_harmonics_is_warned() {
     assert!(cfg.validate().unwrap().is_empty());
 }
 
-/// The hold rule weighs a rate table at a constant rate of its amplitude; the swing adds
-/// dynamic terms, so on a 20 Hz mode split the table read 1.06 mdeg off where 0.949 was
-/// stated as "up to". The warning now calls its figure an estimate, and the run shows why.
+/// The hold rule weighed a rate table at a constant rate of its amplitude, and on a 20 Hz mode
+/// split the table read 1.06 mdeg off where 0.949 was stated as "up to". It now states the
+/// periodic steady state of the board's own recursion, amplitude and lag, and the run reads it.
 #[test]
-fn a_tables_hold_figure_is_stated_as_an_estimate_and_the_swing_exceeds_it() {
+fn a_tables_hold_figure_is_what_the_run_reads() {
     let mut cfg = table_config(2_000.0, 60_000.0, 200.0, 2.0, &[25.0, 175.0, 1000.0]);
     cfg.device.mode2_f0_offset_hz = 20.0;
     let w = cfg.validate().unwrap();
@@ -152,12 +152,8 @@ fn a_tables_hold_figure_is_stated_as_an_estimate_and_the_swing_exceeds_it() {
         .iter()
         .find(|w| w.contains("zero-order hold"))
         .expect("a hold warning");
-    assert!(
-        hold.contains("an estimate, not a bound") && !hold.contains("by up to"),
-        "{hold}"
-    );
     let stated: f64 = {
-        let rest = &hold[hold.find("by about ").unwrap() + "by about ".len()..];
+        let rest = &hold[hold.find("by up to ").unwrap() + "by up to ".len()..];
         rest[..rest.find(" mdeg").unwrap()].parse().unwrap()
     };
     let r = run(&cfg);
@@ -167,7 +163,7 @@ fn a_tables_hold_figure_is_stated_as_an_estimate_and_the_swing_exceeds_it() {
         .flat_map(|p| (0..2).map(move |k| ((p.phase_deg[k] - p.theory_deg[k]) * 1e3).abs()))
         .fold(0.0, f64::max);
     assert!(
-        worst > stated,
+        (worst - stated).abs() <= 1e-3 * worst + 1e-4,
         "{worst} mdeg measured against {stated} stated"
     );
 }

@@ -601,3 +601,46 @@ fn a_null_two_mode_estimate_says_why() {
     }
     assert!(nulls > 0, "no seed made a null estimate");
 }
+
+/// Selfcal's plain line fits (`plain_fit`, in selfcal.json) take the readings on their branch
+/// as a sweep's summary does: the Coriolis phases -59, +59, +66 deg (Q = 50 at 1 kHz, +-6000
+/// and 8000 deg/s) had been moved a half turn apart (slope -0.0044 for +0.0092, r2 0.947).
+#[test]
+fn selfcals_plain_fits_keep_a_steep_step_between_rates() {
+    let c = gyroemu::config::parse_config(
+        r#"
+[device]
+f0_hz = 1000.0
+q = 50.0
+angular_gain = 1.0
+[drive]
+f1 = 1.0
+f2 = 1.0
+[board]
+fs_hz = 16000.0
+[experiment]
+kind = "rotating"
+rates_dps = [-6000.0, 6000.0, 8000.0]
+average_s = 0.5
+"#,
+    )
+    .unwrap();
+    validate_selfcal(&c).unwrap();
+    let r = run_selfcal_core(&c, &quiet, &quiet, None).unwrap();
+    for (sweep, fit) in [
+        (&r.coriolis, r.modes[0].coriolis.plain_fit),
+        (&r.rotating, r.modes[0].rotating.plain_fit),
+    ] {
+        let xs: Vec<f64> = sweep.points.iter().map(|p| p.rate_dps).collect();
+        let ys: Vec<f64> = sweep.points.iter().map(|p| p.phase_deg[0]).collect();
+        // The readings are continuous as written; the plain fit is theirs, and the sweep's.
+        let plain = gyroemu::experiment::fit::fit_line(&xs, &ys);
+        assert_eq!(
+            fit.slope.to_bits(),
+            plain.slope.to_bits(),
+            "{fit:?} {plain:?} {ys:?}"
+        );
+        assert_eq!(fit.slope.to_bits(), sweep.fit[0].slope.to_bits());
+        assert!(fit.slope > 0.0 && fit.r2 > 0.99, "{fit:?}");
+    }
+}

@@ -406,6 +406,17 @@ impl Config {
                     "is required with rate_table = \"sinusoid\"",
                 )),
                 Some(ft) => {
+                    // A table's rates are amplitudes: -A sin is A sin half a table period on
+                    // (the same amplitude read, its lag 180 deg on), and 0 has no swing and no
+                    // lag. Signed amplitudes had made the sweep's line a V: a slope of 0 for
+                    // the symmetric -175 ..= 175, and a lag of noise at 0.
+                    if let Some(&bad) = e.rates_dps.iter().find(|r| !(**r > 0.0)) {
+                        p.push(ConfigError::key(
+                            "experiment.rates_dps",
+                            bad,
+                            "with rate_table = \"sinusoid\" each rate is the table's amplitude and must be > 0: a negative one is the positive table half a period on (the same amplitude, the lag 180 deg on), and 0 has no swing and no lag to read (a sinusoid sweep needs no zero-rate reference)",
+                        ));
+                    }
                     let key = "experiment.table_freq_hz";
                     if p.clean(&["board.lpf_cutoff_hz"]) {
                         p.check(

@@ -38,9 +38,10 @@ pub const NODE_RANGE: (f64, f64) = (1e-100, 1e100);
 /// refused.
 pub const MAX_HOLD_ERROR_MDEG: f64 = 1000.0;
 
-/// Below this `1 - |W(2 Omega)|^2` a rotating window cannot part its two sidebands: refused
-/// (a rounding of the window's sums, 1e-16, is then amplified past 1e-10).
-pub const MIN_SIDEBAND_DET: f64 = 1e-6;
+/// Above this gain of the sideband solve, `1 / (1 - |W(2 Omega)|)`, a rotating window cannot
+/// part its two sidebands: refused (a rounding of the window's sums, 1e-16, is then amplified
+/// past 1e-10).
+pub const MAX_SIDEBAND_GAIN: f64 = 1e6;
 
 /// Above this hold error (mdeg) it is stated in a warning.
 pub const WARN_HOLD_ERROR_MDEG: f64 = 0.01;
@@ -176,10 +177,12 @@ impl Config {
 
     /// A rotating point reads its two sidebands f_c +- Omega from the window's averages of the
     /// stage-2 outputs, removing what the window keeps of the 2 Omega term, `W = W(2 Omega)`:
-    /// the solve divides by `1 - |W|^2`. A window of one output sample keeps all of it
-    /// (a Hann window of one sample was accepted and read NaN, "overflowed"): refused below
-    /// [`MIN_SIDEBAND_DET`]. Between that and 0.1 the solve multiplies every other error of
-    /// the reading (noise, converters, the hold) by up to `1 / (1 - |W|^2)`: warned.
+    /// the solve inverts `[[1, conj W], [W, 1]]`, whose eigenvalues are `1 +- |W|`, so it
+    /// multiplies an error of the averages by up to `1 / (1 - |W|)`. A window of one output
+    /// sample keeps all of it (a Hann window of one sample was accepted and read NaN,
+    /// "overflowed"): refused where the gain passes [`MAX_SIDEBAND_GAIN`]. Above 10 every
+    /// other error of the reading (noise, converters, the hold) is multiplied by up to it:
+    /// warned with the gain.
     fn validate_sideband_solve(&self, p: &mut Rules, warnings: &mut Vec<String>) {
         if !matches!(self.shape(), Shape::Rotating) {
             return;
@@ -189,23 +192,23 @@ impl Config {
         for &rate in self.experiment.rates_dps.iter().filter(|r| **r != 0.0) {
             let window = self.plan_point(rate).window;
             let fm = rate.abs() / 360.0;
-            let det = 1.0 - window.response(2.0 * fm / fs_out).norm_sqr();
-            if worst.is_none_or(|(d, _, _)| det < d) {
-                worst = Some((det, rate, window.span()));
+            let kept = window.response(2.0 * fm / fs_out).norm();
+            if worst.is_none_or(|(k, _, _)| kept > k) {
+                worst = Some((kept, rate, window.span()));
             }
         }
-        let Some((det, rate, n)) = worst else {
+        let Some((kept, rate, n)) = worst else {
             return;
         };
+        let gain = 1.0 / (1.0 - kept);
         let window = match self.experiment.window {
             crate::WindowKind::Hann => "Hann",
             crate::WindowKind::Boxcar => "boxcar",
         };
         let what = format!(
-            "at {rate} deg/s the {window} window of {n} output samples keeps {:.6} of the stage-2 product at 2 Omega, and the read-out parts the sidebands f_c +- Omega by dividing by 1 - |W(2 Omega)|^2 = {det:.3e}",
-            (1.0 - det).max(0.0).sqrt()
+            "at {rate} deg/s the {window} window of {n} output samples keeps |W(2 Omega)| = {kept:.6} of the stage-2 product at 2 Omega, and the read-out parts the sidebands f_c +- Omega by a solve that multiplies errors by up to 1/(1 - |W|) = {gain:.3e}"
         );
-        if det < MIN_SIDEBAND_DET {
+        if !(gain <= MAX_SIDEBAND_GAIN) {
             p.push(ConfigError::key(
                 "experiment.average_s",
                 self.experiment.average_s,
@@ -213,11 +216,10 @@ impl Config {
                     "{what}: the two sidebands cannot be told apart; average over more output samples (a longer average_s, or a smaller board.decimation)"
                 ),
             ));
-        } else if det < 0.1 {
+        } else if gain > 10.0 {
             warnings.push(format!(
-                "experiment.average_s = {}: {what}, which multiplies every other error of the reading (noise, converters, the DAC hold) by up to {:.3e}; the figures other warnings state do not include it; average over more output samples",
-                self.experiment.average_s,
-                1.0 / det
+                "experiment.average_s = {}: {what}: every other error of the reading (noise, converters, the DAC hold) is multiplied by up to that, which the figures other warnings state do not include; average over more output samples",
+                self.experiment.average_s
             ));
         }
     }

@@ -811,6 +811,21 @@ fn cases() -> Vec<Case> {
             &["experiment.table_freq_hz", "(missing)", "required"],
         ),
         invalid(
+            "a negative table amplitude",
+            set(&t, "experiment", "rates_dps", "[25.0, -175.0]"),
+            &[
+                "experiment.rates_dps",
+                "-175",
+                "must be > 0",
+                "lag 180 deg on",
+            ],
+        ),
+        invalid(
+            "a zero table amplitude",
+            set(&t, "experiment", "rates_dps", "[0.0, 25.0]"),
+            &["experiment.rates_dps", "= 0", "no swing and no lag"],
+        ),
+        invalid(
             "table_freq_hz with a constant table",
             set(&c, "experiment", "table_freq_hz", "2.0"),
             &["experiment.table_freq_hz", "= 2", "only applies"],

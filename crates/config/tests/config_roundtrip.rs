@@ -153,7 +153,8 @@ fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
             x.rate_table = RateTable::Sinusoid;
             let ft = 0.5 * cutoff * rates[0].abs();
             x.table_freq_hz = Some(ft);
-            x.rates_dps = rates.iter().map(|r| r * 500.0).collect();
+            // A table's rates are amplitudes (> 0).
+            x.rates_dps = rates.iter().map(|r| r.abs() * 500.0).collect();
             x.average_s = avg_mult * (1.0 / ft).max(out_period);
         }
         _ => {
