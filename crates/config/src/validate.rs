@@ -410,7 +410,7 @@ impl Config {
                     // (the same amplitude read, its lag 180 deg on), and 0 has no swing and no
                     // lag. Signed amplitudes had made the sweep's line a V: a slope of 0 for
                     // the symmetric -175 ..= 175, and a lag of noise at 0.
-                    if let Some(&bad) = e.rates_dps.iter().find(|r| !(**r > 0.0)) {
+                    if let Some(&bad) = e.rates_dps.iter().find(|r| r.is_nan() || **r <= 0.0) {
                         p.push(ConfigError::key(
                             "experiment.rates_dps",
                             bad,

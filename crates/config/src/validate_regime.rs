@@ -208,7 +208,7 @@ impl Config {
         let what = format!(
             "at {rate} deg/s the {window} window of {n} output samples keeps |W(2 Omega)| = {kept:.6} of the stage-2 product at 2 Omega, and the read-out parts the sidebands f_c +- Omega by a solve that multiplies errors by up to 1/(1 - |W|) = {gain:.3e}"
         );
-        if !(gain <= MAX_SIDEBAND_GAIN) {
+        if gain.is_nan() || gain > MAX_SIDEBAND_GAIN {
             p.push(ConfigError::key(
                 "experiment.average_s",
                 self.experiment.average_s,
