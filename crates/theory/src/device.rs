@@ -4,7 +4,7 @@
 
 use crate::closed_form::{coriolis_theta_rad, rotating_psi_rad};
 use gyroemu_core::Complex64;
-use gyroemu_mixer::phase_fundamental;
+use gyroemu_mixer::phase_fundamental_fine;
 use gyroemu_resonator::{
     continuous_steady_state, held_table_steady_state, rate_table_steady_state, Resonator,
     ResonatorParams,
@@ -188,8 +188,12 @@ impl DrivenDevice {
         rel: f64,
         max: usize,
     ) -> Option<usize> {
-        let n = max + 8;
-        let env = self.rate_table_envelopes(amplitude_rad_s, table_hz, n);
+        // The converged balance (a truncated one misjudges a large swing's outer harmonics),
+        // with at least eight beyond `max`.
+        let env = converged_envelopes(|m| {
+            self.rate_table_envelopes(amplitude_rad_s, table_hz, m.max(max + 8))
+        })?;
+        let n = env[0].len() / 2;
         let peak = env.iter().flatten().map(|v| v.norm()).fold(0.0, f64::max);
         let beyond = |k: usize| {
             env.iter()
@@ -225,7 +229,7 @@ impl DrivenDevice {
             );
             [0, 1].map(|k| x.iter().map(|xn| xn[2 + k]).collect::<Vec<_>>())
         };
-        fundamental_of(env, 24, 48)
+        fundamental_of(env)
     }
 
     /// The exact phase response of each mode to the rate table `amplitude sin(2 pi table_hz
@@ -234,32 +238,46 @@ impl DrivenDevice {
     /// per mode, a lag `a sin(w_t t - l)` read as `(a, l)`. NaN when the envelope passes
     /// through 0 (no continuous phase).
     pub fn rate_table_response(&self, amplitude_rad_s: f64, table_hz: f64) -> ([f64; 2], [f64; 2]) {
-        fundamental_of(
-            |n| self.rate_table_envelopes(amplitude_rad_s, table_hz, n),
-            24,
-            48,
-        )
+        fundamental_of(|n| self.rate_table_envelopes(amplitude_rad_s, table_hz, n))
     }
 }
 
-/// Each mode's phase fundamental `(amplitude rad, lag rad)` of the envelopes `env(n)`
-/// (harmonics `-n ..= n`): with `few` harmonics, or `many` where the outermost two of `few`
-/// still hold more than f64's resolution of the envelope (24 for swings up to tens of
-/// degrees, 48 beyond).
-fn fundamental_of(
+/// The most envelope harmonics a rate table's theory takes (a swing of 785 degrees needs
+/// about 150); a swing that needs more has no theory here (NaN).
+pub const MAX_THEORY_HARMONICS: usize = 384;
+
+/// The envelopes `env(n)` (harmonics `-n ..= n`) with enough harmonics that the outermost two
+/// hold no more than f64's resolution of the envelope: 24 for swings up to tens of degrees,
+/// doubled as the swing needs, up to [`MAX_THEORY_HARMONICS`]; `None` beyond. Stopping at 48
+/// whatever the swing had left a 785-degree swing read as 336 (a truncated balance).
+pub fn converged_envelopes(
     env: impl Fn(usize) -> [Vec<Complex64>; 2],
-    few: usize,
-    many: usize,
-) -> ([f64; 2], [f64; 2]) {
-    let mut e = env(few);
-    let peak = e.iter().flatten().map(|v| v.norm()).fold(0.0, f64::max);
-    let last = 2 * few;
-    if e.iter()
-        .any(|h| h[2].norm().max(h[last - 2].norm()) > 1e-17 * peak)
-    {
-        e = env(many);
+) -> Option<[Vec<Complex64>; 2]> {
+    let mut n = 24;
+    loop {
+        let e = env(n);
+        let peak = e.iter().flatten().map(|v| v.norm()).fold(0.0, f64::max);
+        let last = e[0].len() - 1;
+        if !e
+            .iter()
+            .any(|h| h[2].norm().max(h[last - 2].norm()) > 1e-17 * peak)
+        {
+            return Some(e);
+        }
+        if n >= MAX_THEORY_HARMONICS {
+            return None;
+        }
+        n *= 2;
     }
-    let x = e.map(|h| phase_fundamental(&h));
+}
+
+/// Each mode's phase fundamental `(amplitude rad, lag rad)` of the converged envelopes
+/// ([`converged_envelopes`]); NaN where they do not converge.
+fn fundamental_of(env: impl Fn(usize) -> [Vec<Complex64>; 2]) -> ([f64; 2], [f64; 2]) {
+    let Some(e) = converged_envelopes(env) else {
+        return ([f64::NAN; 2], [f64::NAN; 2]);
+    };
+    let x = e.map(|h| phase_fundamental_fine(&h));
     let amp = x.map(|x| x.norm());
     let lag = x.map(|x| -(x * Complex64::new(0.0, 1.0)).arg());
     (amp, lag)
