@@ -137,6 +137,8 @@ impl Config {
         };
         let n = self.table_harmonics();
         let dev = self.driven_device();
+        let chain = gyroemu_board::ChainResponse::new(&self.board_params()).ok();
+        let fc = self.carrier_hz();
         let (mut amp_err, mut lag_err, mut at) = (0.0f64, 0.0f64, f64::NAN);
         let mut read_at = (f64::NAN, f64::NAN);
         for &rate in &self.experiment.rates_dps {
@@ -154,12 +156,52 @@ impl Config {
                 ));
                 return;
             };
+            let window = self.plan_point(rate).window;
             for h in &env {
                 let c = h.len() / 2;
                 let full = gyroemu_mixer::phase_fundamental_fine(h);
-                let read = gyroemu_mixer::phase_fundamental(&h[c - n..=c + n]);
-                let a = (read.norm() - full.norm()).abs() / DEG * 1e3;
-                let l = turn_mdeg(read.arg(), full.arg());
+                let read = gyroemu_mixer::phase_fundamental_fine(&h[c - n..=c + n]);
+                // What the harmonics beyond N leak into the N read through a window that is
+                // not whole table periods (a Hann window read 9.2 mdeg where the truncation
+                // alone is 2.0), bounded: each read harmonic's share, divided by the chain's
+                // response there as the read-out divides, over the truncated envelope's
+                // smallest size, through the fundamental (4/pi).
+                let leak = chain.as_ref().map_or(0.0, |chain| {
+                    let resp =
+                        |m: f64| (chain.lowpass(m * freq_hz) * chain.tia(fc + m * freq_hz)).norm();
+                    let fs_out = self.fs_out_hz();
+                    let shares: f64 = (-(n as i64)..=n as i64)
+                        .map(|r| {
+                            let r = r as f64;
+                            (0..h.len())
+                                .map(|i| i as f64 - c as f64)
+                                .filter(|m| m.abs() > n as f64)
+                                .map(|m| {
+                                    h[(m + c as f64) as usize].norm()
+                                        * resp(m)
+                                        * window.response((m - r) * freq_hz / fs_out).norm()
+                                })
+                                .sum::<f64>()
+                                / resp(r)
+                        })
+                        .sum();
+                    let smallest = (0..4096)
+                        .map(|g| {
+                            let theta = core::f64::consts::TAU * g as f64 / 4096.0;
+                            (-(n as i64)..=n as i64)
+                                .map(|r| {
+                                    h[(r + c as i64) as usize]
+                                        * Complex64::from_polar(1.0, r as f64 * theta)
+                                })
+                                .sum::<Complex64>()
+                                .norm()
+                        })
+                        .fold(f64::INFINITY, f64::min);
+                    4.0 / core::f64::consts::PI * (shares / smallest).min(1.0).asin()
+                });
+                let a = (read.norm() - full.norm()).abs() / DEG * 1e3 + leak / DEG * 1e3;
+                let l = turn_mdeg(read.arg(), full.arg())
+                    + (leak / full.norm()).min(1.0).asin() / DEG * 1e3;
                 if a.is_nan() || a > amp_err {
                     (amp_err, at) = (a, rate);
                     read_at = (read.norm() / DEG, full.norm() / DEG);
@@ -181,7 +223,7 @@ impl Config {
             ));
         } else if amp_err.max(lag_err) > WARN_HOLD_ERROR_MDEG {
             warnings.push(format!(
-                "experiment.rates_dps: {what}: the amplitudes read are off by up to {amp_err:.3e} mdeg and the lags by up to {lag_err:.3e} mdeg; lower the amplitude or raise experiment.table_freq_hz"
+                "experiment.rates_dps: {what}: the amplitudes read are off by up to {amp_err:.3e} mdeg and the lags by up to {lag_err:.3e} mdeg (exactly, over whole table periods of a boxcar; with the leak of the harmonics beyond through any other window, bounded); lower the amplitude or raise experiment.table_freq_hz"
             ));
         }
     }
@@ -197,14 +239,24 @@ impl Config {
         };
         let dev = self.driven_device();
         for &rate in &self.experiment.rates_dps {
-            let (amp, _) = dev.rate_table_response(rate.abs() * DEG, freq_hz);
-            if let Some(k) = amp.iter().position(|a| a.is_nan()) {
+            // A swing beyond the theory's harmonics is the harmonics rule's to refuse.
+            let Some(env) = gyroemu_theory::converged_envelopes(|m| {
+                dev.rate_table_envelopes(rate.abs() * DEG, freq_hz, m)
+            }) else {
+                continue;
+            };
+            for (k, h) in env.iter().enumerate() {
+                let what = match gyroemu_mixer::phase_fundamental_checked(h) {
+                    Ok(_) => continue,
+                    Err(gyroemu_mixer::NoFundamental::Winds) => "passes around zero once per table period",
+                    Err(gyroemu_mixer::NoFundamental::Unresolved) => "passes so near zero once per table period that its phase turns by nearly a half turn within 1e-5 of the period, and its fundamental cannot be resolved",
+                };
                 let drive = ["drive.f1", "drive.f2"][k];
                 return Err(ConfigError::key(
                     "experiment.rates_dps",
                     rate,
                     format!(
-                        "at this rate-table amplitude mode {}'s velocity envelope (its phasor at the carrier, exact periodic steady state) passes around zero once per table period ({freq_hz} Hz): what the rate couples in from the other mode outweighs the mode's own driven response at the swing's peaks, so its phase turns a whole turn per period and has no lag or amplitude to read; lower the amplitude, raise {drive}, or bring the mode nearer the carrier",
+                        "at this rate-table amplitude mode {}'s velocity envelope (its phasor at the carrier, exact periodic steady state) {what} ({freq_hz} Hz): what the rate couples in from the other mode outweighs the mode's own driven response at the swing's peaks, so there is no lag or amplitude to read; lower the amplitude, raise {drive}, or bring the mode nearer the carrier",
                         k + 1
                     ),
                 ));
@@ -246,7 +298,8 @@ impl Config {
         let what = format!(
             "at {rate} deg/s the {window} window of {n} output samples keeps |W(2 Omega)| = {kept:.6} of the stage-2 product at 2 Omega, and the read-out parts the sidebands f_c +- Omega by a solve that multiplies errors by up to 1/(1 - |W|) = {gain:.3e}"
         );
-        if gain.is_nan() || gain > MAX_SIDEBAND_GAIN {
+        // Fails closed: |W| rounded to 1 or above (a negative gain) is refused too.
+        if kept.is_nan() || kept >= 1.0 - 1.0 / MAX_SIDEBAND_GAIN {
             p.push(ConfigError::key(
                 "experiment.average_s",
                 self.experiment.average_s,

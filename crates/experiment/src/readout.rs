@@ -10,8 +10,8 @@ use gyroemu_board::{
 use gyroemu_config::Config;
 use gyroemu_core::{Complex64, ParamError};
 use gyroemu_mixer::{
-    paper_i_channel_psi_rad, phase_fundamental, phase_lag_rad, sideband_estimate, wrap_pi, Mode,
-    MAX_TABLE_HARMONIC,
+    paper_i_channel_psi_rad, phase_fundamental_checked, phase_lag_rad, sideband_estimate, wrap_pi,
+    Mode, NoFundamental, MAX_TABLE_HARMONIC,
 };
 use serde::Serialize;
 
@@ -312,9 +312,11 @@ fn small_rate_slope(cfg: &Config) -> [f64; 2] {
 /// The rate-table read-out of one point: each harmonic of `z` freed of the window's leak, the
 /// low-pass `L(n f_t)` and the TIA `H(f_c + n f_t)` divided out of it (the chain acts on `z`,
 /// not on its phase), then the fundamental of the phase lag of the envelope they make. Writes
-/// the amplitude into `phase_deg` and returns the lag, degrees per mode, and whether each
-/// mode's envelope went around zero (finite harmonics, no continuous phase: NaN, and not
-/// an overflow).
+/// the amplitude into `phase_deg` and returns the lag, degrees per mode, and why a mode with
+/// finite harmonics has no phase (its envelope went around zero, or so near it that its
+/// phase cannot be resolved: NaN, and not an overflow). The phase's fundamental is taken on a
+/// grid as fine as its phase needs, as the theory's is (on 1024 points a dip's phase aliased:
+/// 12 mdeg off the theory, unwarned).
 fn table_phase_readout(
     chain: &ChainResponse,
     lr: &LaneResult,
@@ -322,12 +324,12 @@ fn table_phase_readout(
     n_settle: u64,
     n: usize,
     phase_deg: &mut [f64; 2],
-) -> ([f64; 2], [bool; 2]) {
+) -> ([f64; 2], [Option<NoFundamental>; 2]) {
     let ft = chain.table_hz();
     let fc = chain.carrier_hz();
     let leak = chain.table_leak(point, n_settle, n);
     let mut lag = [0.0; 2];
-    let mut wound = [false; 2];
+    let mut wound = [None; 2];
     for k in 0..2 {
         let avg = &lr.table_z[k][MAX_TABLE_HARMONIC - n..=MAX_TABLE_HARMONIC + n];
         let v: Vec<Complex64> = unleak_table_harmonics(avg, &leak)
@@ -338,8 +340,15 @@ fn table_phase_readout(
                 z / (chain.lowpass(f) * chain.tia(fc + f))
             })
             .collect();
-        let x = phase_fundamental(&v);
-        wound[k] = x.is_nan() && v.iter().all(|z| z.is_finite());
+        let x = match phase_fundamental_checked(&v) {
+            Ok(x) => x,
+            Err(why) => {
+                if v.iter().all(|z| z.is_finite()) {
+                    wound[k] = Some(why);
+                }
+                Complex64::new(f64::NAN, f64::NAN)
+            }
+        };
         phase_deg[k] = x.norm() / DEG;
         // A lag a sin(w_t t - l) has the complex amplitude -j a e^{-j l}.
         lag[k] = -(x * Complex64::new(0.0, 1.0)).arg() / DEG;
@@ -390,7 +399,7 @@ pub fn post_process_with(
             Shape::RateTable { freq_hz } => Some(dev.rate_table_response(omega, freq_hz)),
             _ => None,
         };
-        let mut wound = [false; 2];
+        let mut wound = [None; 2];
         let mut r = PointResult {
             rate_dps: rate,
             phase_deg: [0.0; 2],
@@ -528,10 +537,14 @@ pub fn post_process_with(
             }
         }
         for k in 0..2 {
-            if !refused[k] && wound[k] {
+            if let (false, Some(why)) = (refused[k], wound[k]) {
                 refused[k] = true;
+                let what = match why {
+                    NoFundamental::Winds => "went around zero within a table period (its phase turns a whole turn per period and has no lag or amplitude to read)",
+                    NoFundamental::Unresolved => "passed so near zero within a table period that its phase turns by nearly a half turn in an instant and its fundamental cannot be resolved",
+                };
                 problems.push(format!(
-                    "point {rate} deg/s, mode {}: no phase: the mode's velocity envelope went around zero within a table period (its phase turns a whole turn per period and has no lag or amplitude to read); lower the rate-table amplitude, raise the mode's drive, or bring the mode nearer the carrier",
+                    "point {rate} deg/s, mode {}: no phase: the mode's velocity envelope {what}; lower the rate-table amplitude, raise the mode's drive, or bring the mode nearer the carrier",
                     k + 1
                 ));
             }

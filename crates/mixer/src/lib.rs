@@ -23,8 +23,9 @@ pub use iq::Iq;
 pub use stage1::Stage1Mixer;
 pub use stage2::{Stage2Mixer, Stage2Out};
 pub use table::{
-    phase_fundamental, phase_fundamental_fine, table_channel, table_reference, TableMixer,
-    MAX_TABLE_HARMONIC, TABLE_CHANNELS, TABLE_HARMONICS,
+    phase_fundamental, phase_fundamental_checked, phase_fundamental_fine, table_channel,
+    table_reference, NoFundamental, TableMixer, MAX_TABLE_HARMONIC, TABLE_CHANNELS,
+    TABLE_HARMONICS,
 };
 
 /// Wraps an angle into `(-pi, pi]` (the branch every read-out here uses).

@@ -123,18 +123,30 @@ pub fn phase_fundamental(h: &[Complex64]) -> Complex64 {
     static GRID: std::sync::OnceLock<Box<[(f64, f64); G + 1]>> = std::sync::OnceLock::new();
     let grid =
         GRID.get_or_init(|| Box::new(core::array::from_fn(|g| sin_cos_turns(g as f64 / G as f64))));
-    fundamental_on(h, &grid[..])
+    fundamental_on(h, &grid[..]).0
+}
+
+/// Why [`phase_fundamental_checked`] has no fundamental to give.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NoFundamental {
+    /// The envelope goes around 0 over the period (on a grid that resolves every phase step).
+    Winds,
+    /// The envelope passes so close to 0 that its phase turns by nearly a half turn within a
+    /// step of the finest grid (2^18 points), or its fundamental never settles there: the
+    /// reading is that ill-conditioned.
+    Unresolved,
 }
 
 /// [`phase_fundamental`] of an envelope of any number of harmonics, on a grid fine enough
 /// for its phase: the phase of an envelope that dips near zero turns fast there, and its
 /// harmonics reach far beyond the envelope's (a 535-degree swing of 96 envelope harmonics
 /// read 534.713 deg on 2048 points and 534.7328 on 8192). The grid doubles from 1024 (or 16
-/// points per harmonic) until the fundamental moves by less than 1e-12 of itself (plus 1e-13
-/// rad), up to 2^20
-/// points; NaN if it never settles. Where 1024 points already hold it, the same bits as
+/// points per harmonic) until every phase step between its points is under a quarter turn
+/// (so winding is judged right) and the fundamental moves by less than 1e-9 of itself (plus
+/// 1e-13 rad), up to 2^18 points. Where 1024 points already hold it, the same bits as
 /// [`phase_fundamental`].
-pub fn phase_fundamental_fine(h: &[Complex64]) -> Complex64 {
+pub fn phase_fundamental_checked(h: &[Complex64]) -> Result<Complex64, NoFundamental> {
+    const MAX_GRID: usize = 1 << 18;
     let nh = h.len() / 2;
     let on = |g: usize| {
         let grid: Vec<(f64, f64)> = (0..=g)
@@ -144,34 +156,41 @@ pub fn phase_fundamental_fine(h: &[Complex64]) -> Complex64 {
     };
     let mut g = (16 * nh).next_power_of_two().max(1024);
     let mut x = if g == 1024 {
-        phase_fundamental(h)
+        let (_, step, turns) = on(g);
+        (phase_fundamental(h), step, turns)
     } else {
         on(g)
     };
-    while g < 1 << 20 {
+    while g < MAX_GRID {
         let finer = on(2 * g);
-        if !(x.is_finite() && finer.is_finite()) {
-            return finer;
+        let resolved = x.1 < core::f64::consts::FRAC_PI_2 && finer.1 < core::f64::consts::FRAC_PI_2;
+        if resolved && x.2 && finer.2 {
+            return Err(NoFundamental::Winds);
         }
-        // Relative, and absolute for a fundamental near 0 (a small swing's phase sums carry
-        // its offset's rounding, about 1e-15 rad).
-        if (finer - x).norm() <= 1e-12 * finer.norm() + 1e-13 {
-            return x;
+        if resolved && !x.2 && !finer.2 && (finer.0 - x.0).norm() <= 1e-9 * finer.0.norm() + 1e-13 {
+            return Ok(x.0);
         }
         (x, g) = (finer, 2 * g);
     }
-    Complex64::new(f64::NAN, f64::NAN)
+    Err(NoFundamental::Unresolved)
+}
+
+/// [`phase_fundamental_checked`], NaN where it has none.
+pub fn phase_fundamental_fine(h: &[Complex64]) -> Complex64 {
+    phase_fundamental_checked(h).unwrap_or(Complex64::new(f64::NAN, f64::NAN))
 }
 
 /// The fundamental on `grid`, `G + 1` points `(sin, cos)` of `2 pi g / G` (the last closes the
-/// period, for the winding test).
-fn fundamental_on(h: &[Complex64], grid: &[(f64, f64)]) -> Complex64 {
+/// period, for the winding test), NaN where the phase turns a whole turn over the period;
+/// with the largest phase step between neighbouring points and whether it turned.
+fn fundamental_on(h: &[Complex64], grid: &[(f64, f64)]) -> (Complex64, f64, bool) {
     let g_len = grid.len() - 1;
     let nh = (h.len() / 2) as isize;
     let mut acc = Complex64::new(0.0, 0.0);
     let mut prev = f64::NAN;
     let mut unwrapped = 0.0;
     let mut first = 0.0;
+    let mut step: f64 = 0.0;
     let values = envelope_on_grid(h, grid);
     for (g, (&(s, c), &v)) in grid.iter().zip(&values).enumerate() {
         let v = v * Complex64::new(c, -s).powi(nh as i32);
@@ -179,7 +198,9 @@ fn fundamental_on(h: &[Complex64], grid: &[(f64, f64)]) -> Complex64 {
         unwrapped = if prev.is_nan() {
             ph
         } else {
-            unwrapped + crate::wrap_pi(ph - prev)
+            let d = crate::wrap_pi(ph - prev);
+            step = step.max(d.abs());
+            unwrapped + d
         };
         prev = ph;
         if g == 0 {
@@ -190,10 +211,11 @@ fn fundamental_on(h: &[Complex64], grid: &[(f64, f64)]) -> Complex64 {
         }
     }
     // A whole turn of the phase over the period: V went around 0.
-    if (unwrapped - first).abs() > core::f64::consts::PI || !acc.is_finite() {
-        return Complex64::new(f64::NAN, f64::NAN);
+    let turned = (unwrapped - first).abs() > core::f64::consts::PI;
+    if turned || !acc.is_finite() {
+        return (Complex64::new(f64::NAN, f64::NAN), step, turned);
     }
-    acc * (2.0 / g_len as f64)
+    (acc * (2.0 / g_len as f64), step, false)
 }
 
 /// `sum_n h[n] e^{j n theta}` at each grid point `(sin, cos)` of `theta`, by Horner from the
