@@ -97,9 +97,13 @@ impl Config {
             p.push(e);
             return;
         }
-        if let Err(e) = self.validate_table_winding() {
-            p.push(e);
-            return;
+        // The table's rules weigh its frequency and window: only once those keys are valid.
+        let table_keys = ["experiment.table_freq_hz", "experiment.average_s"];
+        if p.clean(&table_keys) {
+            if let Err(e) = self.validate_table_winding() {
+                p.push(e);
+                return;
+            }
         }
         self.validate_sideband_solve(p, warnings);
         let largest = (0..2)
@@ -118,7 +122,9 @@ impl Config {
         self.validate_dac_rounding(warnings, locked);
         self.validate_mixer_product(warnings);
         self.validate_lowpass_rounding(warnings);
-        self.validate_table_harmonics(p, warnings);
+        if p.clean(&table_keys) {
+            self.validate_table_harmonics(p, warnings);
+        }
         self.validate_hold(p, warnings);
     }
 
@@ -199,6 +205,8 @@ impl Config {
                         .fold(f64::INFINITY, f64::min);
                     4.0 / core::f64::consts::PI * (shares / smallest).min(1.0).asin()
                 });
+                // A leak that cannot be weighed is charged at its largest (2 rad).
+                let leak = if leak.is_nan() { 2.0 } else { leak };
                 let a = (read.norm() - full.norm()).abs() / DEG * 1e3 + leak / DEG * 1e3;
                 let l = turn_mdeg(read.arg(), full.arg())
                     + (leak / full.norm()).min(1.0).asin() / DEG * 1e3;
