@@ -129,11 +129,12 @@ impl Config {
     }
 
     /// A rate table whose swing has more harmonics than the board demodulates: the read-out
-    /// takes the phase's fundamental of harmonics `-N ..= N` of the envelope alone, which the
-    /// converged periodic steady state gives exactly, so the error is stated as it is (an
-    /// estimate from a 16-harmonic balance had stated 4.9e4 mdeg where a 785-degree swing read
-    /// 119 degrees). Refused where the amplitude read is more than 1000 mdeg off, or where
-    /// the swing needs more harmonics than the theory takes.
+    /// takes the phase's fundamental of harmonics `-N ..= N`, into which the rest leak through
+    /// the window; the converged periodic steady state, put through the read-out's own steps,
+    /// gives exactly what it reads, so the error is stated as it is (an estimate from a
+    /// 16-harmonic balance had stated 4.9e4 mdeg where a 785-degree swing read 119 degrees).
+    /// Refused where the amplitude read is more than 1000 mdeg off, or where the swing needs
+    /// more harmonics than the theory takes.
     fn validate_table_harmonics(&self, p: &mut Rules, warnings: &mut Vec<String>) {
         if self.table_harmonics_needed().is_some() {
             return;
@@ -162,54 +163,47 @@ impl Config {
                 ));
                 return;
             };
-            let window = self.plan_point(rate).window;
+            let point = self.plan_point(rate);
             for h in &env {
                 let c = h.len() / 2;
                 let full = gyroemu_mixer::phase_fundamental_fine(h);
-                let read = gyroemu_mixer::phase_fundamental_fine(&h[c - n..=c + n]);
-                // What the harmonics beyond N leak into the N read through a window that is
-                // not whole table periods (a Hann window read 9.2 mdeg where the truncation
-                // alone is 2.0), bounded: each read harmonic's share, divided by the chain's
-                // response there as the read-out divides, over the truncated envelope's
-                // smallest size, through the fundamental (4/pi).
-                let leak = chain.as_ref().map_or(0.0, |chain| {
-                    let resp =
-                        |m: f64| (chain.lowpass(m * freq_hz) * chain.tia(fc + m * freq_hz)).norm();
-                    let fs_out = self.fs_out_hz();
-                    let shares: f64 = (-(n as i64)..=n as i64)
-                        .map(|r| {
-                            let r = r as f64;
-                            (0..h.len())
-                                .map(|i| i as f64 - c as f64)
-                                .filter(|m| m.abs() > n as f64)
-                                .map(|m| {
-                                    h[(m + c as f64) as usize].norm()
-                                        * resp(m)
-                                        * window.response((m - r) * freq_hz / fs_out).norm()
-                                })
-                                .sum::<f64>()
-                                / resp(r)
-                        })
-                        .sum();
-                    let smallest = (0..4096)
-                        .map(|g| {
-                            let theta = core::f64::consts::TAU * g as f64 / 4096.0;
-                            (-(n as i64)..=n as i64)
-                                .map(|r| {
-                                    h[(r + c as i64) as usize]
-                                        * Complex64::from_polar(1.0, r as f64 * theta)
-                                })
-                                .sum::<Complex64>()
-                                .norm()
-                        })
-                        .fold(f64::INFINITY, f64::min);
-                    4.0 / core::f64::consts::PI * (shares / smallest).min(1.0).asin()
-                });
-                // A leak that cannot be weighed is charged at its largest (2 rad).
-                let leak = if leak.is_nan() { 2.0 } else { leak };
-                let a = (read.norm() - full.norm()).abs() / DEG * 1e3 + leak / DEG * 1e3;
-                let l = turn_mdeg(read.arg(), full.arg())
-                    + (leak / full.norm()).min(1.0).asin() / DEG * 1e3;
+                // What the read-out makes of the whole envelope: every harmonic m through
+                // the chain (L(m f_t) H(f_c + m f_t)) and the window's leak K(m - r) into
+                // each read harmonic r, the leak solve within -N ..= N, the chain divided out,
+                // then the fundamental. Exact for any window (the truncation alone, through a
+                // whole-period boxcar; a Hann window's leak of the harmonics beyond read 9.2
+                // mdeg where the truncation is 2.0).
+                let read = chain
+                    .as_ref()
+                    .map_or(Complex64::new(f64::NAN, f64::NAN), |chain| {
+                        let resp =
+                            |m: f64| chain.lowpass(m * freq_hz) * chain.tia(fc + m * freq_hz);
+                        let big = c.div_ceil(2) + n;
+                        let k_all = chain.table_leak(&point, self.n_settle_out(), big);
+                        let avg: Vec<Complex64> = (-(n as i64)..=n as i64)
+                            .map(|r| {
+                                (0..h.len())
+                                    .map(|i| {
+                                        let m = i as i64 - c as i64;
+                                        h[i] * resp(m as f64)
+                                            * k_all[(m - r + 2 * big as i64) as usize]
+                                    })
+                                    .sum()
+                            })
+                            .collect();
+                        let solved = gyroemu_board::unleak_table_harmonics(
+                            &avg,
+                            &chain.table_leak(&point, self.n_settle_out(), n),
+                        );
+                        let v: Vec<Complex64> = solved
+                            .iter()
+                            .enumerate()
+                            .map(|(i, x)| x / resp(i as f64 - n as f64))
+                            .collect();
+                        gyroemu_mixer::phase_fundamental_fine(&v)
+                    });
+                let a = (read.norm() - full.norm()).abs() / DEG * 1e3;
+                let l = turn_mdeg(read.arg(), full.arg());
                 if a.is_nan() || a > amp_err {
                     (amp_err, at) = (a, rate);
                     read_at = (read.norm() / DEG, full.norm() / DEG);
@@ -231,7 +225,7 @@ impl Config {
             ));
         } else if amp_err.max(lag_err) > WARN_HOLD_ERROR_MDEG {
             warnings.push(format!(
-                "experiment.rates_dps: {what}: the amplitudes read are off by up to {amp_err:.3e} mdeg and the lags by up to {lag_err:.3e} mdeg (exactly, over whole table periods of a boxcar; with the leak of the harmonics beyond through any other window, bounded); lower the amplitude or raise experiment.table_freq_hz"
+                "experiment.rates_dps: {what}: the amplitudes read are off by up to {amp_err:.3e} mdeg and the lags by up to {lag_err:.3e} mdeg (the read-out of the whole periodic steady state, the window's leak of the harmonics beyond included); lower the amplitude or raise experiment.table_freq_hz"
             ));
         }
     }

@@ -137,9 +137,10 @@ fn the_boards_fifteen_harmonics_are_warned_with_what_they_miss_or_refused() {
 }
 
 /// Through a Hann window the harmonics beyond 15 leak into the 15 read (9.2 mdeg read where
-/// the truncation alone is 2.0, with nothing said of it): the figure stated bounds the run.
+/// the truncation alone is 2.0, with nothing said of it): the figure stated is the read-out of
+/// the whole periodic steady state, leak and leak solve included, and the run reads it.
 #[test]
-fn a_hann_windows_leak_of_the_harmonics_beyond_is_bounded() {
+fn a_hann_windows_leak_of_the_harmonics_beyond_is_stated_as_read() {
     let mut cfg = fork(0.2, "[600.0]", 5.0);
     cfg.experiment.window = gyroemu_config::WindowKind::Hann;
     let w = cfg.validate().unwrap();
@@ -173,8 +174,12 @@ fn a_hann_windows_leak_of_the_harmonics_beyond_is_bounded() {
         .fold(0.0, f64::max);
     assert!(amp > 2.5, "{amp}");
     assert!(
-        amp <= amp_stated && lag <= lag_stated,
-        "read {amp}, {lag}; stated {amp_stated}, {lag_stated}"
+        (amp - amp_stated).abs() < 1e-2 * amp,
+        "read {amp}, stated {amp_stated}"
+    );
+    assert!(
+        (lag - lag_stated).abs() < 1e-2 * lag + 1e-3,
+        "read {lag}, stated {lag_stated}"
     );
 }
 
