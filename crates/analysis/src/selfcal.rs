@@ -59,15 +59,12 @@ pub fn mode_selfcal(cfg: &Config, rot: &SweepResult, cor: &SweepResult, k: usize
     let mut coriolis = linearised_slope(&cor_rates, &cor_phase);
     // The plain line's R² on the readings' own branch, as a sweep's summary fits them.
     let (rot_cfg, cor_cfg) = sweep_configs(cfg);
-    let on_branch = |ys: &[f64]| fit_line(&rates, &fit_readings(&rot_cfg, &rates, ys, k));
-    rotating.plain_fit = on_branch(&rot_phase);
-    rotating_paper_i.plain_fit = on_branch(&paper);
+    let on_branch = |c: &Config, xs: &[f64], ys: &[f64]| fit_line(xs, &fit_readings(c, xs, ys, k));
+    rotating.plain_fit = on_branch(&rot_cfg, &rates, &rot_phase);
+    rotating_paper_i.plain_fit = on_branch(&rot_cfg, &rates, &paper);
     // A Coriolis phase is known within a whole turn: a step of more than a quarter turn
     // between rates had been moved a half turn (slope -0.0044 for +0.0092).
-    coriolis.plain_fit = fit_line(
-        &cor_rates,
-        &fit_readings(&cor_cfg, &cor_rates, &cor_phase, k),
-    );
+    coriolis.plain_fit = on_branch(&cor_cfg, &cor_rates, &cor_phase);
     let theory = |r: &SweepResult| {
         let ph: Vec<f64> = r.points.iter().map(|p| p.theory_deg[k]).collect();
         linearised_slope(&rates_of(r), &ph).slope_deg_per_dps

@@ -66,6 +66,19 @@ fn node_amplitudes(c: &Config, k: usize) -> [f64; 5] {
     ]
 }
 
+/// Both modes' velocity envelopes on the rate table of amplitude `rate_dps` at `freq_hz`,
+/// converged in harmonics ([`gyroemu_theory::converged_envelopes`]); `None` beyond the
+/// theory's harmonics. What the winding and the harmonics rules weigh.
+fn table_envelopes(
+    dev: &gyroemu_theory::DrivenDevice,
+    rate_dps: f64,
+    freq_hz: f64,
+) -> Option<[Vec<Complex64>; 2]> {
+    gyroemu_theory::converged_envelopes(|m| {
+        dev.rate_table_envelopes(rate_dps.abs() * DEG, freq_hz, m)
+    })
+}
+
 /// |H(f)| / tia_gain_ohm of the TIA as built (its discretised pole, not the analogue one,
 /// whose factor differs where the pole's coefficient rounds); 1 without a pole.
 fn tia_pole_factor(c: &Config, f_hz: f64) -> f64 {
@@ -149,10 +162,7 @@ impl Config {
         let (mut amp_err, mut lag_err, mut at) = (0.0f64, 0.0f64, f64::NAN);
         let mut read_at = (f64::NAN, f64::NAN);
         for &rate in &self.experiment.rates_dps {
-            let envelopes = gyroemu_theory::converged_envelopes(|m| {
-                dev.rate_table_envelopes(rate.abs() * DEG, freq_hz, m)
-            });
-            let Some(env) = envelopes else {
+            let Some(env) = table_envelopes(&dev, rate, freq_hz) else {
                 p.push(ConfigError::key(
                     "experiment.rates_dps",
                     rate,
@@ -242,9 +252,7 @@ impl Config {
         let dev = self.driven_device();
         for &rate in &self.experiment.rates_dps {
             // A swing beyond the theory's harmonics is the harmonics rule's to refuse.
-            let Some(env) = gyroemu_theory::converged_envelopes(|m| {
-                dev.rate_table_envelopes(rate.abs() * DEG, freq_hz, m)
-            }) else {
+            let Some(env) = table_envelopes(&dev, rate, freq_hz) else {
                 continue;
             };
             for (k, h) in env.iter().enumerate() {

@@ -162,30 +162,9 @@ fn theory_change(theory: &dyn Fn(f64) -> f64, x0: f64, x1: f64, period: f64) -> 
 /// read a slope of -0.081 against a theory of +0.0244 while every point matched its theory).
 /// A NaN stays NaN and is stepped over; readings already continuous keep their bits.
 pub fn unwrapped_along(xs: &[f64], ys: &[f64], period: f64) -> Vec<f64> {
-    let mut order: Vec<usize> = (0..xs.len().min(ys.len())).collect();
-    order.sort_by(|&a, &b| xs[a].total_cmp(&xs[b]));
-    let mut out = ys.to_vec();
-    let mut prev: Option<f64> = None;
-    for i in order {
-        let y = ys[i];
-        if !y.is_finite() {
-            continue;
-        }
-        let moved = match prev {
-            Some(p) => {
-                let k = ((p - y) / period).round();
-                if k == 0.0 {
-                    y
-                } else {
-                    y + k * period
-                }
-            }
-            None => y,
-        };
-        out[i] = moved;
-        prev = Some(moved);
-    }
-    out
+    // No theory: each reading against its neighbour alone (a step of 0 where the theory's
+    // change would be).
+    unwrapped_along_theory(xs, ys, period, &|_| f64::NAN)
 }
 
 #[cfg(test)]

@@ -118,12 +118,21 @@ impl<S: Sample> Stage for TableMixer<S> {
 /// gives `-j a e^{-j l}`. Evaluated on 1024 points (the rectangle rule is exact for a periodic
 /// function's harmonics below 512). NaN when `V` winds around 0 (no continuous phase).
 pub fn phase_fundamental(h: &[Complex64]) -> Complex64 {
-    const G: usize = 1024;
-    // The grid's (sin, cos), once per process (the same bits as computing them here).
-    static GRID: std::sync::OnceLock<Box<[(f64, f64); G + 1]>> = std::sync::OnceLock::new();
-    let grid =
-        GRID.get_or_init(|| Box::new(core::array::from_fn(|g| sin_cos_turns(g as f64 / G as f64))));
-    fundamental_on(h, &grid[..]).0
+    fundamental_on(h, grid(1024)).0
+}
+
+/// The `g + 1` points `(sin, cos)` of `2 pi k / g`, `k = 0 ..= g`, for `g` a power of two from
+/// 1024 to 2^18: built once per process (the same bits as computing them here), so a read-out
+/// or a theory curve that checks its fundamental on a finer grid does not recompute its sines.
+fn grid(g: usize) -> &'static [(f64, f64)] {
+    type Grid = std::sync::OnceLock<Box<[(f64, f64)]>>;
+    static GRIDS: [Grid; 9] = [const { Grid::new() }; 9];
+    debug_assert!(g.is_power_of_two() && (1024..=1 << 18).contains(&g));
+    GRIDS[(g.trailing_zeros() - 10) as usize].get_or_init(|| {
+        (0..=g)
+            .map(|k| sin_cos_turns(k as f64 / g as f64))
+            .collect()
+    })
 }
 
 /// Why [`phase_fundamental_checked`] has no fundamental to give.
@@ -148,19 +157,10 @@ pub enum NoFundamental {
 pub fn phase_fundamental_checked(h: &[Complex64]) -> Result<Complex64, NoFundamental> {
     const MAX_GRID: usize = 1 << 18;
     let nh = h.len() / 2;
-    let on = |g: usize| {
-        let grid: Vec<(f64, f64)> = (0..=g)
-            .map(|k| sin_cos_turns(k as f64 / g as f64))
-            .collect();
-        fundamental_on(h, &grid)
-    };
-    let mut g = (16 * nh).next_power_of_two().max(1024);
-    let mut x = if g == 1024 {
-        let (_, step, turns) = on(g);
-        (phase_fundamental(h), step, turns)
-    } else {
-        on(g)
-    };
+    let on = |g: usize| fundamental_on(h, grid(g));
+    let mut g = (16 * nh).next_power_of_two().clamp(1024, MAX_GRID);
+    // At 1024 points, the value is phase_fundamental's: the same grid, the same bits.
+    let mut x = on(g);
     while g < MAX_GRID {
         let finer = on(2 * g);
         let resolved = x.1 < core::f64::consts::FRAC_PI_2 && finer.1 < core::f64::consts::FRAC_PI_2;
