@@ -3,9 +3,11 @@
 //! -> +53.1 deg) is not moved a half turn before the fit (the summary's slope had read -0.19
 //! for +0.42, its intercept -90 deg).
 
+mod common;
+
+use common::finished;
 use gyroemu_config::{presets::preset, Config};
 use gyroemu_experiment::fit::fit_line;
-use gyroemu_experiment::{finish_sweep, run_sweep_with, SweepOptions};
 
 fn high_q() -> Config {
     let mut c = preset("m2tfg-rotating").unwrap();
@@ -20,8 +22,7 @@ fn high_q() -> Config {
 #[test]
 fn a_steep_rotating_sweep_is_fitted_as_its_readings_lie() {
     let cfg = high_q();
-    let run = run_sweep_with(&cfg, &|_, _| {}, None, SweepOptions::default()).unwrap();
-    let res = finish_sweep(&cfg, &run.lanes).unwrap();
+    let res = finished(&cfg);
     assert!(res.problems.is_empty(), "{:?}", res.problems);
     let xs: Vec<f64> = res.points.iter().map(|p| p.rate_dps).collect();
     for k in 0..2 {

@@ -3,8 +3,10 @@
 //! warning (1.7 mdeg at fc/fs = 1.7e-7, 77.5 at 2e-8). The warning's figure is the rounding's
 //! reach, which the emulated error must stay within, and the presets are not warned.
 
+mod common;
+
+use common::{finished, number_after};
 use gyroemu_config::{presets::preset, Config};
-use gyroemu_experiment::{finish_sweep, run_sweep_with, SweepOptions};
 
 /// The Coriolis preset behind a 0.4 Hz low-pass at 240 kHz (fc/fs = 1.7e-6), read at 1 Hz.
 fn narrow() -> Config {
@@ -20,20 +22,14 @@ fn stated(warnings: &[String]) -> Option<f64> {
     let w = warnings
         .iter()
         .find(|w| w.contains("direct-form sections"))?;
-    w.split("by up to about ")
-        .nth(1)?
-        .split(' ')
-        .next()?
-        .parse()
-        .ok()
+    Some(number_after(w, "by up to about "))
 }
 
 #[test]
 fn the_rounding_of_a_narrow_lowpass_is_warned_and_bounds_the_run() {
     let cfg = narrow();
     let warnings = cfg.validate().unwrap();
-    let run = run_sweep_with(&cfg, &|_, _| {}, None, SweepOptions::default()).unwrap();
-    let res = finish_sweep(&cfg, &run.lanes).unwrap();
+    let res = finished(&cfg);
     let moved = res
         .points
         .iter()

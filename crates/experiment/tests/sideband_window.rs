@@ -3,10 +3,12 @@
 //! accepted, then read NaN blaming an overflow), and warned, with the factor the sideband
 //! solve multiplies other errors by, where it is merely ill-conditioned.
 
+mod common;
+
+use common::finished;
 use gyroemu_board::unleak_sidebands;
 use gyroemu_config::{presets::preset, Config, WindowKind};
 use gyroemu_core::Complex64;
-use gyroemu_experiment::{finish_sweep, run_sweep_with, SweepOptions};
 
 /// The rotating preset read at 1 output sample per second behind a 0.49 Hz low-pass, a
 /// Hann window of `average_s`, at 175 deg/s (Omega / 2 pi = 0.486 Hz).
@@ -29,8 +31,7 @@ fn a_one_sample_hann_window_is_refused_where_the_emulation_reads_nothing() {
         "{err}"
     );
     // Past the rule, the emulation has no phase to give for either mode.
-    let run = run_sweep_with(&cfg, &|_, _| {}, None, SweepOptions::default()).unwrap();
-    let res = finish_sweep(&cfg, &run.lanes).unwrap();
+    let res = finished(&cfg);
     assert!(
         res.points[0].phase_deg.iter().all(|p| p.is_nan()),
         "{:?}",

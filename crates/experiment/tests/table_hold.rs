@@ -4,8 +4,10 @@
 //! unequal drives (its +A shift crosses zero at 940 deg/s), and 9.7 mdeg of a detuned
 //! table's amplitude (the hold's images scale the swing, at any rate).
 
+mod common;
+
+use common::{finished, number_after, table_errors_mdeg, warning};
 use gyroemu_config::{parse_config, Config};
-use gyroemu_experiment::{finish_sweep, run_sweep_with, SweepOptions};
 
 fn asymmetric() -> Config {
     parse_config(
@@ -32,36 +34,6 @@ average_s = 3.0003
 "#,
     )
     .unwrap()
-}
-
-/// The stated hold figures (amplitude, lag), mdeg.
-fn stated(warnings: &[String]) -> Option<(f64, f64)> {
-    let w = warnings.iter().find(|w| w.contains("zero-order hold"))?;
-    let after = w.split("by up to ").nth(1)?;
-    let amp = after.split(' ').next()?.parse().ok()?;
-    let lag = after
-        .split("amplitude and ")
-        .nth(1)?
-        .split(' ')
-        .next()?
-        .parse()
-        .ok()?;
-    Some((amp, lag))
-}
-
-/// The largest |reading - theory| of amplitude and lag over the points and modes, mdeg.
-fn moved(cfg: &Config) -> (f64, f64) {
-    let run = run_sweep_with(cfg, &|_, _| {}, None, SweepOptions::default()).unwrap();
-    let res = finish_sweep(cfg, &run.lanes).unwrap();
-    let (mut amp, mut lag) = (0.0f64, 0.0f64);
-    for p in &res.points {
-        let (l, lt) = (p.table_lag_deg.unwrap(), p.table_lag_theory_deg.unwrap());
-        for k in 0..2 {
-            amp = amp.max((p.phase_deg[k] - p.theory_deg[k]).abs() * 1e3);
-            lag = lag.max((l[k] - lt[k]).abs() * 1e3);
-        }
-    }
-    (amp, lag)
 }
 
 /// A Q-50 device at 1 kHz driven 3 half-bandwidths off resonance (1030 Hz), a 40 Hz table,
@@ -117,13 +89,16 @@ average_s = 0.05
 fn the_hold_warning_states_what_the_board_reads() {
     for cfg in [asymmetric(), detuned(), fast()] {
         let warnings = cfg.validate().unwrap();
-        let (amp, lag) = moved(&cfg);
+        let (amp, lag) = table_errors_mdeg(&finished(&cfg));
         // The emulated board reads the hold well above the warning threshold (0.01 mdeg) ...
         assert!(amp > 0.1, "{amp}");
         // ... and the warning gives it: the board's steady state, to what the run's settling
         // and read-out leave (1e-3 of the figure, plus 1e-4 mdeg).
-        let (s_amp, s_lag) =
-            stated(&warnings).unwrap_or_else(|| panic!("no hold warning: {warnings:?}"));
+        let w = warning(&warnings, "zero-order hold");
+        let (s_amp, s_lag) = (
+            number_after(w, "by up to "),
+            number_after(w, "amplitude and "),
+        );
         assert!(
             (s_amp - amp).abs() < 1e-3 * amp + 1e-4,
             "stated {s_amp}, read {amp}"

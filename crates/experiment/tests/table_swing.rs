@@ -3,9 +3,11 @@
 //! swing read as 336), and the board, which demodulates 15 harmonics, is warned with the error
 //! it makes, exactly, or refused where that error passes 1000 mdeg.
 
+mod common;
+
+use common::{finished, number_after, table_errors_mdeg, warning};
 use gyroemu_config::{parse_config, Config};
 use gyroemu_core::Complex64;
-use gyroemu_experiment::{finish_sweep, run_sweep_with, SweepOptions};
 
 /// The fork of the rate-table preset (Q = 36000 at 15 kHz, corner 0.21 Hz) on a slow table.
 fn fork(table_hz: f64, rates: &str, average_s: f64) -> Config {
@@ -83,40 +85,17 @@ fn a_large_swings_theory_converges() {
     );
 }
 
-#[test]
-fn the_boards_fifteen_harmonics_are_warned_with_what_they_miss_or_refused() {
-    // 600 deg/s at 0.2 Hz: 290.6 degrees, read 2 mdeg short through 15 harmonics.
-    let cfg = fork(0.2, "[600.0]", 5.0);
-    let w = cfg.validate().unwrap();
-    let w = w
-        .iter()
-        .find(|w| w.contains("demodulates harmonics"))
-        .unwrap_or_else(|| panic!("not warned: {w:?}"));
-    let after = |key: &str| -> f64 {
-        w.split(key)
-            .nth(1)
-            .unwrap()
-            .split(' ')
-            .next()
-            .unwrap()
-            .parse()
-            .unwrap()
-    };
+/// The harmonics rule's warning on `cfg` states, amplitude and lag, what its run reads (to 1 %,
+/// plus 1e-3 mdeg of lag); the amplitude read passes `at_least` mdeg.
+fn stated_as_read(cfg: &Config, at_least: f64) {
+    let warnings = cfg.validate().unwrap();
+    let w = warning(&warnings, "demodulates harmonics");
     let (amp_stated, lag_stated) = (
-        after("amplitudes read are off by up to "),
-        after("lags by up to "),
+        number_after(w, "amplitudes read are off by up to "),
+        number_after(w, "lags by up to "),
     );
-    let run = run_sweep_with(&cfg, &|_, _| {}, None, SweepOptions::default()).unwrap();
-    let res = finish_sweep(&cfg, &run.lanes).unwrap();
-    let p = &res.points[0];
-    let (l, lt) = (p.table_lag_deg.unwrap(), p.table_lag_theory_deg.unwrap());
-    let amp = (0..2)
-        .map(|k| (p.phase_deg[k] - p.theory_deg[k]).abs() * 1e3)
-        .fold(0.0, f64::max);
-    let lag = (0..2)
-        .map(|k| (l[k] - lt[k]).abs() * 1e3)
-        .fold(0.0, f64::max);
-    assert!(amp > 1.0, "{amp}");
+    let (amp, lag) = table_errors_mdeg(&finished(cfg));
+    assert!(amp > at_least, "{amp}");
     assert!(
         (amp - amp_stated).abs() < 1e-2 * amp,
         "read {amp}, stated {amp_stated}"
@@ -125,6 +104,12 @@ fn the_boards_fifteen_harmonics_are_warned_with_what_they_miss_or_refused() {
         (lag - lag_stated).abs() < 1e-2 * lag + 1e-3,
         "read {lag}, stated {lag_stated}"
     );
+}
+
+#[test]
+fn the_boards_fifteen_harmonics_are_warned_with_what_they_miss_or_refused() {
+    // 600 deg/s at 0.2 Hz: 290.6 degrees, read 2 mdeg short through 15 harmonics.
+    stated_as_read(&fork(0.2, "[600.0]", 5.0), 1.0);
     // 2000 deg/s at 0.05 Hz: the board would read 119 degrees of a 785-degree swing.
     let err = fork(0.05, "[175.0, 2000.0]", 20.0)
         .validate()
@@ -143,44 +128,7 @@ fn the_boards_fifteen_harmonics_are_warned_with_what_they_miss_or_refused() {
 fn a_hann_windows_leak_of_the_harmonics_beyond_is_stated_as_read() {
     let mut cfg = fork(0.2, "[600.0]", 5.0);
     cfg.experiment.window = gyroemu_config::WindowKind::Hann;
-    let w = cfg.validate().unwrap();
-    let w = w
-        .iter()
-        .find(|w| w.contains("demodulates harmonics"))
-        .unwrap_or_else(|| panic!("not warned: {w:?}"));
-    let after = |key: &str| -> f64 {
-        w.split(key)
-            .nth(1)
-            .unwrap()
-            .split(' ')
-            .next()
-            .unwrap()
-            .parse()
-            .unwrap()
-    };
-    let (amp_stated, lag_stated) = (
-        after("amplitudes read are off by up to "),
-        after("lags by up to "),
-    );
-    let run = run_sweep_with(&cfg, &|_, _| {}, None, SweepOptions::default()).unwrap();
-    let res = finish_sweep(&cfg, &run.lanes).unwrap();
-    let p = &res.points[0];
-    let (l, lt) = (p.table_lag_deg.unwrap(), p.table_lag_theory_deg.unwrap());
-    let amp = (0..2)
-        .map(|k| (p.phase_deg[k] - p.theory_deg[k]).abs() * 1e3)
-        .fold(0.0, f64::max);
-    let lag = (0..2)
-        .map(|k| (l[k] - lt[k]).abs() * 1e3)
-        .fold(0.0, f64::max);
-    assert!(amp > 2.5, "{amp}");
-    assert!(
-        (amp - amp_stated).abs() < 1e-2 * amp,
-        "read {amp}, stated {amp_stated}"
-    );
-    assert!(
-        (lag - lag_stated).abs() < 1e-2 * lag + 1e-3,
-        "read {lag}, stated {lag_stated}"
-    );
+    stated_as_read(&cfg, 2.5);
 }
 
 /// A swing whose envelope dips near zero (the rate-table preset with a 1.5 Hz split and
@@ -193,19 +141,9 @@ fn a_dipping_envelope_is_read_on_a_fine_enough_grid() {
     cfg.device.mode2_f0_offset_hz = 1.5;
     cfg.drive.f2 = Some(0.5);
     cfg.experiment.rates_dps = vec![24.25];
-    let w = cfg.validate().unwrap();
-    let hold = w.iter().find(|w| w.contains("zero-order hold")).unwrap();
-    let stated: f64 = hold
-        .split("by up to ")
-        .nth(1)
-        .unwrap()
-        .split(' ')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
-    let run = run_sweep_with(&cfg, &|_, _| {}, None, SweepOptions::default()).unwrap();
-    let p = &finish_sweep(&cfg, &run.lanes).unwrap().points[0];
+    let warnings = cfg.validate().unwrap();
+    let stated = number_after(warning(&warnings, "zero-order hold"), "by up to ");
+    let p = &finished(&cfg).points[0];
     let amp = (p.phase_deg[1] - p.theory_deg[1]).abs() * 1e3;
     assert!(
         (amp - stated).abs() < 0.01,

@@ -2,8 +2,10 @@
 //! refuses it before any sample agrees with the emulation on where that starts, and a run past
 //! the rule says why it has no phase (it had blamed an overflow).
 
+mod common;
+
+use common::finished;
 use gyroemu_config::{presets::preset, Config};
-use gyroemu_experiment::{finish_sweep, run_sweep_with, SweepOptions};
 
 /// The rate-table preset with mode 2 split 1.5 Hz from the carrier (seven half-bandwidths)
 /// and driven at half of mode 1's force: the Coriolis part coupled in from mode 1 outweighs
@@ -57,8 +59,7 @@ fn the_rule_refuses_where_the_emulated_envelope_winds_and_the_run_says_so() {
     // The emulation, past the rule: below, mode 2 reads its theory; above, its envelope went
     // around zero in the emulated run too, and the problem says so, not an overflow.
     let cfg = split(&[below, above]);
-    let run = run_sweep_with(&cfg, &|_, _| {}, None, SweepOptions::default()).unwrap();
-    let res = finish_sweep(&cfg, &run.lanes).unwrap();
+    let res = finished(&cfg);
     let [b, a] = &res.points[..] else {
         panic!("two points")
     };
