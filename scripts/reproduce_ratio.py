@@ -6,8 +6,8 @@
 The prediction is the sum over the experiments of their point-samples (each experiment's
 `summary.json`, `point_samples_emulated`; the bandwidth sweep's are the closing line's total
 less theirs) divided by the bench's `whole chain` rate of the experiment's preset on all
-threads, in the lanes this CPU runs (the best of R runs; the bandwidth sweep at the rate-table
-chain's rate). The bench is run before and after the `reproduce` runs, and the prediction is
+threads, in the lanes a run of that chain uses on this CPU (the row without a lane type; the
+best of R runs; the bandwidth sweep at the rate-table chain's rate). The bench is run before and after the `reproduce` runs, and the prediction is
 their mean: a shared host's speed moves by 10 % or more within minutes. The binaries'
 `reproduce` runs alternate (N each), and each is reported as prediction / wall time, at the
 median and at the best run. The first binary is benched; give the same CPU's binaries only.
@@ -36,10 +36,11 @@ def bench(binary: str, repeats: int) -> dict:
             [binary, "bench", "--preset", preset, "--repeats", str(repeats)],
             check=True, capture_output=True, text=True,
         ).stdout
+        # The row without a lane type is the chain in the lanes a run of it uses on this CPU
+        # (eight, or four where they run faster: `gyroemu_board::max_lanes_for`).
         rows = [line.split() for line in out.splitlines()
-                if re.match(r"whole chain( \(f64x[48]\))? +\d", line)]
-        # The widest lanes' rows on the most threads: what a run uses.
-        rows = [r for r in rows if r[2] == "(f64x8)"] or rows
+                if re.match(r"whole chain +\d", line)]
+        # On the most threads.
         best = max(rows, key=lambda r: int(r[-3]))
         rates[preset] = float(best[-2]) * 1e6
     return rates

@@ -9,7 +9,7 @@ pub use crate::selfcal::drift_pll_design;
 use crate::selfcal::{drifted, run_selfcal_core, sweep_configs};
 use crate::selfcal_combined::{combined_slope, CombinedSlope};
 use crate::slope_fit::{linearised_slope, SlopeFit};
-use gyroemu_board::{lane_groups, max_lanes, GroupBoard, LaneResult, Point, RunOptions};
+use gyroemu_board::{lane_groups, max_lanes_for, GroupBoard, LaneResult, Point, RunOptions};
 use gyroemu_config::{Config, WindowKind};
 use gyroemu_experiment::post_process;
 use gyroemu_experiment::sweep::{add_group_progress, group_samples};
@@ -314,7 +314,8 @@ pub fn tau_analysis(
     let mut groups: Vec<(usize, &[Point])> = Vec::new();
     let mut first = 0;
     let threads = group_threads.unwrap_or_else(rayon::current_num_threads);
-    for size in lane_groups(points.len(), threads, max_lanes()) {
+    let params = rot.board_params();
+    for size in lane_groups(points.len(), threads, max_lanes_for(&params)) {
         groups.push((first, &points[first..first + size]));
         first += size;
     }
@@ -322,7 +323,6 @@ pub fn tau_analysis(
     // canonical four-lane grouping the results report, so it ends at 100 %.
     let total: u64 = groups.iter().map(|(_, g)| group_samples(&rot, g)).sum();
     let done = AtomicU64::new(0);
-    let params = rot.board_params();
     let mut boards = Vec::new();
     for (first, g) in &groups {
         let r: Vec<f64> = g.iter().map(|p| p.rate_rad_s).collect();

@@ -71,6 +71,8 @@ pub fn stepped_sine_work(cfg: &Config) -> Work {
         point_samples: 2 * n as u64 * per_run,
         longest_s: per_run as f64 / cfg.fs_hz(),
         longest_samples: per_run,
+        // One point per run: a group of four lanes.
+        longest_lanes: 4,
     }
 }
 

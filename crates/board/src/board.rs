@@ -319,8 +319,7 @@ impl<S: Sample> Board<S> {
         };
         let (sigma_force, sigma_current) = noise_sigmas(p);
         let adc = build_adc(p)?.map(|q| [q, q]);
-        let imperfect =
-            p.noise.is_some() || adc.is_some() || p.dac.is_some() || p.tia.rail_v.is_some();
+        let imperfect = p.imperfect();
         let eps = p.phase_shifter_error_deg.to_radians();
         let mod_shift = (p.shape.is_rotating() && eps != 0.0)
             .then(|| (S::splat(eps.cos()), S::splat(eps.sin())));

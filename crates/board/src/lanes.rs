@@ -1,8 +1,11 @@
 //! How wide a lane group is: eight points in `F64x8` lanes on a CPU with AVX-512, four in
 //! `f64x4` lanes elsewhere (or when a process limits itself to four: `--lanes 4`, for tests and
-//! benchmarks). Each lane is its own point, so no result depends on the width or the grouping;
-//! the width is a speed choice made at run time.
+//! benchmarks). On a CPU that runs each 512-bit operation as two 256-bit halves (AMD Zen 4),
+//! eight lanes gain on some chains and lose on others, so there the width is chosen per chain
+//! ([`max_lanes_for`]). Each lane is its own point, so no result depends on the width or the
+//! grouping; the width is a speed choice made at run time.
 
+use crate::params::BoardParams;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The widest lane group (`F64x8`).
@@ -12,8 +15,11 @@ pub const MAX_LANES: usize = 8;
 /// `canonical_work`), the same on every CPU whatever width actually ran.
 pub const CANONICAL_LANES: usize = 4;
 
-/// The widest group this process may use ([`set_max_lanes`]).
-static LIMIT: AtomicUsize = AtomicUsize::new(MAX_LANES);
+/// `--lanes` not given: the width is chosen per chain ([`max_lanes_for`]).
+const AUTO: usize = 0;
+
+/// The widest group this process may use ([`set_max_lanes`]): [`AUTO`], 4 or 8.
+static LIMIT: AtomicUsize = AtomicUsize::new(AUTO);
 
 /// The CPU runs eight-lane groups (AVX-512 F, VL, DQ and BW).
 pub fn eight_lanes_available() -> bool {
@@ -27,9 +33,9 @@ pub fn eight_lanes_available() -> bool {
     }
 }
 
-/// Limits this process's lane groups to `lanes` (4 or 8; 8 only on a CPU that runs eight):
-/// how `gyroemu --lanes 4|8` compares the two widths (tests, benchmarks). A refusal names the
-/// value and the rule, and changes nothing.
+/// Sets this process's lane groups to `lanes` (4 or 8; 8 only on a CPU that runs eight) for
+/// every chain, in place of the choice per chain: how `gyroemu --lanes 4|8` compares the two
+/// widths (tests, benchmarks). A refusal names the value and the rule, and changes nothing.
 pub fn set_max_lanes(lanes: usize) -> Result<(), String> {
     match lanes {
         4 => {}
@@ -44,12 +50,99 @@ pub fn set_max_lanes(lanes: usize) -> Result<(), String> {
     Ok(())
 }
 
-/// The widest lane group this process runs: 8 on a CPU with AVX-512 (unless limited), else 4.
+/// The widest lane group this process can run: 8 on a CPU with AVX-512 (unless limited to
+/// 4), else 4. What a given chain runs in is [`max_lanes_for`].
 pub fn max_lanes() -> usize {
-    if LIMIT.load(Ordering::Relaxed) >= 8 && eight_lanes_available() {
+    if LIMIT.load(Ordering::Relaxed) != 4 && eight_lanes_available() {
         8
     } else {
         4
+    }
+}
+
+/// The widest lane group a board of `p` runs in on this CPU: [`max_lanes`], except on a CPU
+/// that splits 512-bit operations in halves ([`halves_512`]), where the noiseless rotating
+/// chain runs in four lanes unless `--lanes 8` asks for eight. Measured there (AMD EPYC
+/// family 25 model 17, docs/performance.md, twenty-seventh session), eight lanes against four
+/// on one thread: the noiseless rotating chain 0.88x to 0.99x (0.88x to 0.95x on two
+/// threads, and `reproduce` 6 % longer), the Coriolis chain 1.14x, the rate-table chain
+/// 1.17x, every chain with noise and converters 1.07x to 1.19x.
+pub fn max_lanes_for(p: &BoardParams) -> usize {
+    LaneCpu::this().lanes_for(p)
+}
+
+/// What the choice of a lane width knows of the CPU and the process.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LaneCpu {
+    /// The widest group the process can run ([`max_lanes`]: 4 or 8).
+    pub widest: usize,
+    /// `--lanes 8` asks for eight lanes on every chain.
+    pub forced_eight: bool,
+    /// The CPU runs 512-bit operations as two halves ([`halves_512`]).
+    pub halves_512: bool,
+}
+
+impl LaneCpu {
+    /// This process on this CPU.
+    pub fn this() -> Self {
+        Self {
+            widest: max_lanes(),
+            forced_eight: LIMIT.load(Ordering::Relaxed) == 8,
+            halves_512: halves_512(),
+        }
+    }
+
+    /// The widest lane group a board of `p` runs in ([`max_lanes_for`]): four where the CPU
+    /// splits 512-bit operations and the chain is the rotating excitation with no noise
+    /// source, converter or rail (the board's ideal loop), unless eight are forced.
+    pub fn lanes_for(self, p: &BoardParams) -> usize {
+        let four_faster = self.halves_512 && p.shape.is_rotating() && !p.imperfect();
+        if self.widest == 8 && four_faster && !self.forced_eight {
+            4
+        } else {
+            self.widest
+        }
+    }
+}
+
+/// The CPU has AVX-512 and runs each 512-bit operation as two 256-bit halves: AMD family
+/// 19h (Zen 4; its Zen 3 parts lack AVX-512). Zen 5 (family 1Ah) and Intel's cores run them
+/// whole.
+pub fn halves_512() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        static HALVES: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+        *HALVES.get_or_init(|| {
+            // Leaves 0 and 1 exist on every x86-64 CPU.
+            use core::arch::x86_64::__cpuid;
+            let (v, f) = (__cpuid(0), __cpuid(1).eax);
+            let vendor = [v.ebx, v.edx, v.ecx];
+            eight_lanes_available() && is_amd(vendor) && family(f) == 0x19
+        })
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// CPUID leaf 0's vendor words (EBX, EDX, ECX) spell "AuthenticAMD".
+fn is_amd(words: [u32; 3]) -> bool {
+    let mut name = [0u8; 12];
+    for (k, w) in words.iter().enumerate() {
+        name[4 * k..4 * k + 4].copy_from_slice(&w.to_le_bytes());
+    }
+    &name == b"AuthenticAMD"
+}
+
+/// The CPU family of CPUID leaf 1's EAX: the base family, plus the extended family when the
+/// base is 0Fh (the rule of both vendors' manuals).
+fn family(eax: u32) -> u32 {
+    let base = (eax >> 8) & 0xF;
+    if base == 0xF {
+        base + ((eax >> 20) & 0xFF)
+    } else {
+        base
     }
 }
 
@@ -117,21 +210,37 @@ pub fn groups_by_length(samples: &[u64], width: usize) -> Vec<usize> {
     sizes
 }
 
-/// The sizes of the lane groups of points whose runs are `samples` input samples (longest
-/// first) for `threads` threads: cut by the runs ([`groups_by_length`]) on one thread (a
-/// thread of a pool shared with other work), else to keep every thread busy
-/// ([`lane_groups`]); each at most [`max_lanes`].
-pub fn group_sizes(samples: &[u64], threads: usize) -> Vec<usize> {
+/// The sizes of the lane groups of points of a board of `p` whose runs are `samples` input
+/// samples (longest first) for `threads` threads: cut by the runs ([`groups_by_length`]) on one
+/// thread (a thread of a pool shared with other work), else to keep every thread busy
+/// ([`lane_groups`]); each at most [`max_lanes_for`] `p`.
+pub fn group_sizes(p: &BoardParams, samples: &[u64], threads: usize) -> Vec<usize> {
+    let width = max_lanes_for(p);
     if threads == 1 {
-        groups_by_length(samples, max_lanes())
+        groups_by_length(samples, width)
     } else {
-        lane_groups(samples.len(), threads, max_lanes())
+        lane_groups(samples.len(), threads, width)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cpuid_words_decode_to_vendor_and_family() {
+        // Leaf 0's EBX, EDX, ECX of each vendor.
+        assert!(is_amd([0x6874_7541, 0x6974_6e65, 0x444d_4163]));
+        assert!(!is_amd([0x756e_6547, 0x4965_6e69, 0x6c65_746e]));
+        // Leaf 1's EAX: Zen 4 EPYC 9004 (family 19h model 11h), Zen 5 (1Ah model 02h),
+        // Zen 3 (19h model 01h), an Intel Sapphire Rapids (6, model 8Fh) and a 486-era base
+        // family 4 whose extended bits must be ignored.
+        assert_eq!(family(0x00A1_0F11), 0x19);
+        assert_eq!(family(0x00B0_0F20), 0x1A);
+        assert_eq!(family(0x00A0_0F11), 0x19);
+        assert_eq!(family(0x0008_06F8), 6);
+        assert_eq!(family(0x0FF0_0400), 4);
+    }
 
     #[test]
     fn groups_cover_the_points_fill_the_threads_and_fit_their_width() {

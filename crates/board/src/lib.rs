@@ -31,8 +31,8 @@ pub use fault::NonFinite;
 pub use group::GroupBoard;
 pub use health::Health;
 pub use lanes::{
-    eight_lanes_available, group_sizes, groups_by_length, lane_groups, max_lanes, set_max_lanes,
-    CANONICAL_LANES, FOUR_LANE_COST, MAX_LANES,
+    eight_lanes_available, group_sizes, groups_by_length, halves_512, lane_groups, max_lanes,
+    max_lanes_for, set_max_lanes, LaneCpu, CANONICAL_LANES, FOUR_LANE_COST, MAX_LANES,
 };
 pub use lock::{lock_carrier, LockRun, LockSample};
 pub use params::{BoardParams, Converter, NoiseParams, Shape};

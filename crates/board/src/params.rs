@@ -156,6 +156,15 @@ impl BoardParams {
         self.plant.fs_hz / self.decimation as f64
     }
 
+    /// The board runs its imperfect sample loop: a noise source, a converter or a TIA rail is
+    /// on (the loop that also counts clipped and zero samples).
+    pub fn imperfect(&self) -> bool {
+        self.noise.is_some()
+            || self.adc.is_some()
+            || self.dac.is_some()
+            || self.tia.rail_v.is_some()
+    }
+
     /// Checks every parameter by building each stage once (so the rules are the stages' own),
     /// plus the board's: decimation >= 1, a finite shifter error within (-90, 90) degrees, a
     /// table frequency > 0, finite noise densities >= 0.

@@ -130,3 +130,86 @@ fn a_bad_lane_count_is_refused_not_a_panic() {
     assert!(Board::<f64x4>::new(&p, &[], &[]).is_err());
     assert!(Board::<f64x4>::new(&p, &[0.0], &[0, 1]).is_err());
 }
+
+/// The width per chain: four only for the ideal rotating loop on a CPU that splits 512-bit
+/// operations, and only when eight are not forced; every other chain, and every chain on
+/// another CPU, runs the widest the process can.
+#[test]
+fn the_lane_width_is_four_only_for_the_ideal_rotating_loop_on_split_512_bit_units() {
+    use gyroemu_board::{Converter, LaneCpu};
+    let shapes = [
+        Shape::Coriolis,
+        Shape::RateTable { freq_hz: 2.0 },
+        Shape::Rotating,
+    ];
+    for shape in shapes {
+        let ideal = m2tfg(shape);
+        // Each part of the imperfect loop alone turns it on.
+        let mut dac = ideal;
+        dac.dac = Some(Converter {
+            bits: 16,
+            full_scale: 1.5,
+        });
+        let mut adc = ideal;
+        adc.adc = Some(Converter {
+            bits: 16,
+            full_scale: 0.1,
+        });
+        let mut rail = ideal;
+        rail.tia.rail_v = Some(5.0);
+        let mut noise = noisy(ideal, 1);
+        noise.adc = None;
+        noise.dac = None;
+        for (name, p) in [
+            ("ideal", &ideal),
+            ("dac", &dac),
+            ("adc", &adc),
+            ("rail", &rail),
+            ("noise", &noise),
+        ] {
+            assert_eq!(p.imperfect(), name != "ideal", "{name}");
+            for widest in [4, 8] {
+                for forced_eight in [false, widest == 8] {
+                    for halves_512 in [false, true] {
+                        let cpu = LaneCpu {
+                            widest,
+                            forced_eight,
+                            halves_512,
+                        };
+                        let four = widest == 4
+                            || (halves_512
+                                && !forced_eight
+                                && shape.is_rotating()
+                                && name == "ideal");
+                        let want = if four { 4 } else { 8 };
+                        assert_eq!(cpu.lanes_for(p), want, "{shape:?} {name} {cpu:?}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// CPUID's answer agrees with the kernel's: a CPU splits 512-bit operations when it runs
+/// eight lanes and `/proc/cpuinfo` names an AMD of family 25 (19h, Zen 4).
+#[test]
+fn split_512_bit_units_are_what_proc_cpuinfo_says() {
+    let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") else {
+        return;
+    };
+    let field = |key: &str| {
+        info.lines()
+            .find(|l| l.split(':').next().map(str::trim) == Some(key))
+            .and_then(|l| l.split(':').nth(1))
+            .map(|v| v.trim().to_string())
+    };
+    let (Some(vendor), Some(family)) = (field("vendor_id"), field("cpu family")) else {
+        return;
+    };
+    let zen4 = vendor == "AuthenticAMD" && family == "25";
+    assert_eq!(
+        gyroemu_board::halves_512(),
+        zen4 && eight_lanes_available(),
+        "{vendor} family {family}"
+    );
+}

@@ -39,8 +39,9 @@ struct Cli {
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long, global = true)]
     threads: Option<usize>,
-    /// For tests and benchmarks: the widest lane group, 4 or 8 operating points (default: 8
-    /// on a CPU with AVX-512, else 4). Results do not depend on it.
+    /// For tests and benchmarks: the widest lane group, 4 or 8 operating points, for every
+    /// chain (default: chosen per chain, 8 on a CPU with AVX-512 except where 4 run faster,
+    /// else 4). Results do not depend on it.
     #[arg(long, global = true, hide = true)]
     lanes: Option<usize>,
     #[command(subcommand)]

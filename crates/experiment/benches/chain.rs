@@ -1,13 +1,13 @@
 //! divan benchmarks of the board (`cargo bench -p gyroemu-experiment`): the whole fused chain
-//! in the lanes this CPU runs (eight operating points per group in f64x8 lanes with AVX-512,
-//! else four in f64x4) on one lane group and on one group per core, noiseless and with every
+//! in the lanes this CPU runs it in (eight operating points per group in f64x8 lanes with
+//! AVX-512, else four in f64x4; `gyroemu_board::max_lanes_for`) on one lane group and on one group per core, noiseless and with every
 //! noise source, DAC and ADC on. Throughput is reported in
 //! point-samples (one input sample of one operating point). `gyroemu bench` prints the same
 //! chain figure and each stage alone.
 
 use divan::counter::ItemsCount;
 use divan::{black_box, Bencher};
-use gyroemu_board::{max_lanes, GroupBoard, Point, RunOptions};
+use gyroemu_board::{max_lanes_for, GroupBoard, Point, RunOptions};
 use gyroemu_config::presets::preset;
 use gyroemu_config::Config;
 use gyroemu_lpf::Window;
@@ -32,7 +32,7 @@ fn rotating(noise: bool) -> Config {
 /// Runs `groups` lane groups of N_IN samples each, one per rayon worker.
 fn run_groups(b: Bencher, noise: bool, groups: usize) {
     let cfg = rotating(noise);
-    let lanes = max_lanes();
+    let lanes = max_lanes_for(&cfg.board_params());
     let listed = &cfg.experiment.rates_dps;
     let rates: Vec<f64> = (0..lanes)
         .map(|i| listed[i % listed.len()].to_radians())

@@ -2,7 +2,7 @@
 //! and on all threads, and each stage alone. Used by `gyroemu bench` and the criterion-free
 //! benchmark; timing lives here, never in tests.
 
-use gyroemu_board::{max_lanes, GroupBoard, Point, RunOptions};
+use gyroemu_board::{max_lanes, max_lanes_for, GroupBoard, Point, RunOptions};
 use gyroemu_config::Config;
 use gyroemu_core::{f64x4, Sample, Stage};
 use gyroemu_lpf::Window;
@@ -90,9 +90,9 @@ pub fn with_flicker(cfg: &Config) -> Config {
 }
 
 /// Runs `groups` lane groups of `n_in` input samples each, spread over the rayon pool, in the
-/// lanes this CPU runs ([`max_lanes`]); returns point-samples per second.
+/// lanes this CPU runs `cfg`'s chain in ([`max_lanes_for`]); returns point-samples per second.
 pub fn chain(cfg: &Config, n_in: u64, groups: usize) -> f64 {
-    chain_in(max_lanes(), cfg, n_in, groups)
+    chain_in(max_lanes_for(&cfg.board_params()), cfg, n_in, groups)
 }
 
 /// [`chain`] in groups of `width` lanes (4, or 8 on a CPU with AVX-512), every lane in use.
@@ -171,10 +171,10 @@ impl Stage for DecoupledPlant {
 }
 
 /// Every figure, each the best and the median of `repeats` runs, on 1 thread and on all
-/// threads: the chain, noiseless, with noise and with noise and flicker, in the lanes this CPU
-/// runs (rows `whole chain`, `whole chain with noise`, `whole chain with noise and flicker`),
-/// then in each lane type it can run (the same rows with `(f64x4)` or `(f64x8)`), then each
-/// stage.
+/// threads: the chain, noiseless, with noise and with noise and flicker, each in the lanes this
+/// CPU runs it in (rows `whole chain`, `whole chain with noise`, `whole chain with noise and
+/// flicker`), then in each lane type it can run (the same rows with `(f64x4)` or `(f64x8)`),
+/// then each stage.
 pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     use gyroemu_am::{AmInput, AmModulator, DrivePattern};
     use gyroemu_lpf::{LowPass, LowPassBank, LowPassDesign};
@@ -193,21 +193,21 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
         }
     };
     // The chain in every lane type this CPU runs; the rows without a lane type repeat the
-    // figures of the type a run uses here ([`max_lanes`]).
+    // figures of the type a run of that chain uses here ([`max_lanes_for`]).
     let noisy = with_noise(cfg);
     let flickering = with_flicker(cfg);
-    let native = max_lanes();
+    let chains = [
+        ("whole chain", cfg),
+        ("whole chain with noise", &noisy),
+        ("whole chain with noise and flicker", &flickering),
+    ];
     let mut widths = vec![4];
-    if native == 8 {
+    if max_lanes() == 8 {
         widths.push(8);
     }
     let mut typed = Vec::new();
     for &w in &widths {
-        for (label, c) in [
-            ("whole chain", cfg),
-            ("whole chain with noise", &noisy),
-            ("whole chain with noise and flicker", &flickering),
-        ] {
+        for (label, c) in chains {
             let name = format!("{label} ({})", lane_type(w));
             typed.push(row(&name, 1, &mut || chain_in(w, c, n_in, 1)));
             if threads > 1 {
@@ -215,15 +215,14 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
             }
         }
     }
-    let suffix = format!(" ({})", lane_type(native));
-    let mut out: Vec<Throughput> = typed
-        .iter()
-        .filter(|r| r.name.ends_with(&suffix))
-        .map(|r| Throughput {
-            name: r.name.replace(&suffix, ""),
+    let mut out = Vec::new();
+    for (label, c) in chains {
+        let name = format!("{label} ({})", lane_type(max_lanes_for(&c.board_params())));
+        out.extend(typed.iter().filter(|r| r.name == name).map(|r| Throughput {
+            name: label.into(),
             ..r.clone()
-        })
-        .collect();
+        }));
+    }
     out.extend(typed);
     let mut push_n = |name: &str, threads: usize, measure: &mut dyn FnMut() -> f64| {
         out.push(row(name, threads, measure));

@@ -96,19 +96,19 @@ impl<'a> PreparedSweep<'a> {
             .as_ref()
             .map(|(_, d)| d.start_s + d.duration_s.max(d.decimated_duration_s));
         let (lanes, packing) = lanes_of(cfg, &todo, &plan, opts.split && whole_run, dump_end_s);
+        let params = cfg.board_params();
         let groups = pack(&lanes, packing, &|set| {
             let runs: Vec<u64> = set
                 .iter()
                 .map(|l| cfg.n_settle_out() + l.window.samples())
                 .collect();
-            group_sizes(&runs, threads)
+            group_sizes(&params, &runs, threads)
         });
         let mut lanes_per_point: BTreeMap<usize, usize> = BTreeMap::new();
         for l in &lanes {
             *lanes_per_point.entry(l.point).or_default() += 1;
         }
         let stop = Arc::new(AtomicBool::new(false));
-        let params = cfg.board_params();
         let m = cfg.decimation() as u64;
         let mut boards = Vec::with_capacity(groups.len());
         for g in &groups {

@@ -122,7 +122,7 @@ impl<'c> PreparedTables<'c> {
                 .iter()
                 .map(|j| n_settle + j.point.window.samples())
                 .collect();
-            for size in group_sizes(&runs, threads) {
+            for size in group_sizes(key, &runs, threads) {
                 let (g, r) = rest.split_at(size);
                 rest = r;
                 // The board demodulates the most harmonics any of its lanes needs; a lane's

@@ -25,6 +25,8 @@ pub struct Work {
     /// The longest point's run in input samples: one lane group runs them in sequence on one
     /// thread, however many threads there are.
     pub longest_samples: u64,
+    /// The lanes of the group that runs the longest point on this CPU (4 or 8).
+    pub longest_lanes: usize,
 }
 
 impl Work {
@@ -36,6 +38,13 @@ impl Work {
             point_samples: self.point_samples.saturating_add(o.point_samples),
             longest_s: self.longest_s.max(o.longest_s),
             longest_samples: self.longest_samples.max(o.longest_samples),
+            longest_lanes: if o.longest_samples > self.longest_samples {
+                o.longest_lanes
+            } else if self.longest_samples > o.longest_samples {
+                self.longest_lanes
+            } else {
+                self.longest_lanes.max(o.longest_lanes)
+            },
         }
     }
 
@@ -54,7 +63,7 @@ impl Work {
             return "no operating point to run".into();
         }
         let time = point_samples_per_s.map_or(String::new(), |r| {
-            let lanes = gyroemu_board::max_lanes();
+            let lanes = self.longest_lanes.max(1);
             let even = self.point_samples as f64 / r;
             let per_thread = r / rayon::current_num_threads() as f64;
             let longest = self.longest_samples as f64 * lanes as f64 / per_thread;
@@ -135,6 +144,12 @@ pub fn points_work(cfg: &Config, indices: &[usize]) -> Work {
         point_samples,
         longest_s: (cfg.n_settle_out() + longest) as f64 / cfg.fs_out_hz(),
         longest_samples: (cfg.n_settle_out() + longest) * cfg.decimation() as u64,
+        // Up to four points run in a group of four (`GroupBoard::new`).
+        longest_lanes: if points.len() <= 4 {
+            4
+        } else {
+            gyroemu_board::max_lanes_for(&cfg.board_params())
+        },
     }
 }
 
@@ -161,6 +176,7 @@ mod tests {
             point_samples: u64::MAX - 1,
             longest_s: 1.0,
             longest_samples: 10,
+            longest_lanes: 8,
         };
         let w = huge.plus(huge);
         assert_eq!((w.points, w.point_samples), (usize::MAX, u64::MAX));
@@ -170,5 +186,23 @@ mod tests {
         let e = w.check_cap_with(false, "lower sweep.points").unwrap_err();
         assert!(e.contains("; lower sweep.points, or add --force"), "{e}");
         assert!(!e.contains("experiment.average_s"), "{e}");
+    }
+
+    #[test]
+    fn the_longest_point_keeps_the_lanes_of_its_own_group() {
+        let w = |longest_samples, longest_lanes| Work {
+            points: 8,
+            point_samples: 80,
+            longest_s: 1.0,
+            longest_samples,
+            longest_lanes,
+        };
+        assert_eq!(w(10, 8).plus(w(20, 4)).longest_lanes, 4);
+        assert_eq!(w(20, 4).plus(w(10, 8)).longest_lanes, 4);
+        assert_eq!(w(20, 8).plus(w(10, 4)).longest_lanes, 8);
+        assert_eq!(w(10, 4).plus(w(10, 8)).longest_lanes, 8);
+        // The time bound: 20 samples in four lanes at 4 point-samples/s on one thread.
+        let s = w(20, 4).summary(Some(4.0 * rayon::current_num_threads() as f64));
+        assert!(s.contains("lane groups of up to 4"), "{s}");
     }
 }

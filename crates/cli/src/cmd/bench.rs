@@ -25,18 +25,26 @@ pub fn bench_command(preset_name: &str, samples: u64, repeats: usize) -> Result<
         ))
         .into());
     }
-    let lanes = gyroemu_board::max_lanes();
-    let lane_type = gyroemu_experiment::bench::lane_type;
-    let typed = if lanes == 8 {
+    use gyroemu_experiment::bench::{lane_type, with_flicker, with_noise};
+    let typed = if gyroemu_board::max_lanes() == 8 {
         "rows marked (f64x4) and (f64x8): groups of 4 and 8"
     } else {
         "rows marked (f64x4): the same"
     };
+    // Each chain in the lanes a run of it uses on this CPU (they differ by chain where the
+    // CPU runs 512-bit operations in halves).
+    let widths: Vec<String> = [cfg.clone(), with_noise(&cfg), with_flicker(&cfg)]
+        .iter()
+        .map(|c| {
+            let lanes = gyroemu_board::max_lanes_for(&c.board_params());
+            format!("{lanes} points in {}", lane_type(lanes))
+        })
+        .collect();
     note!(
         "bench: preset {preset_name}, fs = {} Hz, {samples} input samples per lane group, best and median of {repeats} runs; \
-         whole chain: {lanes} operating points per group in {} lanes (what a run uses on this CPU), {typed}; stages: 4 lanes",
+         whole chain (noiseless / with noise / with noise and flicker): {} per group (what a run uses on this CPU), {typed}; stages: 4 lanes",
         cfg.fs_hz(),
-        lane_type(lanes)
+        widths.join(" / ")
     );
     print_out(&format!(
         "{:<48} {:>7} {:>10} {:>10}\n",
