@@ -63,10 +63,10 @@ pub fn max_lanes() -> usize {
 /// The widest lane group a board of `p` runs in on this CPU: [`max_lanes`], except on a CPU
 /// that splits 512-bit operations in halves ([`halves_512`]), where the noiseless rotating
 /// chain runs in four lanes unless `--lanes 8` asks for eight. Measured there (AMD EPYC
-/// family 25 model 17, docs/performance.md, twenty-seventh session), eight lanes against four
-/// on one thread: the noiseless rotating chain 0.88x to 0.99x (0.88x to 0.95x on two
-/// threads, and `reproduce` 6 % longer), the Coriolis chain 1.14x, the rate-table chain
-/// 1.17x, every chain with noise and converters 1.07x to 1.19x.
+/// family 25 model 17, docs/performance.md, twenty-seventh session), eight lanes against four,
+/// both threads busy (alternating `run`s of 16 points): the noiseless rotating chain 0.93x at
+/// the best run (`reproduce` 5 % longer), the Coriolis chain 1.06x, the rate-table chain
+/// 1.08x; the bench's chains with noise and converters 1.07x to 1.19x.
 pub fn max_lanes_for(p: &BoardParams) -> usize {
     LaneCpu::this().lanes_for(p)
 }
