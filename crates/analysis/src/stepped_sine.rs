@@ -72,7 +72,7 @@ pub fn stepped_sine_work(cfg: &Config) -> Work {
         longest_s: per_run as f64 / cfg.fs_hz(),
         longest_samples: per_run,
         // One point per run: a group of four lanes.
-        longest_lanes: 4,
+        widest_lanes: 4,
     }
 }
 

@@ -25,7 +25,10 @@ enum Lanes {
 }
 
 /// The lanes [`GroupBoard::new`] runs `n` points in: four for up to four, else the widest
-/// this process runs.
+/// this process runs. The sweeps size their groups by the chain's width
+/// ([`crate::max_lanes_for`]), so a group of more than four reaches here only where eight are
+/// the chain's width; five to eight points handed in by other callers (tests) get eight
+/// lanes on any chain rather than a refusal.
 fn width_for(n: usize) -> usize {
     if n <= 4 {
         4

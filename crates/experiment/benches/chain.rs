@@ -1,9 +1,9 @@
 //! divan benchmarks of the board (`cargo bench -p gyroemu-experiment`): the whole fused chain
 //! in the lanes this CPU runs it in (eight operating points per group in f64x8 lanes with
-//! AVX-512, else four in f64x4; `gyroemu_board::max_lanes_for`) on one lane group and on one group per core, noiseless and with every
-//! noise source, DAC and ADC on. Throughput is reported in
-//! point-samples (one input sample of one operating point). `gyroemu bench` prints the same
-//! chain figure and each stage alone.
+//! AVX-512, else four in f64x4; `gyroemu_board::max_lanes_for`) on one lane group and on one
+//! group per core, noiseless and with every noise source, DAC and ADC on. Throughput is
+//! reported in point-samples (one input sample of one operating point). `gyroemu bench` prints
+//! the same chain figure and each stage alone.
 
 use divan::counter::ItemsCount;
 use divan::{black_box, Bencher};

@@ -25,8 +25,10 @@ pub struct Work {
     /// The longest point's run in input samples: one lane group runs them in sequence on one
     /// thread, however many threads there are.
     pub longest_samples: u64,
-    /// The lanes of the group that runs the longest point on this CPU (4 or 8).
-    pub longest_lanes: usize,
+    /// The widest lane group any of the work may run in on this CPU (4 or 8: the chain's
+    /// [`gyroemu_board::max_lanes_for`]): an upper bound, as the plan says it ("lane groups of
+    /// up to ..."), for the lanes beside the longest point.
+    pub widest_lanes: usize,
 }
 
 impl Work {
@@ -38,13 +40,7 @@ impl Work {
             point_samples: self.point_samples.saturating_add(o.point_samples),
             longest_s: self.longest_s.max(o.longest_s),
             longest_samples: self.longest_samples.max(o.longest_samples),
-            longest_lanes: if o.longest_samples > self.longest_samples {
-                o.longest_lanes
-            } else if self.longest_samples > o.longest_samples {
-                self.longest_lanes
-            } else {
-                self.longest_lanes.max(o.longest_lanes)
-            },
+            widest_lanes: self.widest_lanes.max(o.widest_lanes),
         }
     }
 
@@ -63,7 +59,7 @@ impl Work {
             return "no operating point to run".into();
         }
         let time = point_samples_per_s.map_or(String::new(), |r| {
-            let lanes = self.longest_lanes.max(1);
+            let lanes = self.widest_lanes.max(1);
             let even = self.point_samples as f64 / r;
             let per_thread = r / rayon::current_num_threads() as f64;
             let longest = self.longest_samples as f64 * lanes as f64 / per_thread;
@@ -144,12 +140,7 @@ pub fn points_work(cfg: &Config, indices: &[usize]) -> Work {
         point_samples,
         longest_s: (cfg.n_settle_out() + longest) as f64 / cfg.fs_out_hz(),
         longest_samples: (cfg.n_settle_out() + longest) * cfg.decimation() as u64,
-        // Up to four points run in a group of four (`GroupBoard::new`).
-        longest_lanes: if points.len() <= 4 {
-            4
-        } else {
-            gyroemu_board::max_lanes_for(&cfg.board_params())
-        },
+        widest_lanes: gyroemu_board::max_lanes_for(&cfg.board_params()),
     }
 }
 
@@ -176,7 +167,7 @@ mod tests {
             point_samples: u64::MAX - 1,
             longest_s: 1.0,
             longest_samples: 10,
-            longest_lanes: 8,
+            widest_lanes: 8,
         };
         let w = huge.plus(huge);
         assert_eq!((w.points, w.point_samples), (usize::MAX, u64::MAX));
@@ -189,20 +180,22 @@ mod tests {
     }
 
     #[test]
-    fn the_longest_point_keeps_the_lanes_of_its_own_group() {
-        let w = |longest_samples, longest_lanes| Work {
+    fn the_plan_states_the_widest_lanes_of_all_its_work() {
+        let w = |widest_lanes| Work {
             points: 8,
             point_samples: 80,
             longest_s: 1.0,
-            longest_samples,
-            longest_lanes,
+            longest_samples: 20,
+            widest_lanes,
         };
-        assert_eq!(w(10, 8).plus(w(20, 4)).longest_lanes, 4);
-        assert_eq!(w(20, 4).plus(w(10, 8)).longest_lanes, 4);
-        assert_eq!(w(20, 8).plus(w(10, 4)).longest_lanes, 8);
-        assert_eq!(w(10, 4).plus(w(10, 8)).longest_lanes, 8);
-        // The time bound: 20 samples in four lanes at 4 point-samples/s on one thread.
-        let s = w(20, 4).summary(Some(4.0 * rayon::current_num_threads() as f64));
+        assert_eq!(w(4).plus(w(8)).widest_lanes, 8);
+        assert_eq!(w(8).plus(w(4)).widest_lanes, 8);
+        assert_eq!(w(4).plus(w(4)).widest_lanes, 4);
+        // The time bound: 20 samples in groups of up to 4 lanes at 4 point-samples/s per
+        // thread take 20 s on one thread, above the 8 / (4 * threads) s of an even spread.
+        let t = rayon::current_num_threads() as f64;
+        let s = w(4).summary(Some(4.0 * t));
         assert!(s.contains("lane groups of up to 4"), "{s}");
+        assert!(s.contains("about 20.000 s"), "{s}");
     }
 }

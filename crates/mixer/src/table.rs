@@ -299,6 +299,35 @@ mod tests {
         r.map(|z| (z.re.to_bits(), z.im.to_bits()))
     }
 
+    /// The identity the reuse rests on: each finer grid's phases are the coarser grid's at its
+    /// even points and its own odd points' in between, bit for bit.
+    #[test]
+    fn a_finer_grid_holds_the_coarser_grids_phases_at_its_even_points() {
+        for (nh, base) in [(1, 1.001), (5, 3.0), (24, 1.05), (96, 0.98)] {
+            let mut h = vec![Complex64::new(0.0, 0.0); 2 * nh + 1];
+            for (i, x) in h.iter_mut().enumerate() {
+                let n = i as f64 - nh as f64;
+                *x = Complex64::new((1.3 * n).sin(), (0.7 * n).cos()) * 1e-3 / (1.0 + n * n);
+            }
+            h[nh] += base;
+            h[nh + 1] += 1.0;
+            for g in [1024, 2048, 8192, 1 << 17] {
+                let coarse = phases_on(&h, grid(g));
+                let fine = phases_on(&h, grid(2 * g));
+                let odd: Vec<(f64, f64)> = grid(2 * g).iter().skip(1).step_by(2).copied().collect();
+                let odd = phases_on(&h, &odd);
+                for k in 0..=2 * g {
+                    let want = if k % 2 == 0 {
+                        coarse[k / 2]
+                    } else {
+                        odd[k / 2]
+                    };
+                    assert_eq!(fine[k].to_bits(), want.to_bits(), "{nh} {g} {k}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn reusing_the_coarser_grid_gives_the_bits_of_every_level_whole() {
         let mut seed = 0x9E37_79B9_7F4A_7C15u64;
