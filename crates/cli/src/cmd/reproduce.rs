@@ -23,7 +23,7 @@ pub fn reproduce_command(out: &Path, quick: bool) -> Result<()> {
     prepare_out(out)?;
     let _lock = lock_out(out, &command_line(), LockScope::Folder, &Terminal)?;
     let _preset_locks = lock_subfolders(out, &plan.preset_folders(), &command_line(), &Terminal)?;
-    let rate = gyroemu_experiment::work::measured_throughput(plan.first_config());
+    let rate = gyroemu_experiment::work::measured_throughput(plan.heaviest_config());
     note!("{}", plan.work().describe(Some(rate)));
     let files = reproduce(&plan, out, &Terminal)?;
     list_written(out, &files);
