@@ -395,21 +395,10 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
     // Groups of eight exist on a CPU with AVX-512 only; the rows without a lane type are the
     // figures of the type a run of that chain uses, which the header names per chain: the
     // widest, except four for the noiseless rotating chain (the default preset's) where the
-    // CPU splits 512-bit operations: an AMD of family 25 (Zen 4), as /proc/cpuinfo says.
+    // CPU splits 512-bit operations (`halves_512`, which the board crate's tests check
+    // against /proc/cpuinfo).
     let eight = gyroemu(&["--lanes", "8", "config"]).status.success();
     let widest = if eight { "f64x8" } else { "f64x4" };
-    let info = std::fs::read_to_string("/proc/cpuinfo").ok();
-    let field = |key: &str| {
-        info.as_deref()?
-            .lines()
-            .find(|l| l.split(':').next().map(str::trim) == Some(key))
-            .and_then(|l| l.split(':').nth(1))
-            .map(|v| v.trim().to_string())
-    };
-    let zen4 = match (field("vendor_id"), field("cpu family")) {
-        (Some(v), Some(f)) => Some(v == "AuthenticAMD" && f == "25"),
-        _ => None,
-    };
     let natives = |err: &str| -> Vec<String> {
         let at = err
             .find("with noise and flicker): ")
@@ -422,12 +411,12 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
     };
     let native = natives(&stderr(&o));
     assert_eq!(native.len(), 3, "{}", stderr(&o));
-    match zen4 {
-        Some(true) => assert_eq!(native[0], "f64x4", "{native:?}"),
-        Some(false) => assert_eq!(native[0], widest, "{native:?}"),
-        // No /proc/cpuinfo: either is right for some CPU.
-        None => assert!(native[0] == "f64x4" || native[0] == widest, "{native:?}"),
-    }
+    let want = if gyroemu_board::halves_512() {
+        "f64x4"
+    } else {
+        widest
+    };
+    assert_eq!(native[0], want, "{native:?}");
     assert_eq!(native[1..], [widest, widest], "{}", stderr(&o));
     // `--lanes 8` runs every chain in eight lanes, `--lanes 4` in four.
     let short = ["bench", "--samples", "20000", "--repeats", "1"];

@@ -177,16 +177,29 @@ pub fn phase_fundamental_checked(h: &[Complex64]) -> Result<Complex64, NoFundame
         }
         both.push(phases[g]);
         let finer = fundamental_of(&both, fine);
-        let resolved = x.1 < core::f64::consts::FRAC_PI_2 && finer.1 < core::f64::consts::FRAC_PI_2;
-        if resolved && x.2 && finer.2 {
-            return Err(NoFundamental::Winds);
-        }
-        if resolved && !x.2 && !finer.2 && (finer.0 - x.0).norm() <= 1e-9 * finer.0.norm() + 1e-13 {
-            return Ok(x.0);
+        if let Some(found) = settled(x, finer) {
+            return found;
         }
         (x, g, phases) = (finer, 2 * g, both);
     }
     Err(NoFundamental::Unresolved)
+}
+
+/// What two successive grids' fundamentals (value, largest phase step, turned) say: winding
+/// where both resolve every step and both turned, the coarser value where both resolve, neither
+/// turned and they agree to 1e-9 of the value (plus 1e-13 rad), else nothing yet.
+fn settled(
+    x: (Complex64, f64, bool),
+    finer: (Complex64, f64, bool),
+) -> Option<Result<Complex64, NoFundamental>> {
+    let resolved = x.1 < core::f64::consts::FRAC_PI_2 && finer.1 < core::f64::consts::FRAC_PI_2;
+    if resolved && x.2 && finer.2 {
+        return Some(Err(NoFundamental::Winds));
+    }
+    if resolved && !x.2 && !finer.2 && (finer.0 - x.0).norm() <= 1e-9 * finer.0.norm() + 1e-13 {
+        return Some(Ok(x.0));
+    }
+    None
 }
 
 /// [`phase_fundamental_checked`], NaN where it has none.
@@ -269,7 +282,8 @@ fn envelope_on_grid(h: &[Complex64], grid: &[(f64, f64)]) -> Vec<Complex64> {
 mod tests {
     use super::*;
 
-    /// [`phase_fundamental_checked`] as it was first written: every level evaluated whole.
+    /// [`phase_fundamental_checked`] as it was first written: every level evaluated whole
+    /// (the same decision between levels, [`settled`]).
     fn checked_level_by_level(h: &[Complex64]) -> Result<Complex64, NoFundamental> {
         const MAX_GRID: usize = 1 << 18;
         let nh = h.len() / 2;
@@ -278,17 +292,8 @@ mod tests {
         let mut x = on(g);
         while g < MAX_GRID {
             let finer = on(2 * g);
-            let resolved =
-                x.1 < core::f64::consts::FRAC_PI_2 && finer.1 < core::f64::consts::FRAC_PI_2;
-            if resolved && x.2 && finer.2 {
-                return Err(NoFundamental::Winds);
-            }
-            if resolved
-                && !x.2
-                && !finer.2
-                && (finer.0 - x.0).norm() <= 1e-9 * finer.0.norm() + 1e-13
-            {
-                return Ok(x.0);
+            if let Some(found) = settled(x, finer) {
+                return found;
             }
             (x, g) = (finer, 2 * g);
         }
