@@ -49,11 +49,18 @@ pub enum Packing {
 /// when `split` is asked and the sweep can be split, else one whole point per lane. A sweep
 /// is split when: its points have boxcar windows on a constant-rate or rotating board without
 /// noise (a rate table counts its phase from sample 0; a noisy point's segments would draw
-/// other streams than the point), settling at least the default time; `k`, the smallest
-/// number of segments that fills whole groups of eight lanes (`8 / gcd(points, 8)`), times
-/// the largest whole factor that keeps the longest point's segments at least
-/// [`MIN_SEGMENT_SETTLES`] settling times long (at most [`MAX_SEGMENTS`]), is above 1; and the
-/// dump (ending at `dump_end_s` from the start of its run) fits in its point's first segment.
+/// other streams than the point), settling at least the default time; the dump (ending at
+/// `dump_end_s` from the start of its run) fits in its point's first segment; and either
+/// - `k`, the smallest number of segments that fills whole groups of eight lanes
+///   (`8 / gcd(points, 8)`), times the largest whole factor that keeps the longest point's
+///   segments at least [`MIN_SEGMENT_SETTLES`] settling times long (at most
+///   [`MAX_SEGMENTS`]), is above 1 (long points: every thread and lane busy), or
+/// - failing that, cutting each point into the fewest segments that fill whole groups of
+///   four (`4 / gcd(points, 4)`, segments that may share any group) runs at least
+///   [`MIN_IDLE_SAVING`] fewer lane-samples than the whole points do with their groups' idle
+///   lanes ([`lane_samples_in_fours`]): Fig. 5's seven BAW points, 1 s each, run as 28
+///   segments in seven full groups of four instead of groups of four and three.
+///
 /// A dump that does not fit keeps the sweep whole: its bits are then a continuous run's, not a
 /// split one's (a dump of the first second, as `reproduce` records, always fits).
 pub fn lanes_of(
@@ -72,7 +79,7 @@ pub fn lanes_of(
                 start_block: 0,
                 window: plan(i).window,
             })
-            .collect();
+            .collect::<Vec<_>>();
         (lanes, Packing::SameStart)
     };
     if !split || todo.is_empty() || !splittable(cfg) {
@@ -93,16 +100,42 @@ pub fn lanes_of(
     let fill = (MAX_LANES / gcd(todo.len(), MAX_LANES)) as u64;
     let most = longest / (MIN_SEGMENT_SETTLES.saturating_mul(settle));
     let k = fill * (most / fill).min(MAX_SEGMENTS / fill);
-    if k < 2 {
-        return whole();
-    }
-    let (len, packing) = segment_length(cfg, longest.div_ceil(k));
+    let (len, packing) = if k >= 2 {
+        segment_length(cfg, longest.div_ceil(k))
+    } else {
+        // Whole points leave lanes of their groups idle; segments that fill groups of four
+        // settle anew. The cut is the same on every machine (groups of four on all).
+        let fours = (4 / gcd(todo.len(), 4)) as u64;
+        if fours < 2 || longest < fours {
+            return whole();
+        }
+        let (len, packing) = segment_length(cfg, longest.div_ceil(fours));
+        let n_settle = cfg.n_settle_out();
+        let (w, _) = whole();
+        let before = lane_samples_in_fours(&w, n_settle);
+        let after = lane_samples_in_fours(&cut(todo, &windows, len), n_settle);
+        let saves = after.saturating_add(before / MIN_IDLE_SAVING) <= before;
+        if packing != Packing::Free || !saves {
+            return whole();
+        }
+        (len, packing)
+    };
     let first_end_s = (cfg.n_settle_out() + len) as f64 / cfg.fs_out_hz();
     if dump_end_s.is_some_and(|e| e > first_end_s) {
         return whole();
     }
+    (cut(todo, &windows, len), packing)
+}
+
+/// A split for idle lanes is taken only if it runs at least 1/this fewer lane-samples (a
+/// smaller gain is not worth other bits than the whole points').
+pub const MIN_IDLE_SAVING: u64 = 32;
+
+/// The points `todo` (boxcar windows `windows`: decimated samples and fractional end) cut
+/// into segments of `len` decimated samples, the last of each point shorter.
+fn cut(todo: &[usize], windows: &[(u64, f64)], len: u64) -> Vec<Lane> {
     let mut lanes = Vec::new();
-    for (&i, &(n, frac)) in todo.iter().zip(&windows) {
+    for (&i, &(n, frac)) in todo.iter().zip(windows) {
         let mut a = 0;
         let mut segment = 0;
         while a < n || (a == n && segment == 0) {
@@ -122,7 +155,19 @@ pub fn lanes_of(
             a = b;
         }
     }
-    (lanes, packing)
+    lanes
+}
+
+/// The decimated samples `lanes` occupy in groups of four, longest first, each group running
+/// `n_settle` plus its longest window, idle lanes included: what they cost where a lane group
+/// of four runs at the cost of four lanes, whatever its lanes do.
+pub fn lane_samples_in_fours(lanes: &[Lane], n_settle: u64) -> u64 {
+    let mut runs: Vec<u64> = lanes
+        .iter()
+        .map(|l| n_settle + l.window.samples())
+        .collect();
+    runs.sort_unstable_by(|a, b| b.cmp(a));
+    runs.chunks(4).map(|g| 4 * g[0]).sum()
 }
 
 /// A board `cfg` describes runs segments that start late (constant rate or rotating, no
@@ -339,6 +384,107 @@ mod tests {
         let mut table = preset("m2tfg-ratetable").unwrap();
         table.experiment.average_s = 2000.0;
         assert!(whole(&table, None));
+    }
+
+    #[test]
+    fn fig5s_seven_points_split_into_four_segments_that_fill_groups_of_four() {
+        // Seven BAW points of 1.02 s, settling 20 ms: too short for 64 settling times a
+        // segment, so they would run whole in groups of four and three (one lane in eight
+        // idle). Four segments each settle anew (3 x 20 ms more per point) and fill seven
+        // groups of four: 7.4 % fewer lane-samples.
+        let cfg = preset("baw-rotating").unwrap();
+        let (lanes, packing) = lanes(&cfg, true, None);
+        assert_eq!(packing, Packing::Free);
+        check_tiling(&cfg, &lanes);
+        assert_eq!(lanes.len(), 28);
+        for i in 0..7 {
+            assert_eq!(
+                lanes.iter().filter(|l| l.point == i).count(),
+                4,
+                "point {i}"
+            );
+        }
+        let settle = cfg.n_settle_out();
+        let (whole, _) = lanes_of(
+            &cfg,
+            &(0..7).collect::<Vec<_>>(),
+            &|i| cfg.plan_point(cfg.emulated_rates_dps()[i]),
+            false,
+            None,
+        );
+        let (before, after) = (
+            lane_samples_in_fours(&whole, settle),
+            lane_samples_in_fours(&lanes, settle),
+        );
+        // 8 (s + L) against 28 (s + L / 4), L = 50.5 s for s the settling.
+        let (s, l) = (settle as f64, whole[0].window.samples() as f64);
+        let want = 1.0 - (28.0 * (s + l / 4.0)) / (8.0 * (s + l));
+        let got = 1.0 - after as f64 / before as f64;
+        assert!((got - want).abs() < 1e-3 && got > 0.07, "{got} {want}");
+        // Every start shares the carrier, so any segments share a group.
+        let m = cfg.decimation() as u64;
+        let starts: Vec<u64> = lanes.iter().map(|l| l.start_block * m).collect();
+        assert!(starts_share_carrier(&cfg.board_params(), &starts));
+    }
+
+    #[test]
+    fn idle_lanes_are_filled_only_where_that_saves_lane_samples() {
+        let base = preset("baw-rotating").unwrap();
+        let whole = |cfg: &Config| {
+            let (l, _) = lanes(cfg, true, None);
+            l.iter().all(|l| l.segment == 0) && l.len() == cfg.emulated_rates_dps().len()
+        };
+        assert!(!whole(&base));
+        // Eight points fill their groups of four: nothing to gain.
+        let mut eight = base.clone();
+        eight.experiment.rates_dps.push(1440.0);
+        assert!(whole(&eight));
+        // Six points (groups of four and two) take two segments each, twelve lanes.
+        let mut six = base.clone();
+        six.experiment.rates_dps.truncate(6);
+        let (l, _) = lanes(&six, true, None);
+        assert_eq!(l.len(), 12);
+        // Windows of 10 settling times (seven faster rates, so that 0.2 s covers half their
+        // modulation period): four segments would add three settlings a point, more than the
+        // idle lanes cost (28 x 3.5 against 8 x 11 settling times).
+        let mut short = base.clone();
+        short.experiment.rates_dps = (0..7).map(|i| 1800.0 + 360.0 * f64::from(i)).collect();
+        short.experiment.average_s = 10.0 * base.settle_s();
+        if let Err(e) = short.validate() {
+            panic!("{e}");
+        }
+        assert!(whole(&short));
+        // Twenty settling times save nothing (28 x 6 = 8 x 21): whole too; forty save 6 %
+        // (28 x 11 against 8 x 41).
+        short.experiment.average_s = 20.0 * base.settle_s();
+        assert!(whole(&short));
+        short.experiment.average_s = 40.0 * base.settle_s();
+        assert!(!whole(&short));
+        // Fig. 9 --quick (15 s, settling 0.71 s): four segments would save 0.6 %, under 1/32.
+        let mut quick = preset("m2tfg-rotating").unwrap();
+        quick.experiment.average_s = 15.0;
+        assert!(whole(&quick));
+        // A carrier whose phase does not repeat: segments could share a group only with
+        // those that start with them, so they cannot fill the idle lanes.
+        let mut odd = base.clone();
+        odd.drive.carrier_hz = Some(odd.device.f0_hz + 0.1);
+        odd.validate().unwrap();
+        assert!(whole(&odd));
+    }
+
+    #[test]
+    fn lane_samples_in_fours_count_each_group_at_its_longest_lane() {
+        let lane = |n: u64| Lane {
+            point: 0,
+            segment: 0,
+            start_block: 0,
+            window: Window::Boxcar { n, frac: 0.0 },
+        };
+        // A boxcar of n runs n + 1 samples (its fractional end): after a settling of 2,
+        // (13, 12, 11, 10) and (9), longest first.
+        let lanes: Vec<Lane> = [7, 10, 6, 9, 8].into_iter().map(lane).collect();
+        assert_eq!(lane_samples_in_fours(&lanes, 2), 4 * 13 + 4 * 9);
+        assert_eq!(lane_samples_in_fours(&[], 2), 0);
     }
 
     #[test]

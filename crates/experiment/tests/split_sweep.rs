@@ -107,6 +107,39 @@ fn segments_that_cannot_share_a_group_read_the_whole_ones_phases_too() {
     reads_the_whole_ones_phases(&cfg);
 }
 
+/// [`rotating`] with three rates and 3 s of averaging (30 settling times): too short for
+/// segments of 64 settling times, so it is cut to fill its idle lane instead: segments of
+/// about 0.75 s (four of the longest window, three of a shorter one whose whole modulation
+/// periods end within three), eleven lanes in three groups of four, against one group of
+/// four at 3.1 s per lane whole.
+fn rotating_three() -> Config {
+    let mut c = rotating();
+    c.experiment.rates_dps = vec![100.0, 140.0, 175.0];
+    c.experiment.average_s = 3.0;
+    c.validate().unwrap();
+    c
+}
+
+#[test]
+fn a_sweep_split_to_fill_its_idle_lanes_reads_the_phases_of_the_whole_one() {
+    // The share of the start transient (6e-11 of the response, tau = 4.2 ms) in a 0.75 s
+    // segment's average is 3.4e-13: within the tolerance of a whole sweep's.
+    let cfg = rotating_three();
+    let rates = cfg.emulated_rates_dps();
+    let (lanes, _) = gyroemu_experiment::split::lanes_of(
+        &cfg,
+        &[0, 1, 2],
+        &|i| cfg.plan_point(rates[i]),
+        true,
+        None,
+    );
+    assert_eq!(lanes.len(), 11);
+    reads_the_whole_ones_phases(&cfg);
+    // And its bits do not depend on how its lanes are grouped.
+    let one = sweep(&cfg, split(1));
+    assert_eq!(one.lanes, sweep(&cfg, split(3)).lanes);
+}
+
 #[test]
 fn a_split_sweeps_bits_do_not_depend_on_how_its_lanes_are_grouped() {
     let cfg = rotating();
