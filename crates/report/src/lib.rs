@@ -21,4 +21,4 @@ pub use freq_sweep_report::{write_freq_sweep, FREQ_SWEEP_COLUMNS, FREQ_SWEEP_FIL
 pub use montecarlo_report::{write_lot, LOT_FILES};
 pub use reproduce::{plan_reproduce, reproduce, ReproducePlan};
 pub use selfcal_report::{write_selfcal, SelfcalFiles, SELFCAL_ANALYSIS_FILES};
-pub use sweep_report::{health_json, run_title, write_run, RUN_FILES};
+pub use sweep_report::{health_json, run_title, write_run, write_run_with, RUN_FILES};

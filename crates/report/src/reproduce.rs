@@ -5,7 +5,7 @@ use crate::dump_figures::write_dump_figures;
 use crate::dump_set::read_dump_set;
 use crate::error::{check_problems, create_dir, ReportError};
 use crate::sweep_report::{
-    fit_series, line_span, phases, sweep_figure, theory_abscissae, theory_series, write_run,
+    fit_series, line_span, phases, sweep_figure, theory_abscissae, theory_series, write_run_with,
 };
 use gyroemu_analysis::bandwidth::{
     bandwidth_configs, bandwidth_points, BandwidthPoint, BANDWIDTH_AMPLITUDE_DPS,
@@ -96,6 +96,8 @@ struct Job {
     preset: &'static str,
     title: &'static str,
     cfg: Config,
+    /// The config's validation warnings (the plan's, for its `summary.json`).
+    warnings: Vec<String>,
 }
 
 /// What `reproduce` checked before running: every experiment's config, validated.
@@ -169,6 +171,7 @@ pub fn plan_reproduce(quick: bool) -> Result<ReproducePlan, ReportError> {
             preset: name,
             title,
             cfg,
+            warnings: Vec::new(),
         });
     }
     // Every config validated in parallel before the first sample (the rate-table rules alone
@@ -185,9 +188,10 @@ pub fn plan_reproduce(quick: bool) -> Result<ReproducePlan, ReportError> {
         || bandwidth_configs(rt_cfg),
     );
     let mut warnings = Vec::new();
-    for (job, found) in jobs.iter().zip(checked) {
+    for (job, found) in jobs.iter_mut().zip(checked) {
+        job.warnings = found?;
         let name = job.preset;
-        warnings.extend(found?.into_iter().map(|w| format!("{name}: {w}")));
+        warnings.extend(job.warnings.iter().map(|w| format!("{name}: {w}")));
     }
     let bandwidth = bandwidth?;
     Ok(ReproducePlan {
@@ -520,14 +524,17 @@ fn write_job(
     r: &SweepResult,
 ) -> Result<(Vec<PathBuf>, Option<PathBuf>), ReportError> {
     let dir = out.join(job.preset);
+    // One figure for both files (its theory overlay is a harmonic balance per abscissa on a
+    // rate table), and the plan's validation for the summary's warnings.
+    let plot = sweep_figure(&job.cfg, r, job.title);
     // In parallel: the last experiment to finish has the pool to itself.
     let (run, figure) = rayon::join(
-        || write_run(&dir, &job.cfg, &job.cfg, r, job.title),
+        || write_run_with(&dir, &job.cfg, Ok(job.warnings.clone()), r, &plot),
         || -> Result<_, ReportError> {
             let Some(name) = figure_name(job.preset) else {
                 return Ok(None);
             };
-            let mut f = sweep_figure(&job.cfg, r, job.title);
+            let mut f = plot.clone();
             if let Some(paper) = paper_i_series(r) {
                 f = f.with(paper);
             }
@@ -651,12 +658,10 @@ mod tests {
             let cfg = preset(job.preset).unwrap();
             assert_eq!(job.cfg, cfg, "{}", job.preset);
             let name = job.preset;
-            warnings.extend(
-                cfg.validate()
-                    .unwrap()
-                    .into_iter()
-                    .map(|w| format!("{name}: {w}")),
-            );
+            let own = cfg.validate().unwrap();
+            // Each job keeps its own, which its `summary.json` gives.
+            assert_eq!(job.warnings, own, "{name}");
+            warnings.extend(own.into_iter().map(|w| format!("{name}: {w}")));
         }
         assert_eq!(plan.warnings, warnings);
         let rt = preset("m2tfg-ratetable").unwrap();

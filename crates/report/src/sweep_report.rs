@@ -84,6 +84,16 @@ pub fn results_table(r: &SweepResult) -> CsvTable {
 /// `cfg` is the config the sweep ran (a `[pll]`'s held carrier in place of the section),
 /// `judged` the one whose validation warnings stderr gave before the run (the user's).
 pub fn summary(cfg: &Config, judged: &Config, r: &SweepResult) -> serde_json::Value {
+    summary_with(cfg, judged.validate(), r)
+}
+
+/// [`summary`] with the judged config's validation already done (`validated`: its warnings,
+/// or the error that stopped it).
+pub fn summary_with(
+    cfg: &Config,
+    validated: Result<Vec<String>, gyroemu_config::ConfigError>,
+    r: &SweepResult,
+) -> serde_json::Value {
     let fit = |k: usize| {
         json!({
             "slope_deg_per_dps": r.fit[k].slope,
@@ -110,7 +120,7 @@ pub fn summary(cfg: &Config, judged: &Config, r: &SweepResult) -> serde_json::Va
         "point_samples_emulated": r.point_samples,
         "converter_counts": health_json(&r.health),
         "problems": r.problems,
-        "warnings": with_config_warnings(judged.validate(), &r.warnings),
+        "warnings": with_config_warnings(validated, &r.warnings),
         "config": cfg,
     })
 }
@@ -371,11 +381,23 @@ pub fn write_run(
     r: &SweepResult,
     title: &str,
 ) -> Result<Vec<PathBuf>, ReportError> {
+    write_run_with(dir, cfg, judged.validate(), r, &sweep_figure(cfg, r, title))
+}
+
+/// [`write_run`] with the judged config's validation already done (`validated`, as
+/// [`summary_with`] takes it) and the run's figure drawn (`figure`, [`sweep_figure`]'s).
+pub fn write_run_with(
+    dir: &Path,
+    cfg: &Config,
+    validated: Result<Vec<String>, gyroemu_config::ConfigError>,
+    r: &SweepResult,
+    figure: &Figure,
+) -> Result<Vec<PathBuf>, ReportError> {
     create_dir(dir)?;
     let [csv, json, png] = RUN_FILES.map(|f| dir.join(f));
     write_csv(&csv, &results_table(r))?;
-    write_json(&json, &summary(cfg, judged, r))?;
-    render_png(&sweep_figure(cfg, r, title), &png)?;
+    write_json(&json, &summary_with(cfg, validated, r))?;
+    render_png(figure, &png)?;
     Ok(vec![csv, json, png])
 }
 
