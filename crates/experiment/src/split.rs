@@ -57,8 +57,8 @@ pub enum Packing {
 ///   [`MAX_SEGMENTS`]), is above 1 (long points: every thread and lane busy), or
 /// - failing that, cutting each point into the fewest segments that fill whole groups of
 ///   four (`4 / gcd(points, 4)`, segments that may share any group) runs at least
-///   [`MIN_IDLE_SAVING`] fewer lane-samples than the whole points do with their groups' idle
-///   lanes ([`lane_samples_in_fours`]): Fig. 5's seven BAW points, 1 s each, run as 28
+///   1/[`MIN_IDLE_SAVING`] fewer lane-samples than the whole points do with their groups'
+///   idle lanes ([`lane_samples_in_fours`]): Fig. 5's seven BAW points, 1 s each, run as 28
 ///   segments in seven full groups of four instead of groups of four and three.
 ///
 /// A dump that does not fit keeps the sweep whole: its bits are then a continuous run's, not a
