@@ -9,6 +9,7 @@ use crate::plan::DEG;
 use crate::rules::Rules;
 use gyroemu_board::{ChainResponse, Shape};
 use gyroemu_core::{Complex64, Response};
+use gyroemu_mixer::NoFundamental;
 use gyroemu_resonator::continuous_steady_state;
 
 /// |a - b| in mdeg within a half turn: a phase and the same plus 180 degrees read alike (the
@@ -79,6 +80,53 @@ fn table_envelopes(
     })
 }
 
+/// A rate table's periodic steady states ([`Config::table_states`]): per rate, both modes'
+/// velocity envelopes and their checked phase fundamentals, `None` beyond the theory's
+/// harmonics.
+struct TableStates {
+    freq_hz: f64,
+    rates: Vec<(f64, Option<TableState>)>,
+}
+
+/// Both modes' envelopes at one rate, each with its checked phase fundamental.
+type TableState = [(Vec<Complex64>, Result<Complex64, NoFundamental>); 2];
+
+/// A rate table whose swing takes a mode's velocity envelope around zero within a table
+/// period: its phase then turns a whole turn per period and has no lag to read, so the
+/// run could only refuse that mode's reading after every sample (it did, blaming an
+/// overflow: a 1.5 Hz mode split with drive.f2 = 0.5 at 100 deg/s). The exact periodic
+/// steady state (`tables`, `None` off a rate table) says so before the run; the first such
+/// rate and mode are named.
+fn validate_table_winding(tables: Option<&TableStates>) -> Result<(), ConfigError> {
+    let Some(tables) = tables else {
+        return Ok(());
+    };
+    let freq_hz = tables.freq_hz;
+    for (rate, state) in &tables.rates {
+        // A swing beyond the theory's harmonics is the harmonics rule's to refuse.
+        let Some(state) = state else {
+            continue;
+        };
+        for (k, (_, fundamental)) in state.iter().enumerate() {
+            let what = match fundamental {
+                Ok(_) => continue,
+                Err(NoFundamental::Winds) => "passes around zero once per table period",
+                Err(NoFundamental::Unresolved) => "passes so near zero once per table period that its phase turns by nearly a half turn within 1e-5 of the period, and its fundamental cannot be resolved",
+            };
+            let drive = ["drive.f1", "drive.f2"][k];
+            return Err(ConfigError::key(
+                "experiment.rates_dps",
+                *rate,
+                format!(
+                    "at this rate-table amplitude mode {}'s velocity envelope (its phasor at the carrier, exact periodic steady state) {what} ({freq_hz} Hz): what the rate couples in from the other mode outweighs the mode's own driven response at the swing's peaks, so there is no lag or amplitude to read; lower the amplitude, raise {drive}, or bring the mode nearer the carrier",
+                    k + 1
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// |H(f)| / tia_gain_ohm of the TIA as built (its discretised pole, not the analogue one,
 /// whose factor differs where the pole's coefficient rounds); 1 without a pole.
 fn tia_pole_factor(c: &Config, f_hz: f64) -> f64 {
@@ -112,8 +160,11 @@ impl Config {
         }
         // The table's rules weigh its frequency and window: only once those keys are valid.
         let table_keys = ["experiment.table_freq_hz", "experiment.average_s"];
+        // Both table rules weigh the same periodic steady states: computed once.
+        let mut tables = None;
         if p.clean(&table_keys) {
-            if let Err(e) = self.validate_table_winding() {
+            tables = self.table_states();
+            if let Err(e) = validate_table_winding(tables.as_ref()) {
                 p.push(e);
                 return;
             }
@@ -136,7 +187,9 @@ impl Config {
         self.validate_mixer_product(warnings);
         self.validate_lowpass_rounding(warnings);
         if p.clean(&table_keys) {
-            self.validate_table_harmonics(p, warnings);
+            // Clean now, so clean before (a rule only adds errors): the states are there.
+            let tables = tables.or_else(|| self.table_states());
+            self.validate_table_harmonics(p, warnings, tables.as_ref());
         }
         self.validate_hold(p, warnings);
     }
@@ -148,21 +201,27 @@ impl Config {
     /// 16-harmonic balance had stated 4.9e4 mdeg where a 785-degree swing read 119 degrees).
     /// Refused where the amplitude read is more than 1000 mdeg off, or where the swing needs
     /// more harmonics than the theory takes.
-    fn validate_table_harmonics(&self, p: &mut Rules, warnings: &mut Vec<String>) {
+    fn validate_table_harmonics(
+        &self,
+        p: &mut Rules,
+        warnings: &mut Vec<String>,
+        tables: Option<&TableStates>,
+    ) {
         if self.table_harmonics_needed().is_some() {
             return;
         }
-        let Shape::RateTable { freq_hz } = self.shape() else {
+        let Some(tables) = tables else {
             return;
         };
+        let freq_hz = tables.freq_hz;
         let n = self.table_harmonics();
-        let dev = self.driven_device();
         let chain = gyroemu_board::ChainResponse::new(&self.board_params()).ok();
         let fc = self.carrier_hz();
         let (mut amp_err, mut lag_err, mut at) = (0.0f64, 0.0f64, f64::NAN);
         let mut read_at = (f64::NAN, f64::NAN);
-        for &rate in &self.experiment.rates_dps {
-            let Some(env) = table_envelopes(&dev, rate, freq_hz) else {
+        for (rate, state) in &tables.rates {
+            let rate = *rate;
+            let Some(state) = state else {
                 p.push(ConfigError::key(
                     "experiment.rates_dps",
                     rate,
@@ -174,22 +233,31 @@ impl Config {
                 return;
             };
             let point = self.plan_point(rate);
-            for h in &env {
+            // The window's leak K(d) for |d| up to 2 big, once for both modes: its middle,
+            // |d| <= 2N, is the leak the read-out solves (the same sums, the same bits).
+            let big = state
+                .iter()
+                .map(|(h, _)| (h.len() / 2).div_ceil(2))
+                .max()
+                .unwrap_or(0)
+                + n;
+            let k_all = chain
+                .as_ref()
+                .map(|chain| chain.table_leak(&point, self.n_settle_out(), big));
+            for (h, fundamental) in state {
                 let c = h.len() / 2;
-                let full = gyroemu_mixer::phase_fundamental_fine(h);
+                let full = fundamental.unwrap_or(Complex64::new(f64::NAN, f64::NAN));
                 // What the read-out makes of the whole envelope: every harmonic m through
                 // the chain (L(m f_t) H(f_c + m f_t)) and the window's leak K(m - r) into
                 // each read harmonic r, the leak solve within -N ..= N, the chain divided out,
                 // then the fundamental. Exact for any window (the truncation alone, through a
                 // whole-period boxcar; a Hann window's leak of the harmonics beyond read 9.2
                 // mdeg where the truncation is 2.0).
-                let read = chain
-                    .as_ref()
-                    .map_or(Complex64::new(f64::NAN, f64::NAN), |chain| {
+                let read = chain.as_ref().zip(k_all.as_ref()).map_or(
+                    Complex64::new(f64::NAN, f64::NAN),
+                    |(chain, k_all)| {
                         let resp =
                             |m: f64| chain.lowpass(m * freq_hz) * chain.tia(fc + m * freq_hz);
-                        let big = c.div_ceil(2) + n;
-                        let k_all = chain.table_leak(&point, self.n_settle_out(), big);
                         let avg: Vec<Complex64> = (-(n as i64)..=n as i64)
                             .map(|r| {
                                 (0..h.len())
@@ -203,7 +271,7 @@ impl Config {
                             .collect();
                         let solved = gyroemu_board::unleak_table_harmonics(
                             &avg,
-                            &chain.table_leak(&point, self.n_settle_out(), n),
+                            &k_all[2 * (big - n)..=2 * (big + n)],
                         );
                         let v: Vec<Complex64> = solved
                             .iter()
@@ -211,7 +279,8 @@ impl Config {
                             .map(|(i, x)| x / resp(i as f64 - n as f64))
                             .collect();
                         gyroemu_mixer::phase_fundamental_fine(&v)
-                    });
+                    },
+                );
                 let a = (read.norm() - full.norm()).abs() / DEG * 1e3;
                 let l = turn_mdeg(read.arg(), full.arg());
                 if a.is_nan() || a > amp_err {
@@ -240,39 +309,28 @@ impl Config {
         }
     }
 
-    /// A rate table whose swing takes a mode's velocity envelope around zero within a table
-    /// period: its phase then turns a whole turn per period and has no lag to read, so the
-    /// run could only refuse that mode's reading after every sample (it did, blaming an
-    /// overflow: a 1.5 Hz mode split with drive.f2 = 0.5 at 100 deg/s). The exact periodic
-    /// steady state says so before the run; the first such rate and mode are named.
-    fn validate_table_winding(&self) -> Result<(), ConfigError> {
+    /// Each rate's mode envelopes on the rate table ([`table_envelopes`]) with their checked
+    /// phase fundamentals; `None` off a rate table.
+    fn table_states(&self) -> Option<TableStates> {
         let Shape::RateTable { freq_hz } = self.shape() else {
-            return Ok(());
+            return None;
         };
         let dev = self.driven_device();
-        for &rate in &self.experiment.rates_dps {
-            // A swing beyond the theory's harmonics is the harmonics rule's to refuse.
-            let Some(env) = table_envelopes(&dev, rate, freq_hz) else {
-                continue;
-            };
-            for (k, h) in env.iter().enumerate() {
-                let what = match gyroemu_mixer::phase_fundamental_checked(h) {
-                    Ok(_) => continue,
-                    Err(gyroemu_mixer::NoFundamental::Winds) => "passes around zero once per table period",
-                    Err(gyroemu_mixer::NoFundamental::Unresolved) => "passes so near zero once per table period that its phase turns by nearly a half turn within 1e-5 of the period, and its fundamental cannot be resolved",
-                };
-                let drive = ["drive.f1", "drive.f2"][k];
-                return Err(ConfigError::key(
-                    "experiment.rates_dps",
-                    rate,
-                    format!(
-                        "at this rate-table amplitude mode {}'s velocity envelope (its phasor at the carrier, exact periodic steady state) {what} ({freq_hz} Hz): what the rate couples in from the other mode outweighs the mode's own driven response at the swing's peaks, so there is no lag or amplitude to read; lower the amplitude, raise {drive}, or bring the mode nearer the carrier",
-                        k + 1
-                    ),
-                ));
-            }
-        }
-        Ok(())
+        let rates = self
+            .experiment
+            .rates_dps
+            .iter()
+            .map(|&rate| {
+                let state = table_envelopes(&dev, rate, freq_hz).map(|env| {
+                    env.map(|h| {
+                        let f = gyroemu_mixer::phase_fundamental_checked(&h);
+                        (h, f)
+                    })
+                });
+                (rate, state)
+            })
+            .collect();
+        Some(TableStates { freq_hz, rates })
     }
 
     /// A rotating point reads its two sidebands f_c +- Omega from the window's averages of the
