@@ -159,9 +159,7 @@ pub enum NoFundamental {
 /// the same phases bit for bit) and evaluates only its odd ones: a third less work where two
 /// levels settle it, the same bits as evaluating every level whole (tested).
 pub fn phase_fundamental_checked(h: &[Complex64]) -> Result<Complex64, NoFundamental> {
-    const MAX_GRID: usize = 1 << 18;
-    let nh = h.len() / 2;
-    let mut g = (16 * nh).next_power_of_two().clamp(1024, MAX_GRID);
+    let mut g = first_grid(h);
     // At 1024 points, the value is phase_fundamental's: the same grid, the same bits.
     let mut phases = phases_on(h, grid(g));
     let mut x = fundamental_of(&phases, grid(g));
@@ -183,6 +181,17 @@ pub fn phase_fundamental_checked(h: &[Complex64]) -> Result<Complex64, NoFundame
         (x, g, phases) = (finer, 2 * g, both);
     }
     Err(NoFundamental::Unresolved)
+}
+
+/// The finest grid [`phase_fundamental_checked`] takes.
+const MAX_GRID: usize = 1 << 18;
+
+/// The grid [`phase_fundamental_checked`] starts on: 16 points per harmonic of `h`, at least
+/// 1024 (where it is [`phase_fundamental`]'s).
+fn first_grid(h: &[Complex64]) -> usize {
+    (16 * (h.len() / 2))
+        .next_power_of_two()
+        .clamp(1024, MAX_GRID)
 }
 
 /// What two successive grids' fundamentals (value, largest phase step, turned) say: winding
@@ -283,12 +292,10 @@ mod tests {
     use super::*;
 
     /// [`phase_fundamental_checked`] as it was first written: every level evaluated whole
-    /// (the same decision between levels, [`settled`]).
+    /// (the same grids and decision between levels, [`first_grid`] and [`settled`]).
     fn checked_level_by_level(h: &[Complex64]) -> Result<Complex64, NoFundamental> {
-        const MAX_GRID: usize = 1 << 18;
-        let nh = h.len() / 2;
         let on = |g: usize| fundamental_on(h, grid(g));
-        let mut g = (16 * nh).next_power_of_two().clamp(1024, MAX_GRID);
+        let mut g = first_grid(h);
         let mut x = on(g);
         while g < MAX_GRID {
             let finer = on(2 * g);
