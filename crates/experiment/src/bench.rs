@@ -89,6 +89,16 @@ pub fn with_flicker(cfg: &Config) -> Config {
     c
 }
 
+/// The chains the bench measures whole, with their rows' labels: `cfg`'s, [`with_noise`] and
+/// [`with_flicker`], in the order of the rows (and of `gyroemu bench`'s header).
+pub fn chains(cfg: &Config) -> [(&'static str, Config); 3] {
+    [
+        ("whole chain", cfg.clone()),
+        ("whole chain with noise", with_noise(cfg)),
+        ("whole chain with noise and flicker", with_flicker(cfg)),
+    ]
+}
+
 /// Runs `groups` lane groups of `n_in` input samples each, spread over the rayon pool, in the
 /// lanes this CPU runs `cfg`'s chain in ([`max_lanes_for`]); returns point-samples per second.
 pub fn chain(cfg: &Config, n_in: u64, groups: usize) -> f64 {
@@ -194,20 +204,14 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     };
     // The chain in every lane type this CPU runs; the rows without a lane type repeat the
     // figures of the type a run of that chain uses here ([`max_lanes_for`]).
-    let noisy = with_noise(cfg);
-    let flickering = with_flicker(cfg);
-    let chains = [
-        ("whole chain", cfg),
-        ("whole chain with noise", &noisy),
-        ("whole chain with noise and flicker", &flickering),
-    ];
+    let chains = chains(cfg);
     let mut widths = vec![4];
     if max_lanes() == 8 {
         widths.push(8);
     }
     let mut typed = Vec::new();
     for &w in &widths {
-        for (label, c) in chains {
+        for (label, c) in &chains {
             let name = format!("{label} ({})", lane_type(w));
             typed.push(row(&name, 1, &mut || chain_in(w, c, n_in, 1)));
             if threads > 1 {
@@ -216,10 +220,10 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
         }
     }
     let mut out = Vec::new();
-    for (label, c) in chains {
+    for (label, c) in &chains {
         let name = format!("{label} ({})", lane_type(max_lanes_for(&c.board_params())));
         out.extend(typed.iter().filter(|r| r.name == name).map(|r| Throughput {
-            name: label.into(),
+            name: (*label).into(),
             ..r.clone()
         }));
     }

@@ -25,7 +25,7 @@ pub fn bench_command(preset_name: &str, samples: u64, repeats: usize) -> Result<
         ))
         .into());
     }
-    use gyroemu_experiment::bench::{lane_type, with_flicker, with_noise};
+    use gyroemu_experiment::bench::{chains, lane_type};
     let typed = if gyroemu_board::max_lanes() == 8 {
         "rows marked (f64x4) and (f64x8): groups of 4 and 8"
     } else {
@@ -33,9 +33,9 @@ pub fn bench_command(preset_name: &str, samples: u64, repeats: usize) -> Result<
     };
     // Each chain in the lanes a run of it uses on this CPU (they differ by chain where the
     // CPU runs 512-bit operations in halves).
-    let widths: Vec<String> = [cfg.clone(), with_noise(&cfg), with_flicker(&cfg)]
+    let widths: Vec<String> = chains(&cfg)
         .iter()
-        .map(|c| {
+        .map(|(_, c)| {
             let lanes = gyroemu_board::max_lanes_for(&c.board_params());
             format!("{lanes} points in {}", lane_type(lanes))
         })
