@@ -15,6 +15,7 @@ pub use gyroemu_experiment as experiment;
 pub use gyroemu_lpf as lpf;
 pub use gyroemu_mixer as mixer;
 pub use gyroemu_nco as nco;
+pub use gyroemu_pll as pll;
 pub use gyroemu_resonator as resonator;
 pub use gyroemu_theory as theory;
 pub use gyroemu_tia as tia;

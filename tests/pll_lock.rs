@@ -231,3 +231,107 @@ fn an_overdamped_loop_locks_within_its_default_lock_run() {
         );
     }
 }
+
+/// A lock run stops on the cancel flag (Ctrl-C): raised before it starts, no block runs and
+/// the lock says it was cancelled, not that it failed to lock; the board's own loop says the
+/// same, with the carrier where it started.
+#[test]
+fn a_raised_cancel_stops_the_lock_before_any_block() {
+    use core::sync::atomic::AtomicBool;
+    let c = with_pll(fork(), 5.0);
+    let raised = AtomicBool::new(true);
+    let e = gyroemu::experiment::lock_config_carrier_with(&c, &c, Some(&raised)).unwrap_err();
+    assert!(
+        matches!(e, gyroemu::experiment::SweepError::Cancelled),
+        "{e}"
+    );
+    let e = gyroemu::experiment::resolve_lock_with(&c, Some(&raised)).unwrap_err();
+    assert!(matches!(e, gyroemu::experiment::SweepError::Cancelled));
+    let mut pll = gyroemu::pll::Pll::new(&pll_params(&c, &c).unwrap().unwrap()).unwrap();
+    let run = gyroemu::board::lock_carrier(&c.board_params(), &mut pll, 0, 1 << 40, Some(&raised))
+        .unwrap()
+        .unwrap();
+    assert!(run.cancelled && !run.locked && run.lock_time_s.is_none());
+    assert_eq!(run.carrier_hz, c.carrier_hz());
+    // Lowered, the same lock runs to its end and locks.
+    let lowered = AtomicBool::new(false);
+    let held = gyroemu::experiment::lock_config_carrier_with(&c, &c, Some(&lowered)).unwrap();
+    assert_eq!(held, lock_config_carrier(&c, &c).unwrap());
+}
+
+/// The lock runs before the points, so the plan counts it: its input samples are whole
+/// decimation blocks covering pll.lock_s, against the cap of point-samples (a lock of 2^40 s,
+/// 2.6e17 samples, was taken and ran for hours while the plan said 0.013 s), and its time on
+/// one thread is added to the estimate. A config without [pll] locks nothing.
+#[test]
+fn the_lock_is_in_the_plan_its_cap_and_its_time() {
+    use gyroemu::experiment::work::{lock_work, measured_lock_rate};
+    use gyroemu::experiment::{sweep_work, MAX_POINT_SAMPLES};
+    let mut c = with_pll(fork(), 5.0);
+    let lock_s = 3.3;
+    c.pll.as_mut().unwrap().lock_s = Some(lock_s);
+    c.validate().unwrap();
+    let m = c.decimation() as u64;
+    // 3.3 s at 2400 outputs/s: 7920 blocks of 100 input samples.
+    assert_eq!(c.fs_hz() / m as f64, 2400.0);
+    let w = lock_work(&c);
+    assert_eq!(w.lock_samples, 7920 * 100);
+    assert_eq!((w.points, w.point_samples), (0, 0));
+    assert_eq!(
+        sweep_work(&c).lock_samples,
+        0,
+        "a sweep's own work has no lock"
+    );
+    assert_eq!(lock_work(&fork()).lock_samples, 0, "no [pll], no lock");
+    // Who locks counts it: a montecarlo device once; selfcal once, and once more for its
+    // drift scenario (which resolves the nominal lock again), with nothing else changed.
+    let device = gyroemu::analysis::montecarlo::device_work(&c).0;
+    assert_eq!(device.lock_samples, 792_000);
+    let mut sc = c.clone();
+    sc.selfcal = Some(Default::default());
+    let lone = gyroemu::analysis::selfcal_work(&sc);
+    assert_eq!(lone.lock_samples, 792_000);
+    sc.selfcal.as_mut().unwrap().drift_delta_t_k = vec![10.0];
+    let drifting = gyroemu::analysis::selfcal_work(&sc);
+    assert_eq!(drifting.lock_samples, 2 * 792_000);
+    let both = sweep_work(&c).plus(w);
+    assert_eq!(both.capped_samples(), both.point_samples + 792_000);
+    assert!(both.check_cap(false).is_ok());
+    let s = both.summary(None);
+    assert!(
+        s.contains("after a carrier lock of 7.920e5 input samples"),
+        "{s}"
+    );
+    // The time: the lock's at its own rate, then the points' (1e7 point-samples in short
+    // points, so not bound by the longest lane group): 0.0792 + 0.1 s.
+    let work = gyroemu::experiment::Work {
+        points: 8,
+        point_samples: 10_000_000,
+        longest_s: 0.01,
+        longest_samples: 2400,
+        widest_lanes: 8,
+        lock_samples: 792_000,
+    };
+    let s = work.summary_at(Some(1e8), Some(1e7));
+    assert!(s.contains("about 0.179 s"), "{s}");
+    assert!(s.contains("the carrier lock first about 0.079 s"), "{s}");
+    // Measured here, the lock's rate is that of a real lock run.
+    assert!(measured_lock_rate(&c).is_some_and(|x| x > 0.0));
+    assert!(measured_lock_rate(&fork()).is_none());
+    // A lock beyond the cap is refused without --force, naming the key to shorten.
+    c.pll.as_mut().unwrap().lock_s = Some(2f64.powi(40));
+    c.validate().unwrap();
+    let huge = sweep_work(&c).plus(lock_work(&c));
+    assert!(huge.lock_samples > MAX_POINT_SAMPLES);
+    let e = huge.check_cap(false).unwrap_err();
+    assert!(
+        e.contains("shorten pll.lock_s") && e.contains("--force"),
+        "{e}"
+    );
+    assert!(huge.check_cap(true).is_ok());
+    // Beyond u64 (1e300 s): saturated, still refused.
+    c.pll.as_mut().unwrap().lock_s = Some(1e300);
+    c.validate().unwrap();
+    assert_eq!(lock_work(&c).lock_samples, u64::MAX);
+    assert!(lock_work(&c).check_cap(false).is_err());
+}

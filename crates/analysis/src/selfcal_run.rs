@@ -8,7 +8,7 @@ use crate::selfcal_analyses::{
 };
 use gyroemu_config::Config;
 use gyroemu_experiment::{
-    resolve_lock, run_sweep, sweep_work, CarrierLock, Reporter, SweepError, Work,
+    lock_work, resolve_lock, run_sweep, sweep_work, CarrierLock, Reporter, SweepError, Work,
 };
 
 /// Everything `selfcal` measured.
@@ -135,10 +135,11 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
 /// What `selfcal` on `cfg` will emulate: both sweeps, then the Allan record (four streams),
 /// the averaging-time run and, per drift temperature, both sweeps open loop and, when the
 /// drift loop fits the board, both again PLL-tracked (the same windows at another carrier;
-/// the lock runs themselves are not counted).
+/// the tracking loop's own lock runs, of a few of its time constants, are not counted). A
+/// `[pll]`'s lock runs first, and once more for the drift scenario.
 pub fn selfcal_work(cfg: &Config) -> Work {
     let (rot, cor) = sweep_configs(cfg);
-    let mut w = sweep_work(&rot).plus(sweep_work(&cor));
+    let mut w = lock_work(cfg).plus(sweep_work(&rot)).plus(sweep_work(&cor));
     let sc = cfg.selfcal.clone().unwrap_or_default();
     if let Some(t) = sc.allan_record_s {
         let mut a = cor.clone();
@@ -158,6 +159,10 @@ pub fn selfcal_work(cfg: &Config) -> Work {
     } else {
         1
     };
+    if !sc.drift_delta_t_k.is_empty() {
+        // `drift_analysis` resolves the nominal lock again.
+        w = w.plus(lock_work(cfg));
+    }
     for &dt in &sc.drift_delta_t_k {
         let (r, c) = sweep_configs(&crate::selfcal::drifted(cfg, dt));
         let pair = sweep_work(&r).plus(sweep_work(&c));

@@ -73,6 +73,8 @@ pub fn stepped_sine_work(cfg: &Config) -> Work {
         longest_samples: per_run,
         // One point per run: a group of four lanes.
         widest_lanes: 4,
+        // The stepped sine runs open loop: a [pll] is not used.
+        lock_samples: 0,
     }
 }
 

@@ -34,7 +34,7 @@ pub use lanes::{
     eight_lanes_available, group_sizes, groups_by_length, halves_512, lane_groups, max_lanes,
     max_lanes_for, set_max_lanes, LaneCpu, CANONICAL_LANES, FOUR_LANE_COST, MAX_LANES,
 };
-pub use lock::{lock_carrier, LockRun, LockSample};
+pub use lock::{lock_carrier, LockRun};
 pub use params::{BoardParams, Converter, NoiseParams, Shape};
 pub use point::{LaneResult, Point, RunOptions, RunOutput};
 pub use probe::{Probe, DUMP_NODES, EVENTS_COUNTED_KEY, EVENT_KEYS};

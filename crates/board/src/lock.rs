@@ -8,19 +8,9 @@
 use crate::board::{Board, CORIOLIS};
 use crate::health::Counters;
 use crate::params::{BoardParams, Shape};
+use core::sync::atomic::{AtomicBool, Ordering};
 use gyroemu_core::{Complex64, ParamError, ParamResult, Stage};
 use gyroemu_pll::Pll;
-
-/// One decimated instant of a lock run.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LockSample {
-    /// Time of the decimated output, s.
-    pub time_s: f64,
-    /// The carrier the PLL set for the next block, Hz.
-    pub carrier_hz: f64,
-    /// The detector's phase error, rad.
-    pub phase_error_rad: f64,
-}
 
 /// How a lock run ended.
 #[derive(Clone, Debug, PartialEq)]
@@ -31,19 +21,23 @@ pub struct LockRun {
     pub locked: bool,
     /// When the lock indicator came on for good (it stayed on to the end), s.
     pub lock_time_s: Option<f64>,
-    /// Every decimated output, in order.
-    pub trace: Vec<LockSample>,
+    /// The cancel flag stopped the run before its last block (`locked` is then false).
+    pub cancelled: bool,
 }
 
 /// Runs the board `p` (its shape replaced by a Coriolis run at zero rate, one operating
 /// point) for `blocks` decimation blocks with `pll` steering its carrier from the demodulated
-/// output of `mode` (0 or 1) after each block. Returns the trace and where it ended; a value
-/// that stops being finite is an error naming the stage, as in a run.
+/// output of `mode` (0 or 1) after each block. Returns where it ended; a value that stops
+/// being finite is an error naming the stage, as in a run. A raised `cancel` (Ctrl-C) stops it
+/// after the block in progress: a lock run can be as long as the user's `pll.lock_s`. It keeps
+/// nothing per block, so its memory does not grow with its length (a kept trace, which nothing
+/// read, grew by 24 bytes a block: gigabytes for a lock of days).
 pub fn lock_carrier(
     p: &BoardParams,
     pll: &mut Pll,
     mode: usize,
     blocks: u64,
+    cancel: Option<&AtomicBool>,
 ) -> ParamResult<Result<LockRun, crate::NonFinite>> {
     if mode > 1 {
         return Err(ParamError::new(
@@ -58,7 +52,7 @@ pub fn lock_carrier(
         ..*p
     };
     let mut board = Board::<f64>::new(&params, &[0.0], &[0])?;
-    Ok(board.run_lock(pll, mode, blocks))
+    Ok(board.run_lock(pll, mode, blocks, cancel))
 }
 
 impl Board<f64> {
@@ -67,11 +61,12 @@ impl Board<f64> {
         pll: &mut Pll,
         mode: usize,
         blocks: u64,
+        cancel: Option<&AtomicBool>,
     ) -> Result<LockRun, crate::NonFinite> {
         macro_rules! by_plant {
             ($($noisy:literal, $dec:literal);*) => {
                 match (self.imperfect, self.plant_decoupled()) {
-                    $(($noisy, $dec) => self.lock_loop::<$noisy, $dec>(pll, mode, blocks),)*
+                    $(($noisy, $dec) => self.lock_loop::<$noisy, $dec>(pll, mode, blocks, cancel),)*
                 }
             };
         }
@@ -84,12 +79,20 @@ impl Board<f64> {
         pll: &mut Pll,
         mode: usize,
         blocks: u64,
+        cancel: Option<&AtomicBool>,
     ) -> Result<LockRun, u64> {
         let m = self.decimation as u64;
         let mut counts = Counters::<f64>::default();
-        let mut trace = Vec::with_capacity(blocks.min(1 << 24) as usize);
         let mut locked_since: Option<f64> = None;
         for k in 0..blocks {
+            if cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+                return Ok(LockRun {
+                    carrier_hz: pll.frequency_hz(),
+                    locked: false,
+                    lock_time_s: None,
+                    cancelled: true,
+                });
+            }
             let n0 = k * m;
             let (z, _) = self.block::<CORIOLIS, NOISY, DECOUPLED>(n0, None, &mut counts);
             if ![z[0].i, z[0].q, z[1].i, z[1].q]
@@ -109,17 +112,12 @@ impl Board<f64> {
                 (true, since) => since,
                 (false, _) => None,
             };
-            trace.push(LockSample {
-                time_s,
-                carrier_hz: f,
-                phase_error_rad: pll.phase_error_rad(),
-            });
         }
         Ok(LockRun {
             carrier_hz: pll.frequency_hz(),
             locked: pll.is_locked(),
             lock_time_s: locked_since,
-            trace,
+            cancelled: false,
         })
     }
 }

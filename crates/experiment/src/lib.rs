@@ -20,7 +20,10 @@ pub mod work;
 
 pub use dump::{dump_extra, DumpPlan};
 pub use leaks::Stage2Leaks;
-pub use lock::{lock_config_carrier, pll_params, resolve_lock, CarrierLock};
+pub use lock::{
+    lock_blocks, lock_config_carrier, lock_config_carrier_with, pll_params, resolve_lock,
+    resolve_lock_with, CarrierLock,
+};
 pub use prepared::{run_sweep, run_sweep_with};
 pub use progress::{Progress, Quiet, Reporter, Task, Written};
 pub use readout::{
@@ -32,4 +35,4 @@ pub use sweep::{
     SweepRun, DUMP_STEM,
 };
 pub use table_sweep::run_table_sweeps;
-pub use work::{sweep_work, Work, MAX_POINT_SAMPLES};
+pub use work::{lock_work, sweep_work, Work, MAX_POINT_SAMPLES};

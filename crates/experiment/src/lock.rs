@@ -3,7 +3,8 @@
 //! sweep then runs: the carrier held where the lock ended.
 
 use crate::sweep::SweepError;
-use gyroemu_board::{lock_carrier as board_lock, ChainResponse, LockSample};
+use core::sync::atomic::AtomicBool;
+use gyroemu_board::{lock_carrier as board_lock, ChainResponse};
 use gyroemu_config::Config;
 use gyroemu_core::{ParamResult, Stage};
 use gyroemu_lpf::LowPass;
@@ -21,8 +22,6 @@ pub struct CarrierLock {
     pub resonance_hz: f64,
     /// When the lock indicator came on for good, s.
     pub lock_time_s: Option<f64>,
-    /// The lock run, one entry per decimated output.
-    pub trace: Vec<LockSample>,
 }
 
 impl CarrierLock {
@@ -100,15 +99,28 @@ pub fn lock_config_carrier(
     cfg: &Config,
     design: &Config,
 ) -> Result<Option<CarrierLock>, SweepError> {
+    lock_config_carrier_with(cfg, design, None)
+}
+
+/// [`lock_config_carrier`], stopped by a raised `cancel` after the block in progress
+/// ([`SweepError::Cancelled`]).
+pub fn lock_config_carrier_with(
+    cfg: &Config,
+    design: &Config,
+    cancel: Option<&AtomicBool>,
+) -> Result<Option<CarrierLock>, SweepError> {
     let Some(params) = pll_params(cfg, design)? else {
         return Ok(None);
     };
     let pll_cfg = design.pll.as_ref().expect("pll_params found a [pll]");
     let mut pll = Pll::new(&params)?;
     let lock_s = design.pll_lock_s().unwrap_or(f64::NAN);
-    let blocks = (lock_s * cfg.fs_out_hz()).ceil() as u64;
+    let blocks = lock_blocks(lock_s, cfg.fs_out_hz());
     let mode = pll_cfg.mode - 1;
-    let run = board_lock(&cfg.board_params(), &mut pll, mode, blocks)??;
+    let run = board_lock(&cfg.board_params(), &mut pll, mode, blocks, cancel)??;
+    if run.cancelled {
+        return Err(SweepError::Cancelled);
+    }
     // The locked mode's configured resonance and half-bandwidth.
     let (resonance, half_bw) = cfg.mode_resonances_hz()[mode];
     if !run.locked {
@@ -146,15 +158,28 @@ pub fn lock_config_carrier(
         carrier_hz: run.carrier_hz,
         resonance_hz: resonance,
         lock_time_s: run.lock_time_s,
-        trace: run.trace,
     }))
+}
+
+/// The decimation blocks of a lock run of `lock_s` seconds at the output rate `fs_out_hz`
+/// (whole blocks, at least the time asked; saturating, as a float cast does).
+pub fn lock_blocks(lock_s: f64, fs_out_hz: f64) -> u64 {
+    (lock_s * fs_out_hz).ceil() as u64
 }
 
 /// The config a sweep of `cfg` runs: with a `[pll]`, its carrier locked first (the lock is
 /// deterministic, so every rerun, shard and merge gets the same bits) and held, the `[pll]`
 /// section then spent; otherwise `cfg` itself.
 pub fn resolve_lock(cfg: &Config) -> Result<(Config, Option<CarrierLock>), SweepError> {
-    let Some(lock) = lock_config_carrier(cfg, cfg)? else {
+    resolve_lock_with(cfg, None)
+}
+
+/// [`resolve_lock`], its lock stopped by a raised `cancel` ([`SweepError::Cancelled`]).
+pub fn resolve_lock_with(
+    cfg: &Config,
+    cancel: Option<&AtomicBool>,
+) -> Result<(Config, Option<CarrierLock>), SweepError> {
+    let Some(lock) = lock_config_carrier_with(cfg, cfg, cancel)? else {
         return Ok((cfg.clone(), None));
     };
     Ok((lock.hold(cfg), Some(lock)))

@@ -39,6 +39,9 @@ pub enum SweepError {
     /// did, and what would help (which depends on who asked for the lock).
     #[error("{cause}; {advice}")]
     NotLocked { cause: String, advice: String },
+    /// The cancel flag (Ctrl-C, SIGTERM) stopped the carrier lock before the sweep began.
+    #[error("stopped during the carrier lock, before any point ran")]
+    Cancelled,
 }
 
 /// The file stem of a sweep's signal dump in its output folder (see [`Probe::write`]).

@@ -14,7 +14,7 @@ use crate::run::RunRequest;
 use crate::shard::{check_split, Shard};
 use gyroemu_analysis::montecarlo::{lot_work, run_device, DeviceResult, LotSummary};
 use gyroemu_config::Config;
-use gyroemu_experiment::work::measured_throughput;
+use gyroemu_experiment::work::{measured_lock_rate, measured_throughput};
 use gyroemu_experiment::{Reporter, SweepError};
 use gyroemu_report::{write_lot, ReportError};
 use rayon::prelude::*;
@@ -125,7 +125,7 @@ pub fn run_lot(
         format!(
             "{what}{resumed}; {} devices to run, {}",
             todo.len(),
-            work.describe(Some(measured_throughput(cfg)))
+            work.describe_at(Some(measured_throughput(cfg)), measured_lock_rate(cfg))
         )
     });
     if let Some(w) = split_warning {

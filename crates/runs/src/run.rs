@@ -13,10 +13,10 @@ use crate::resume::previous_points;
 use crate::shard::{check_split, manifest_path, Shard};
 use gyroemu_board::LaneResult;
 use gyroemu_config::Config;
-use gyroemu_experiment::work::{measured_throughput, points_work};
+use gyroemu_experiment::work::{lock_work, measured_lock_rate, measured_throughput, points_work};
 use gyroemu_experiment::{
-    dump_point, finish_sweep, resolve_lock, run_sweep_with, sweep_work, Reporter, SweepOptions,
-    Work,
+    dump_point, finish_sweep, resolve_lock_with, run_sweep_with, sweep_work, Reporter, SweepError,
+    SweepOptions, Work,
 };
 use gyroemu_report::{check_problems, run_title, write_run};
 use std::path::{Path, PathBuf};
@@ -138,7 +138,9 @@ pub fn check_run(
     let share = match shard {
         Some(s) => points_work(cfg, &s.points(n)),
         None => sweep_work(cfg),
-    };
+    }
+    // Every run of a [pll] config (each shard, each resume) locks its carrier first.
+    .plus(lock_work(cfg));
     share.check_cap(force).map_err(RunError::BadInput)?;
     let warning = check_split(out, shard, RunKind::Run, &config_hash(cfg), "point")?;
     Ok((share, warning))
@@ -157,7 +159,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     // Say what this will cost before anything runs.
     let (share, split_warning) = check_run(cfg, out, req.shard.as_ref(), req.force)?;
     let throughput = measured_throughput(cfg);
-    reporter.note(&share.describe(Some(throughput)));
+    reporter.note(&share.describe_at(Some(throughput), measured_lock_rate(cfg)));
     if let Some(w) = split_warning {
         reporter.warn(&w);
     }
@@ -193,7 +195,9 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
         format!(
             "{what}: resuming, {reused} already computed for this config in `{}`; left to run: {}",
             points_dir.display(),
-            points_work(cfg, &todo).summary(Some(throughput))
+            points_work(cfg, &todo)
+                .plus(lock_work(cfg))
+                .summary_at(Some(throughput), measured_lock_rate(cfg))
         )
     } else {
         what
@@ -210,8 +214,13 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     )?;
 
     // With a [pll], the carrier is locked on the emulated board first and held for the sweep
-    // (deterministic: a resume, a shard and a merge lock to the same bits).
-    let (held, lock) = resolve_lock(cfg).map_err(|e| ledger.fail(e.into(), &prev))?;
+    // (deterministic: a resume, a shard and a merge lock to the same bits). Ctrl-C stops the
+    // lock too: it can run as long as the user's pll.lock_s.
+    let (held, lock) = match resolve_lock_with(cfg, Some(&req.cancel)) {
+        Ok(v) => v,
+        Err(SweepError::Cancelled) => return Err(ledger.interrupted(&prev, "point", &points_dir)),
+        Err(e) => return Err(ledger.fail(e.into(), &prev)),
+    };
     if let Some(l) = &lock {
         reporter.note(&l.note());
     }

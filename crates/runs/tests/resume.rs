@@ -114,3 +114,62 @@ fn a_cancel_before_the_start_saves_nothing_and_says_so() {
     assert_eq!(m["status"], "interrupted");
     assert_eq!(indices(&m["points_missing"]).len(), 10);
 }
+
+/// Ctrl-C during a `[pll]`'s carrier lock stops the lock itself (it can run as long as the
+/// user's pll.lock_s): the run ends interrupted before any point, having said nothing of a
+/// lock. Were the lock to go on, it would end (0.01 s of emulation here) and report its
+/// carrier, or fail to lock, before the sweep saw the flag.
+#[test]
+fn a_cancel_during_the_carrier_lock_stops_the_lock() {
+    let mut cfg = config();
+    cfg.noise = None;
+    // At Q = 1000 no loop fits this board's low-pass.
+    cfg.device.q = 2000.0;
+    cfg.pll = Some(gyroemu_config::PllConfig {
+        natural_hz: None,
+        damping: core::f64::consts::FRAC_1_SQRT_2,
+        lock_s: Some(5.0),
+        mode: 1,
+    });
+    cfg.resolve();
+    cfg.validate().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    prepare_out(&out).unwrap();
+    let seen = Record::default();
+    let req = RunRequest {
+        config: &cfg,
+        out: &out,
+        shard: None,
+        force: false,
+        cancel: Arc::new(AtomicBool::new(true)),
+        on_saved: None,
+    };
+    let e = run(&req, &seen).unwrap_err();
+    assert!(matches!(e, RunError::Interrupted(_)), "{e}");
+    let notes = seen.0.lock().unwrap();
+    assert!(
+        notes.iter().any(|n| n.contains("after a carrier lock of")),
+        "{notes:?}"
+    );
+    assert!(!notes.iter().any(|n| n.contains("pll:")), "{notes:?}");
+    assert!(point_files(&out).is_empty());
+    let m = json(&out.join("manifest.json"));
+    assert_eq!(m["status"], "interrupted");
+    assert_eq!(indices(&m["points_missing"]).len(), 10);
+    drop(notes);
+    // Lowered, the same run locks, says where, and saves every point.
+    let req = RunRequest {
+        cancel: Arc::new(AtomicBool::new(false)),
+        ..req
+    };
+    run(&req, &seen).unwrap();
+    let notes = seen.0.lock().unwrap();
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.starts_with("pll: locked the carrier")),
+        "{notes:?}"
+    );
+    assert_eq!(point_files(&out).len(), 10);
+}

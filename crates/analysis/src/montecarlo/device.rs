@@ -6,7 +6,9 @@
 use super::draw::{device_config, draw_device};
 use crate::selfcal::{sweep_configs, SelfcalCore};
 use gyroemu_config::Config;
-use gyroemu_experiment::{finish_sweep, resolve_lock, run_sweep_with, SweepError, SweepOptions};
+use gyroemu_experiment::{
+    finish_sweep, resolve_lock_with, run_sweep_with, SweepError, SweepOptions,
+};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 
@@ -182,8 +184,13 @@ pub fn run_device(
             "the config has no [montecarlo] section",
         )));
     };
-    // With a [pll], both sweeps run at the carrier it locks, as in `selfcal`.
-    let (cfg, _lock) = resolve_lock(&device_config(base, &draw_device(mc, index)))?;
+    // With a [pll], both sweeps run at the carrier it locks, as in `selfcal`; the cancel
+    // flag stops the lock too (it runs as long as the user's pll.lock_s).
+    let device = device_config(base, &draw_device(mc, index));
+    let (cfg, _lock) = match resolve_lock_with(&device, cancel.map(|c| &**c)) {
+        Err(SweepError::Cancelled) => return Ok(None),
+        other => other?,
+    };
     let (rot_cfg, cor_cfg) = sweep_configs(&cfg);
     let mut runs = Vec::with_capacity(2);
     for c in [&rot_cfg, &cor_cfg] {

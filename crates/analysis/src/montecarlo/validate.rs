@@ -6,7 +6,7 @@ use crate::selfcal::{sweep_configs, validate_selfcal};
 use gyroemu_board::Point;
 use gyroemu_config::{Config, ConfigError};
 use gyroemu_experiment::sweep::canonical_work;
-use gyroemu_experiment::{sweep_work, Work, MAX_POINT_SAMPLES};
+use gyroemu_experiment::{lock_work, sweep_work, Work, MAX_POINT_SAMPLES};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 
@@ -108,7 +108,7 @@ pub fn validate_lot_capped(
             }
         }
         validated += chunk.len();
-        if !force && refused_devices == 0 && work.point_samples > MAX_POINT_SAMPLES {
+        if !force && refused_devices == 0 && work.capped_samples() > MAX_POINT_SAMPLES {
             return Err(LotRefusal::Cap(cap_refusal(
                 &work,
                 validated,
@@ -163,14 +163,14 @@ fn cap_refusal(work: &Work, validated: usize, total: usize) -> String {
             .check_cap(false)
             .expect_err("the caller saw the work above the cap");
     }
-    let mean = work.point_samples as f64 / validated as f64;
+    let mean = work.capped_samples() as f64 / validated as f64;
     format!(
         "plan: the first {validated} of these {total} devices alone run {:.3e} point-samples \
          (about {:.3e} for all {total} at their mean; longest point {:.4} s of signal): above \
          the cap of {:.0e} point-samples without --force (a mistyped --devices, Q or \
          averaging time would otherwise start a run of days); run fewer devices, shorten \
          experiment.average_s or experiment.settle_s, or add --force to run it anyway",
-        work.point_samples as f64,
+        work.capped_samples() as f64,
         mean * total as f64,
         work.longest_s,
         MAX_POINT_SAMPLES as f64
@@ -191,7 +191,10 @@ pub fn device_work(device: &Config) -> (Work, u64) {
         canonical_work(c, &points).0
     };
     (
-        sweep_work(&rot).plus(sweep_work(&cor)),
+        // A [pll] locks each device's carrier first.
+        lock_work(device)
+            .plus(sweep_work(&rot))
+            .plus(sweep_work(&cor)),
         input(&rot) + input(&cor),
     )
 }

@@ -6,7 +6,7 @@ use crate::signals;
 use anyhow::Result;
 use gyroemu_analysis::selfcal::validate_selfcal;
 use gyroemu_analysis::{run_selfcal, selfcal_work};
-use gyroemu_experiment::work::measured_throughput;
+use gyroemu_experiment::work::{measured_lock_rate, measured_throughput};
 use gyroemu_report::{check_problems, write_selfcal};
 use gyroemu_runs::{lock_out, prepare_out, LockScope};
 use std::path::Path;
@@ -22,7 +22,10 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
     }
     let work = selfcal_work(&cfg);
     work.check_cap(force).map_err(BadInput)?;
-    note!("{}", work.describe(Some(measured_throughput(&cfg))));
+    note!(
+        "{}",
+        work.describe_at(Some(measured_throughput(&cfg)), measured_lock_rate(&cfg))
+    );
     signals::install(false);
     prepare_out(out)?;
     let _lock = lock_out(out, &command_line(), LockScope::Folder, &Terminal)?;
