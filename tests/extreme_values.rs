@@ -14,7 +14,7 @@ use gyroemu::config::presets::PRESETS;
 use gyroemu::config::{parse_config, Config};
 use gyroemu::experiment::pll_params;
 use gyroemu::experiment::readout::post_process;
-use gyroemu::experiment::sweep_work;
+use gyroemu::experiment::{lock_work, sweep_work, MAX_POINT_SAMPLES};
 use gyroemu::lpf::Window;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use toml::Value;
@@ -112,6 +112,7 @@ fn check(name: &str, text: &str) {
         if let Err(e) = pll_params(&cfg, &cfg) {
             panic!("validated, but the PLL's design refused: {e}");
         }
+        lock_plans_without_wrapping(&cfg);
     }
     if cfg.montecarlo.is_some() {
         let _ = validate_lot(&cfg, &[0, 1]);
@@ -180,6 +181,25 @@ fn stepped_sine_plans(cfg: &Config) {
     );
 }
 
+/// The lock run's input samples (whole decimation blocks covering pll.lock_s) agree with the
+/// same product in f64, saturated at the largest count, and the cap weighs them: a lock of
+/// 2^40 s had planned nothing, run for hours and grown without bound.
+fn lock_plans_without_wrapping(cfg: &Config) {
+    let want = (cfg.pll_lock_s().unwrap() * cfg.fs_out_hz()).ceil() * cfg.decimation() as f64;
+    let got = lock_work(cfg).lock_samples;
+    if want >= u64::MAX as f64 {
+        assert_eq!(got, u64::MAX, "{want}");
+    } else {
+        assert!(
+            (got as f64 - want).abs() <= 1e-9 * want,
+            "{got} against {want}"
+        );
+    }
+    let w = sweep_work(cfg).plus(lock_work(cfg));
+    let above = w.point_samples as f64 + want > MAX_POINT_SAMPLES as f64;
+    assert_eq!(w.check_cap(false).is_err(), above, "{w:?}");
+}
+
 /// The sweep's integer sample counts agree with the same sums in f64 (a wrapped sum would be
 /// far off); validation bounds a point's run at 2^53 input samples.
 fn plans_without_wrapping(cfg: &Config) {
@@ -211,7 +231,17 @@ fn no_extreme_number_panics_validation_or_wraps_a_plan() {
     let mut failures = Vec::new();
     let mut tried = 0;
     for (name, _, text) in PRESETS {
-        for extra in ["", DUMP] {
+        // The [pll] preset's lock_s is commented out: a variant sets it, so its extremes
+        // are tried too.
+        let lock = text.contains("\n[pll]").then(|| {
+            let at = text.find("\n[pll]").unwrap() + 1;
+            let line_end = at + text[at..].find('\n').unwrap() + 1;
+            format!("{}lock_s = 5.0\n{}", &text[..line_end], &text[line_end..])
+        });
+        let variants = [(text.to_string(), ""), (text.to_string(), DUMP)]
+            .into_iter()
+            .chain(lock.map(|t| (t, "")));
+        for (text, extra) in variants {
             let text = format!("{text}{extra}");
             let tree: Value = toml::from_str(&text).expect("presets parse");
             let mut paths = Vec::new();
