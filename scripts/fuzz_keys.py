@@ -5,7 +5,7 @@
 
 Each run takes one preset (`gyroemu config --preset NAME`), changes one key (a key the preset
 sets: replaced by an odd value or removed; with --optional, a key the user guide's section 3
-lists that the preset leaves out, added with an odd value), shortens the averaging so an
+lists that the preset leaves out, added with an odd value; with --pairs, one of each), shortens the averaging so an
 accepted config runs in seconds, and runs the preset's command (`run`, `selfcal`, `sweep`,
 `montecarlo`) on one thread. It reports the runs that panicked or died by a signal (their
 configs kept in --keep), and those still running after --timeout seconds, which deserve a
@@ -97,39 +97,46 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=400)
     ap.add_argument("--timeout", type=float, default=20.0)
     ap.add_argument("--optional", action="store_true")
+    ap.add_argument("--pairs", action="store_true",
+                    help="two changes per run: a set key and an optional one")
     ap.add_argument("--keep", default="fuzz-keys-found")
     a = ap.parse_args()
     names = [line.split()[0] for line in subprocess.run(
         [a.binary, "config", "--list"], check=True, capture_output=True, text=True).stdout.splitlines()]
     presets = {n: subprocess.run([a.binary, "config", "--preset", n], check=True,
                                  capture_output=True, text=True).stdout for n in names}
+    guide = Path(__file__).resolve().parent.parent / "docs" / "user-guide.md"
+    rng = random.Random(a.seed)
     jobs = []
     for name, text in presets.items():
         base = tomllib.loads(text)
-        if a.optional:
-            guide = Path(__file__).resolve().parent.parent / "docs" / "user-guide.md"
-            for sec, key in guide_keys(guide):
-                if key not in base.get(sec, {}):
-                    jobs += [(name, sec, key, v) for v in ODD + PLAUSIBLE]
+        optional = [(name, sec, key, v) for sec, key in guide_keys(guide)
+                    if key not in base.get(sec, {}) for v in ODD + PLAUSIBLE]
+        present = [(name, sec, k, v) for sec, kv in base.items() if isinstance(kv, dict)
+                   for k in kv for v in ODD + [None]]
+        if a.pairs:
+            jobs += [(p, rng.choice(optional)) for p in present]
         else:
-            for sec, kv in base.items():
-                if isinstance(kv, dict):
-                    jobs += [(name, sec, k, v) for k in kv for v in ODD + [None]]
-    random.Random(a.seed).shuffle(jobs)
+            jobs += [(j, None) for j in (optional if a.optional else present)]
+    rng.shuffle(jobs)
     found, slow, passed = [], [], 0
     with tempfile.TemporaryDirectory() as tmp:
-        for name, sec, key, value in jobs[: a.runs]:
+        for first, second in jobs[: a.runs]:
+            name = first[0]
             d = tomllib.loads(presets[name])
-            if value is None:
-                del d[sec][key]
-            else:
-                d.setdefault(sec, {})[key] = value
+            changes = []
+            for _, sec, key, value in [c for c in (first, second) if c]:
+                if value is None:
+                    d[sec].pop(key, None)
+                else:
+                    d.setdefault(sec, {})[key] = value
+                changes.append(f"{sec}.{key} = {'(removed)' if value is None else toml_value(value)}")
             cmd = COMMANDS.get(name, "run")
             shorten(d, cmd)
             cfg, out = Path(tmp, "c.toml"), Path(tmp, "out")
             shutil.rmtree(out, ignore_errors=True)
             cfg.write_text(toml_text(d))
-            what = f"{name}: {sec}.{key} = {'(removed)' if value is None else toml_value(value)}"
+            what = f"{name}: {', '.join(changes)}"
             try:
                 r = subprocess.run([a.binary, "--threads", "1", cmd, str(cfg), "--out", str(out)],
                                    capture_output=True, text=True, timeout=a.timeout)

@@ -75,7 +75,7 @@ impl Work {
     /// lane group alone on one thread (a point's samples run in sequence, so more threads do
     /// not shorten it), after the carrier locks at `lock_per_s` input samples/s (one thread;
     /// [`measured_lock_rate`]), or when that is not given at a lane's share of a lane group's
-    /// rate (an upper bound: the lock's one-lane board runs 2 to 4 times faster).
+    /// rate (an upper bound: the lock's one-lane board ran 4 times faster on an AMD Zen 4).
     pub fn summary_at(&self, point_samples_per_s: Option<f64>, lock_per_s: Option<f64>) -> String {
         if self.points == 0 {
             // A shard with no point: no longest point, no time to estimate.
