@@ -158,8 +158,8 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
     let mine = Shard::items(req.shard.as_ref(), n);
     // Say what this will cost before anything runs.
     let (share, split_warning) = check_run(cfg, out, req.shard.as_ref(), req.force)?;
-    let throughput = measured_throughput(cfg);
-    reporter.note(&share.describe_at(Some(throughput), measured_lock_rate(cfg)));
+    let (throughput, lock_rate) = (measured_throughput(cfg), measured_lock_rate(cfg));
+    reporter.note(&share.describe_at(Some(throughput), lock_rate));
     if let Some(w) = split_warning {
         reporter.warn(&w);
     }
@@ -197,7 +197,7 @@ pub fn run(req: &RunRequest, reporter: &dyn Reporter) -> Result<RunOutcome, RunE
             points_dir.display(),
             points_work(cfg, &todo)
                 .plus(lock_work(cfg))
-                .summary_at(Some(throughput), measured_lock_rate(cfg))
+                .summary_at(Some(throughput), lock_rate)
         )
     } else {
         what
