@@ -140,8 +140,17 @@ impl Work {
         if force || self.capped_samples() <= MAX_POINT_SAMPLES {
             return Ok(());
         }
+        // With a lock the cap weighs two kinds of samples: say so, and give their sum.
+        let what = if self.lock_samples > 0 {
+            format!(
+                "samples ({:.3e}: the point-samples and the carrier lock's input samples together)",
+                self.capped_samples() as f64
+            )
+        } else {
+            "point-samples".to_string()
+        };
         Err(format!(
-            "{}: above the cap of {:.0e} point-samples without --force (a mistyped Q or averaging time would otherwise start a run of days); {remedy}, or add --force to run it anyway",
+            "{}: above the cap of {:.0e} {what} without --force (a mistyped Q or averaging time would otherwise start a run of days); {remedy}, or add --force to run it anyway",
             self.describe(None),
             MAX_POINT_SAMPLES as f64
         ))
@@ -301,6 +310,17 @@ mod tests {
         assert!(w(0, half).check_cap(false).is_ok());
         let e = w(half, half).check_cap(false).unwrap_err();
         assert!(e.contains("experiment.average_s"), "{e}");
+        // What it weighs is said as such, with the sum the cap compared (1.000e11 + 2).
+        assert!(
+            e.contains("above the cap of 1e11 samples (1.000e11: the point-samples and the carrier lock's input samples together)"),
+            "{e}"
+        );
+        // Without a lock the cap counts point-samples alone, and says only that.
+        let e = w(2 * half, 0).check_cap(false).unwrap_err();
+        assert!(
+            e.contains("above the cap of 1e11 point-samples without"),
+            "{e}"
+        );
         // The lock the larger part: its key is the one named.
         let e = w(1, 2 * half).check_cap(false).unwrap_err();
         assert!(e.contains("shorten pll.lock_s"), "{e}");
