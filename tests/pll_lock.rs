@@ -265,6 +265,7 @@ fn a_raised_cancel_stops_the_lock_before_any_block() {
 /// one thread is added to the estimate. A config without [pll] locks nothing.
 #[test]
 fn the_lock_is_in_the_plan_its_cap_and_its_time() {
+    use gyroemu::analysis::selfcal_analyses::drift_tracking_design;
     use gyroemu::experiment::work::{lock_work, measured_lock_rate};
     use gyroemu::experiment::{sweep_work, MAX_POINT_SAMPLES};
     let mut c = with_pll(fork(), 5.0);
@@ -283,17 +284,32 @@ fn the_lock_is_in_the_plan_its_cap_and_its_time() {
         "a sweep's own work has no lock"
     );
     assert_eq!(lock_work(&fork()).lock_samples, 0, "no [pll], no lock");
-    // Who locks counts it: a montecarlo device once; selfcal once, and once more for its
-    // drift scenario (which resolves the nominal lock again), with nothing else changed.
+    // Who locks counts it: a montecarlo device once; selfcal once for its sweeps (its drift
+    // scenario runs on that held carrier), and once per temperature where the drift
+    // scenario's tracking loop fits (that loop keeps the config's [pll], so its lock_s).
     let device = gyroemu::analysis::montecarlo::device_work(&c).0;
     assert_eq!(device.lock_samples, 792_000);
     let mut sc = c.clone();
     sc.selfcal = Some(Default::default());
     let lone = gyroemu::analysis::selfcal_work(&sc);
     assert_eq!(lone.lock_samples, 792_000);
-    sc.selfcal.as_mut().unwrap().drift_delta_t_k = vec![10.0];
+    sc.selfcal.as_mut().unwrap().drift_delta_t_k = vec![10.0, -10.0];
+    assert!(drift_tracking_design(&sc).is_some());
     let drifting = gyroemu::analysis::selfcal_work(&sc);
-    assert_eq!(drifting.lock_samples, 2 * 792_000);
+    assert_eq!(drifting.lock_samples, 3 * 792_000);
+    // Without a [pll] nothing locks before the sweeps; the drift loop's default lock_s
+    // (derived from the nominal device) runs once per temperature.
+    let mut open = fork();
+    open.selfcal = Some(Default::default());
+    open.selfcal.as_mut().unwrap().drift_delta_t_k = vec![10.0, -10.0, 20.0];
+    let design = drift_tracking_design(&open).expect("the default loop fits the fork");
+    let one = design.pll_lock_s().expect("derived") * design.fs_out_hz();
+    let per_lock = one.ceil() as u64 * design.decimation() as u64;
+    assert!(per_lock > 0);
+    assert_eq!(
+        gyroemu::analysis::selfcal_work(&open).lock_samples,
+        3 * per_lock
+    );
     let both = sweep_work(&c).plus(w);
     assert_eq!(both.capped_samples(), both.point_samples + 792_000);
     assert!(both.check_cap(false).is_ok());

@@ -462,9 +462,30 @@ pub fn drift_analysis(
     group_threads: Option<usize>,
     progress: Progress,
 ) -> Result<Vec<DriftPoint>, SweepError> {
+    let (held, _) = resolve_lock(cfg)?;
+    drift_analysis_held(
+        cfg,
+        &held,
+        deltas_k,
+        nominal_deg_per_dps,
+        group_threads,
+        progress,
+    )
+}
+
+/// [`drift_analysis`] on `held`, `cfg` with its nominal carrier already locked and held
+/// ([`resolve_lock`]): `selfcal` has locked it for its sweeps, and the lock is
+/// deterministic, so locking it again would only repeat the same run.
+pub fn drift_analysis_held(
+    cfg: &Config,
+    held: &Config,
+    deltas_k: &[f64],
+    nominal_deg_per_dps: f64,
+    group_threads: Option<usize>,
+    progress: Progress,
+) -> Result<Vec<DriftPoint>, SweepError> {
     let design = drift_tracking_design(cfg);
     let tracked_too = design.is_some();
-    let (held, _) = resolve_lock(cfg)?;
     // Progress in thousandths of each offset (two self-calibrations of two sweeps, a quarter
     // each; the tracked half only when a loop fits), summed over the offsets and quarters,
     // which all run side by side.
@@ -475,7 +496,7 @@ pub fn drift_analysis(
     let parts: Vec<[AtomicU64; 4]> = deltas_k.iter().map(|_| Default::default()).collect();
     let done = AtomicU64::new(0);
     let one = |(i, &dt): (usize, &f64)| -> Result<DriftPoint, SweepError> {
-        let open = drifted(&held, dt);
+        let open = drifted(held, dt);
         let at = |quarter: usize, d: u64, t: u64| {
             let v = d.min(t) * 250 / t.max(1);
             let prev = parts[i][quarter].fetch_max(v, Ordering::Relaxed);

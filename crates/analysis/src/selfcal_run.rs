@@ -3,8 +3,8 @@
 
 use crate::selfcal::{sweep_configs, SelfcalCore};
 use crate::selfcal_analyses::{
-    allan_analysis, drift_analysis, drift_tracking_design, tau_analysis, AllanResult, DriftPoint,
-    TauPoint,
+    allan_analysis, drift_analysis_held, drift_tracking_design, tau_analysis, AllanResult,
+    DriftPoint, TauPoint,
 };
 use gyroemu_config::Config;
 use gyroemu_experiment::{
@@ -111,8 +111,9 @@ pub fn run_selfcal(cfg: &Config, reporter: &dyn Reporter) -> Result<SelfcalRepor
             return Ok(None);
         }
         let p = reporter.task("drift scenario");
-        let d = drift_analysis(
+        let d = drift_analysis_held(
             cfg,
+            &held,
             &sc.drift_delta_t_k,
             m.coriolis.slope_deg_per_dps,
             share,
@@ -154,20 +155,19 @@ pub fn selfcal_work(cfg: &Config) -> Work {
         r.experiment.average_s = t;
         w = w.plus(sweep_work(&r));
     }
-    let cases = if drift_tracking_design(cfg).is_some() {
-        2
-    } else {
-        1
-    };
-    if !sc.drift_delta_t_k.is_empty() {
-        // `drift_analysis` resolves the nominal lock again.
-        w = w.plus(lock_work(cfg));
-    }
+    // The drift scenario runs on the carrier locked above; where its tracking loop fits,
+    // each temperature locks that loop first (the design's `lock_s`, on the same board
+    // rates), then runs its sweeps at the open-loop carrier and at the locked one.
+    let design = drift_tracking_design(cfg);
+    let cases = if design.is_some() { 2 } else { 1 };
     for &dt in &sc.drift_delta_t_k {
         let (r, c) = sweep_configs(&crate::selfcal::drifted(cfg, dt));
         let pair = sweep_work(&r).plus(sweep_work(&c));
         for _ in 0..cases {
             w = w.plus(pair);
+        }
+        if let Some(d) = &design {
+            w = w.plus(lock_work(d));
         }
     }
     w
