@@ -9,6 +9,7 @@ use crate::merge_split::{bad, read_split, Split};
 use crate::points::{config_hash, PointFile};
 use gyroemu_analysis::montecarlo::LotSummary;
 use gyroemu_config::parse_config;
+use gyroemu_experiment::work::{lock_work, measured_lock_rate};
 use gyroemu_experiment::{finish_sweep, resolve_lock, Reporter};
 use gyroemu_report::{check_problems, run_title, write_run};
 use std::collections::BTreeMap;
@@ -77,6 +78,18 @@ fn merge_run(dir: &Path, split: Split, reporter: &dyn Reporter) -> Result<Vec<Pa
         })
         .collect::<Result<BTreeMap<_, _>, RunError>>()?;
     // The shards swept at the carrier a [pll] locked: lock again (the same bits) to read out.
+    // Said first, with its size: the lock is as long as the user's pll.lock_s (the shards
+    // passed the cap with it, or were forced), and nothing else in a merge takes time.
+    let lock_samples = lock_work(&cfg).lock_samples;
+    if lock_samples > 0 {
+        let time = measured_lock_rate(&cfg).map_or(String::new(), |r| {
+            format!(", about {:.3} s on one thread", lock_samples as f64 / r)
+        });
+        reporter.note(&format!(
+            "merge: the shards ran at the carrier their [pll] locked; locking it again to read them out (the same lock run, so the same carrier): {:.3e} input samples{time}",
+            lock_samples as f64
+        ));
+    }
     let (held, lock) = resolve_lock(&cfg)?;
     if let Some(l) = &lock {
         reporter.note(&l.note());
