@@ -121,18 +121,7 @@ fn a_cancel_before_the_start_saves_nothing_and_says_so() {
 /// carrier, or fail to lock, before the sweep saw the flag.
 #[test]
 fn a_cancel_during_the_carrier_lock_stops_the_lock() {
-    let mut cfg = config();
-    cfg.noise = None;
-    // At Q = 1000 no loop fits this board's low-pass.
-    cfg.device.q = 2000.0;
-    cfg.pll = Some(gyroemu_config::PllConfig {
-        natural_hz: None,
-        damping: core::f64::consts::FRAC_1_SQRT_2,
-        lock_s: Some(5.0),
-        mode: 1,
-    });
-    cfg.resolve();
-    cfg.validate().unwrap();
+    let cfg = pll_config();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     prepare_out(&out).unwrap();

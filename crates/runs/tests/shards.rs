@@ -626,28 +626,21 @@ fn a_hash_edited_into_non_ascii_is_refused_not_a_panic() {
 /// lock is as long as the user's pll.lock_s. The merged results are a one-machine run's.
 #[test]
 fn merge_says_it_locks_the_carrier_again_and_how_long() {
-    let mut cfg = config();
-    cfg.noise = None;
-    // At Q = 1000 no loop fits this board's low-pass.
-    cfg.device.q = 2000.0;
-    cfg.pll = Some(gyroemu_config::PllConfig {
-        natural_hz: None,
-        damping: core::f64::consts::FRAC_1_SQRT_2,
-        lock_s: Some(5.0),
-        mode: 1,
-    });
-    cfg.resolve();
-    cfg.validate().unwrap();
+    // Runs `cfg` as two shards into `out`, merges them, and returns what merge said.
+    let split_and_merge = |cfg: &Config, out: &Path| {
+        for s in ["0/2", "1/2"] {
+            run_shard(cfg, out, Some(parse_shard(s).unwrap()))
+                .0
+                .unwrap();
+        }
+        let rec = Record::default();
+        merge(out, &rec).unwrap();
+        rec.0.into_inner().unwrap()
+    };
+    let cfg = pll_config();
     let dir = tempfile::tempdir().unwrap();
     let (split, whole) = (dir.path().join("split"), dir.path().join("whole"));
-    for s in ["0/2", "1/2"] {
-        run_shard(&cfg, &split, Some(parse_shard(s).unwrap()))
-            .0
-            .unwrap();
-    }
-    let rec = Record::default();
-    merge(&split, &rec).unwrap();
-    let notes = rec.0.into_inner().unwrap();
+    let notes = split_and_merge(&cfg, &split);
     // 5 s at 2400 outputs/s: 12000 blocks of 100 input samples.
     let said = notes
         .iter()
@@ -666,16 +659,8 @@ fn merge_says_it_locks_the_carrier_again_and_how_long() {
     let csv = |d: &Path| std::fs::read(d.join("results.csv")).unwrap();
     assert!(csv(&split) == csv(&whole));
     // Without a [pll], nothing is locked and nothing said of it.
-    let plain = dir.path().join("plain");
     let mut open = cfg.clone();
     open.pll = None;
-    for s in ["0/2", "1/2"] {
-        run_shard(&open, &plain, Some(parse_shard(s).unwrap()))
-            .0
-            .unwrap();
-    }
-    let rec = Record::default();
-    merge(&plain, &rec).unwrap();
-    let notes = rec.0.into_inner().unwrap();
+    let notes = split_and_merge(&open, &dir.path().join("plain"));
     assert!(!notes.iter().any(|n| n.contains("lock")), "{notes:?}");
 }

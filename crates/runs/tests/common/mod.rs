@@ -84,3 +84,20 @@ pub fn config() -> gyroemu_config::Config {
     c.validate().unwrap();
     c
 }
+
+/// [`config`] without noise, with a `[pll]` that locks for 5 s (12000 blocks of 100 input
+/// samples at 2400 outputs/s). Q is 2000: at 1000 no loop fits this board's low-pass.
+pub fn pll_config() -> gyroemu_config::Config {
+    let mut cfg = config();
+    cfg.noise = None;
+    cfg.device.q = 2000.0;
+    cfg.pll = Some(gyroemu_config::PllConfig {
+        natural_hz: None,
+        damping: core::f64::consts::FRAC_1_SQRT_2,
+        lock_s: Some(5.0),
+        mode: 1,
+    });
+    cfg.resolve();
+    cfg.validate().unwrap();
+    cfg
+}
