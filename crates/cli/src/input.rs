@@ -68,7 +68,9 @@ pub fn print_out(text: &str) -> Result<()> {
 
 /// This process's command line, for the output folder's lock (arguments with spaces quoted).
 pub fn command_line() -> String {
-    std::env::args()
+    // `args_os`: `args` panics on an argument that is not UTF-8 (a path of Latin-1 bytes).
+    std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
         .map(|a| {
             if a.contains(char::is_whitespace) || a.is_empty() {
                 format!("'{a}'")

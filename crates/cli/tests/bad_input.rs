@@ -436,3 +436,34 @@ fn integers_out_of_range_exit_2_echoed_as_written() {
         assert!(!out.exists());
     }
 }
+
+/// Paths are bytes on Unix, not always UTF-8 (a Latin-1 file name): a config or an output
+/// folder so named runs, and `merge` on such a folder reads it; none panics (the command
+/// line kept in the folder's lock had been read as UTF-8, exit 101 after creating `--out`).
+#[cfg(unix)]
+#[test]
+fn paths_that_are_not_utf8_run_without_a_panic() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(dir.path(), "ok.toml", GOOD.as_bytes());
+    let latin = dir.path().join(OsStr::from_bytes(b"caf\xe9.toml"));
+    std::fs::copy(&cfg, &latin).unwrap();
+    let out = dir.path().join(OsStr::from_bytes(b"r\xe9sultats"));
+    let o = run(&latin, &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("results.csv").is_file());
+    // The folder is released: a second command takes it and reads its run.
+    let o = Command::new(env!("CARGO_BIN_EXE_gyroemu"))
+        .arg("merge")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_ne!(
+        o.status.code(),
+        Some(101),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("panicked"));
+}
