@@ -62,7 +62,7 @@ pub(crate) fn holds(text: &str) -> bool {
 /// Removes the lock at `path` if it still holds `text` (not a lock another process took
 /// over after this one was found stale).
 pub(crate) fn remove_if_ours(path: &Path, text: &str) {
-    if std::fs::read_to_string(path).is_ok_and(|t| t == text) {
+    if gyroemu_io::read_own_text(path, gyroemu_io::MAX_LOCK_BYTES).is_ok_and(|t| t == text) {
         let _ = std::fs::remove_file(path);
     }
 }

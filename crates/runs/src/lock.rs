@@ -184,7 +184,7 @@ fn acquire(path: &Path, text: &str, reporter: &dyn Reporter) -> Result<(), RunEr
 /// The live holder of the lock at `path`: `None` when there is no lock or it was stale (and
 /// is now removed, with a warning). An unreadable lock is refused: its holder is unknown.
 fn live_holder(path: &Path, reporter: &dyn Reporter) -> Result<Option<LockInfo>, RunError> {
-    let text = match std::fs::read_to_string(path) {
+    let text = match gyroemu_io::read_own_text(path, gyroemu_io::MAX_LOCK_BYTES) {
         Ok(t) => t,
         Err(e) if e.kind() == ErrorKind::NotFound => return Ok(None),
         // A folder or an unreadable file where the lock goes: the user's to fix (exit 2),
@@ -243,7 +243,7 @@ fn take_over(path: &Path, stale: &str) {
     if std::fs::rename(path, &aside).is_err() {
         return;
     }
-    if std::fs::read_to_string(&aside).is_ok_and(|t| t != stale) {
+    if gyroemu_io::read_own_text(&aside, gyroemu_io::MAX_LOCK_BYTES).is_ok_and(|t| t != stale) {
         let _ = std::fs::hard_link(&aside, path);
     }
     let _ = std::fs::remove_file(&aside);
@@ -293,7 +293,7 @@ pub(crate) fn live_other_lock(
     let mut locks = files_like(out, "gyroemu-shard-", ".lock")?;
     locks.push(out.join(LOCK_FILE));
     for p in locks {
-        let Ok(text) = std::fs::read_to_string(&p) else {
+        let Ok(text) = gyroemu_io::read_own_text(&p, gyroemu_io::MAX_LOCK_BYTES) else {
             continue;
         };
         let ours = serde_json::from_str::<LockInfo>(&text).is_ok_and(|i| {

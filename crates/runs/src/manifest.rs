@@ -149,7 +149,8 @@ impl Manifest {
 
 /// Reads a manifest file.
 pub fn read_manifest(path: &Path) -> Result<Manifest, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
+    let text = gyroemu_io::read_own_text(path, gyroemu_io::MAX_MANIFEST_BYTES)
+        .map_err(|e| e.to_string())?;
     let m: Manifest =
         serde_json::from_str(&text).map_err(|e| gyroemu_config::plain_words(&e.to_string()))?;
     if m.format != MANIFEST_FORMAT {

@@ -104,7 +104,7 @@ pub fn scan_records<R: RecordFile>(out: &Path) -> Result<Scan<R>, String> {
         .collect();
     paths.sort();
     for p in paths {
-        let parsed = std::fs::read_to_string(&p)
+        let parsed = gyroemu_io::read_own_text(&p, gyroemu_io::MAX_RECORD_BYTES)
             .map_err(|e| e.to_string())
             .and_then(|t| {
                 let v = checked_value(&t)?;

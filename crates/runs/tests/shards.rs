@@ -664,3 +664,47 @@ fn merge_says_it_locks_the_carrier_again_and_how_long() {
     let notes = split_and_merge(&open, &dir.path().join("plain"));
     assert!(!notes.iter().any(|n| n.contains("lock")), "{notes:?}");
 }
+
+/// What stands under a point file's name may not be a file: a symlink to /dev/zero was read
+/// until memory ran out, and a FIFO blocked `merge` and `run` forever. Merge refuses either,
+/// naming the shard to rerun, and that shard's rerun computes the point again.
+#[cfg(unix)]
+#[test]
+fn a_point_file_that_is_a_device_or_a_fifo_is_refused_not_read() {
+    let cfg = config();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    for s in ["0/2", "1/2"] {
+        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
+            .0
+            .unwrap();
+    }
+    let p4 = out.join("points").join("point-4.json");
+    let fifo = |p: &Path| {
+        let made = std::process::Command::new("mkfifo").arg(p).status();
+        assert!(
+            made.is_ok_and(|s| s.success()),
+            "mkfifo (coreutils) made no FIFO"
+        );
+    };
+    let zero = |p: &Path| std::os::unix::fs::symlink("/dev/zero", p).unwrap();
+    for (what, make) in [("/dev/zero", &zero as &dyn Fn(&Path)), ("a FIFO", &fifo)] {
+        std::fs::remove_file(&p4).unwrap();
+        make(&p4);
+        let why = merge_refusal(&out);
+        assert!(
+            why.contains("point-4.json") && why.contains("not a regular file"),
+            "{what}: {why}"
+        );
+        let owner = why
+            .split("--shard ")
+            .nth(1)
+            .and_then(|s| s.split_whitespace().next())
+            .unwrap_or_else(|| panic!("{what}: no shard named in {why}"));
+        run_shard(&cfg, &out, Some(parse_shard(owner).unwrap()))
+            .0
+            .unwrap();
+        assert!(std::fs::metadata(&p4).unwrap().is_file(), "{what}");
+        merge(&out, &Quiet).unwrap();
+    }
+}
