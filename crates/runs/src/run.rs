@@ -142,6 +142,7 @@ pub fn check_run(
     // Every run of a [pll] config (each shard, each resume) locks its carrier first.
     .plus(lock_work(cfg));
     share.check_cap(force).map_err(RunError::BadInput)?;
+    crate::refuse_other_summary(out, force)?;
     let warning = check_split(out, shard, RunKind::Run, &config_hash(cfg), "point")?;
     Ok((share, warning))
 }

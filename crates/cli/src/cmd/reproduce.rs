@@ -5,7 +5,7 @@ use crate::progress::Terminal;
 use crate::signals;
 use anyhow::Result;
 use gyroemu_report::{plan_reproduce, reproduce, ReportError};
-use gyroemu_runs::{lock_out, lock_subfolders, prepare_out, LockScope};
+use gyroemu_runs::{lock_out, lock_subfolders, prepare_out, refuse_runs_under, LockScope};
 use std::path::Path;
 
 /// Reproduces the paper's figures from the embedded presets into `out`.
@@ -20,6 +20,7 @@ pub fn reproduce_command(out: &Path, quick: bool) -> Result<()> {
     }
     signals::install(false);
     // The folders are checked and locked before any sample (the throughput measure included).
+    refuse_runs_under(out, &plan.preset_folders())?;
     prepare_out(out)?;
     let _lock = lock_out(out, &command_line(), LockScope::Folder, &Terminal)?;
     let _preset_locks = lock_subfolders(out, &plan.preset_folders(), &command_line(), &Terminal)?;
