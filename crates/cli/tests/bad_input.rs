@@ -467,3 +467,47 @@ fn paths_that_are_not_utf8_run_without_a_panic() {
     );
     assert!(!String::from_utf8_lossy(&o.stderr).contains("panicked"));
 }
+
+/// An output folder whose path leaves no room below it for the files a run writes (near the
+/// system's PATH_MAX) is refused before any sample: the folder could be made, so the run went
+/// on and failed on its first file after the emulation (exit 1, dump files without their
+/// siblings, no point saved). A path with room runs.
+#[cfg(target_os = "linux")]
+#[test]
+fn an_output_path_too_long_for_its_files_is_refused_before_any_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(dir.path(), "ok.toml", GOOD.as_bytes());
+    // A path of exactly `len` bytes below the temporary folder (components of at most 200
+    // bytes: a name may not pass 255), its parent made.
+    let path_of = |len: usize, c: &str| {
+        let mut p = dir.path().to_path_buf();
+        while p.as_os_str().len() + 1 + 200 + 1 + 50 <= len {
+            p.push(c.repeat(200));
+        }
+        let rest = len - p.as_os_str().len() - 1;
+        p.push(c.repeat(rest));
+        assert_eq!(p.as_os_str().len(), len);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        p
+    };
+    // 4050 bytes: the folder could be made (PATH_MAX is 4096), its files could not.
+    let out = path_of(4050, "d");
+    let o = run(&cfg, &out);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("a path of 4050 bytes") && err.contains("shorter --out"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing is made");
+    // 3900 bytes leave room for every file a run writes: it runs.
+    let short = path_of(3900, "f");
+    let o = run(&cfg, &short);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(short.join("points").is_dir());
+}

@@ -73,6 +73,7 @@ pub fn prepare_out(out: &Path) -> Result<(), RunError> {
             out.display()
         )));
     }
+    check_path_room(out)?;
     std::fs::create_dir_all(out).map_err(|e| {
         RunError::BadInput(format!(
             "output folder `{}` cannot be created: {e}",
@@ -88,6 +89,31 @@ pub fn prepare_out(out: &Path) -> Result<(), RunError> {
                 out.display()
             ))
         })
+}
+
+/// What the files written below an output folder add to its path, at most: the longest is a
+/// preset folder's dump temporary, `m2tfg-ratetable/.dump_decimated.sigmf-data.tmpXXXXXX.sigmf-data`
+/// (63 bytes), and a lot's `devices/.device-999999.json.tmpXXXXXX.json` is shorter.
+const PATH_ROOM: usize = 96;
+
+/// The longest path the system opens (PATH_MAX, with its terminating NUL).
+#[cfg(target_os = "linux")]
+const PATH_MAX: usize = 4096;
+#[cfg(not(target_os = "linux"))]
+const PATH_MAX: usize = 1024;
+
+/// Refuses an output folder whose path leaves no room for the files written below it: the
+/// folder itself could be made, so the run went on and failed on its first point or dump
+/// file, after the emulation ("File name too long", exit 1).
+fn check_path_room(out: &Path) -> Result<(), RunError> {
+    let len = out.as_os_str().len();
+    if len + PATH_ROOM < PATH_MAX {
+        return Ok(());
+    }
+    Err(RunError::BadInput(format!(
+        "output folder `{}` is a path of {len} bytes: the files written below it add up to {PATH_ROOM} more, past the system's limit of {PATH_MAX} bytes on a path (PATH_MAX): choose a shorter --out (a relative one from a nearer working folder counts only its own length)",
+        out.display()
+    )))
 }
 
 /// The folders `names` below `out`, for a command that writes several runs (reproduce: one per
