@@ -109,3 +109,30 @@ fn run_refuses_a_summary_no_run_wrote_unless_forced() {
     // The run's own folder is its to rerun: no refusal.
     ok(gyroemu(&["run", s(&cfg), "--out", s(&out)], &[]));
 }
+
+/// `--force` deletes another config's results first; what it cannot delete (here a folder
+/// where `results.csv` goes, which not even root deletes as a file) is an output folder that
+/// cannot be written: exit 2 before any sample, naming it (it was exit 1, an I/O failure).
+#[test]
+fn what_force_cannot_delete_is_refused_as_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = config(dir.path(), "a.toml", GOOD);
+    let b = config(
+        dir.path(),
+        "b.toml",
+        &GOOD.replace("q = 1000.0", "q = 1200.0"),
+    );
+    let out = dir.path().join("o");
+    ok(gyroemu(&["run", s(&a), "--out", s(&out)], &[]));
+    std::fs::remove_file(out.join("results.csv")).unwrap();
+    std::fs::create_dir_all(out.join("results.csv/kept")).unwrap();
+    let o = gyroemu(&["run", s(&b), "--out", s(&out), "--force"], &[]);
+    refused(
+        &o,
+        &[
+            "--force cannot delete",
+            "results.csv",
+            "choose another --out",
+        ],
+    );
+}

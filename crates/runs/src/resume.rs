@@ -5,7 +5,7 @@
 
 use crate::config_diff::{config_diff_for, describe_diff};
 use crate::device_file::{lot_hash, DeviceFile, DEVICES_DIR};
-use crate::dumps::{dump_files, remove_files};
+use crate::dumps::dump_files;
 use crate::error::RunError;
 use crate::manifest::{read_manifest, shard_manifest_paths, RunKind, BUILD, RUN_MANIFEST};
 use crate::points::{config_hash, scan_points, short_sha, PointFile, POINTS_DIR};
@@ -256,11 +256,20 @@ fn clear_out(out: &Path, reporter: &dyn Reporter) -> Result<(), RunError> {
             lock.display()
         )));
     }
+    // A folder --force cannot clear is one that cannot be written: bad input (exit 2), like
+    // an output folder that cannot be created, and refused before any sample.
+    let cannot = |p: &Path| {
+        let p = p.display().to_string();
+        move |e: std::io::Error| {
+            RunError::BadInput(format!(
+                "--force cannot delete `{p}` ({e}): make the output folder writable, or choose another --out"
+            ))
+        }
+    };
     for dir in [POINTS_DIR, DEVICES_DIR] {
         let d = out.join(dir);
         if d.exists() {
-            std::fs::remove_dir_all(&d)
-                .map_err(RunError::io(format!("cannot delete `{}`", d.display())))?;
+            std::fs::remove_dir_all(&d).map_err(cannot(&d))?;
         }
     }
     let mut files = shard_manifest_paths(out)?;
@@ -273,5 +282,8 @@ fn clear_out(out: &Path, reporter: &dyn Reporter) -> Result<(), RunError> {
     );
     files.retain(|f| f.exists());
     files.extend(dump_files(out));
-    remove_files(&files)
+    for f in &files {
+        std::fs::remove_file(f).map_err(cannot(f))?;
+    }
+    Ok(())
 }
