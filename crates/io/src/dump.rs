@@ -292,6 +292,49 @@ fn optional<T>(
     }
 }
 
+/// The numbers a recording's `gyroemu:` keys describe it with (the operating point, the
+/// converter events), by name without the prefix. gyroemu writes a finite number under every
+/// such key but its channel list, its doc and `t0_s` (read apart): anything else there is
+/// refused, not dropped (a clip count written as "2800" was dropped, and the clipped window
+/// read clean). Counts (`*_samples*`) must be whole and >= 0; frequencies (`*_hz`) >= 0, and
+/// the carrier, the resonances and the low-pass cutoff > 0; the decimation and the low-pass
+/// order whole and >= 1.
+fn extra_keys(g: &serde_json::Map<String, Value>) -> Result<BTreeMap<String, f64>, String> {
+    let mut extra = BTreeMap::new();
+    for (k, v) in g {
+        let Some(name) = k.strip_prefix("gyroemu:") else {
+            continue;
+        };
+        if matches!(name, "channels" | "doc" | "t0_s") {
+            continue;
+        }
+        let x = v
+            .as_f64()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("{k} = {v}: must be a finite number (gyroemu writes one)"))?;
+        let whole = x.fract() == 0.0;
+        let rule = if name.contains("_samples") {
+            (!(whole && x >= 0.0)).then_some("a whole count >= 0")
+        } else if matches!(name, "decimation" | "lpf_order") {
+            (!(whole && x >= 1.0)).then_some("a whole number >= 1")
+        } else if matches!(
+            name,
+            "carrier_hz" | "f0_hz" | "f0_mode2_hz" | "lpf_cutoff_hz"
+        ) {
+            (x <= 0.0).then_some("a frequency > 0")
+        } else if name.ends_with("_hz") {
+            (x < 0.0).then_some("a frequency >= 0")
+        } else {
+            None
+        };
+        if let Some(rule) = rule {
+            return Err(format!("{k} = {v}: must be {rule}"));
+        }
+        extra.insert(name.to_string(), x);
+    }
+    Ok(extra)
+}
+
 /// Reads a SigMF recording from its `.sigmf-meta` path.
 pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
     let bad = |reason: String| read_err(meta_path, reason);
@@ -402,11 +445,7 @@ pub fn read_sigmf(meta_path: &Path) -> Result<Dump, IoError> {
         Value::as_u64,
     )
     .map_err(bad)?;
-    let extra = g
-        .iter()
-        .filter_map(|(k, v)| Some((k.strip_prefix("gyroemu:")?.to_string(), v.as_f64()?)))
-        .filter(|(k, _)| k != "t0_s")
-        .collect();
+    let extra = extra_keys(g).map_err(bad)?;
     let name = meta_path.file_name().unwrap_or_default().to_string_lossy();
     let data_path = meta_path.with_file_name(format!(
         "{}.sigmf-data",

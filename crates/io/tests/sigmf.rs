@@ -371,3 +371,58 @@ fn a_sample_float32_cannot_hold_writes_no_wav_and_says_why() {
         assert_eq!(files.len(), 4, "{x:e}: {files:?}");
     }
 }
+
+/// The numbers under a recording's `gyroemu:` keys are read as written or refused, never
+/// dropped: a clip count edited into a string had been dropped without a word, and the
+/// clipped window then read clean; negative or fractional counts and a negative carrier were
+/// taken. Each bad value is refused naming its key; the numbers as gyroemu writes them read.
+#[test]
+fn gyroemu_keys_that_are_not_their_numbers_are_refused_not_dropped() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut r = SignalRecorder::new(vec!["tia1_v".into()], 1000.0, 0, 4);
+    for n in 0..4 {
+        r.record(n, &[n as f64]);
+    }
+    r.write(dir.path(), "d").unwrap();
+    let meta_path = dir.path().join("d.sigmf-meta");
+    let written = read_meta(&meta_path);
+    let with = |key: &str, v: Value| {
+        let mut m = written.clone();
+        m["global"][format!("gyroemu:{key}")] = v;
+        std::fs::write(&meta_path, serde_json::to_vec(&m).unwrap()).unwrap();
+        gyroemu_io::read_sigmf(&meta_path)
+    };
+    use serde_json::json;
+    let good = with("adc_clipped_samples_mode1", json!(2800.0)).unwrap();
+    assert_eq!(good.extra["adc_clipped_samples_mode1"], 2800.0);
+    let good = with("carrier_hz", json!(15000.0)).unwrap();
+    assert_eq!(good.extra["carrier_hz"], 15000.0);
+    assert_eq!(
+        with("rate_dps", json!(-25.0)).unwrap().extra["rate_dps"],
+        -25.0
+    );
+    for (key, v, rule) in [
+        (
+            "adc_clipped_samples_mode1",
+            json!("2800"),
+            "a finite number",
+        ),
+        (
+            "adc_clipped_samples_mode1",
+            json!(-3.0),
+            "a whole count >= 0",
+        ),
+        ("tia_railed_samples_mode2", json!(3.5), "a whole count >= 0"),
+        ("events_counted_samples", json!(null), "a finite number"),
+        ("carrier_hz", json!(-1.0), "a frequency > 0"),
+        ("omega_hz", json!(-0.5), "a frequency >= 0"),
+        ("decimation", json!(0.0), "a whole number >= 1"),
+        ("rate_dps", json!([25.0]), "a finite number"),
+    ] {
+        let e = with(key, v.clone()).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("gyroemu:{key} = {v}: must be {rule}")),
+            "{key} = {v}: {e}"
+        );
+    }
+}
