@@ -11,12 +11,14 @@ macro_rules! note {
     }};
 }
 
-/// `println!` that never panics, for the same reason (`gyroemu selfcal ... | head -1`).
+/// `println!` that never panics, for the same reason (`gyroemu selfcal ... | head -1`: a
+/// reader that closed the pipe ends the output quietly), and whose other failures are the
+/// command's (`> /dev/full` lost selfcal's headline with exit 0): `?` in a function returning
+/// `anyhow::Result`, as [`input::print_out`].
 macro_rules! say {
-    ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stdout(), $($arg)*);
-    }};
+    ($($arg:tt)*) => {
+        $crate::input::print_out(&format!("{}\n", format_args!($($arg)*)))?
+    };
 }
 
 mod cmd;

@@ -71,3 +71,53 @@ fn a_full_standard_output_and_a_dangling_out_link_are_named() {
         stderr(&o)
     );
 }
+
+/// `selfcal` prints its headline on stdout: a stdout that fails (a full device) is the
+/// command's failure, exit 1 naming the standard output, as for `config` (it exited 0 and the
+/// two lines were lost); a reader gone (`| head -1`) still ends quietly with exit 0.
+#[test]
+fn selfcal_headline_lost_to_a_full_stdout_is_an_error_but_not_to_a_closed_pipe() {
+    const SELFCAL: &str = r#"
+[device]
+f0_hz = 15000.0
+q = 1000.0
+angular_gain = 1.0
+[drive]
+f1 = 1.0
+[board]
+fs_hz = 240000.0
+lpf_cutoff_hz = 200.0
+decimation = 100
+[experiment]
+kind = "rotating"
+rates_dps = [200.0, 300.0, 400.0]
+average_s = 0.9
+settle_s = 0.05
+"#;
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = config(dir.path(), "sc.toml", SELFCAL);
+    let full = std::fs::File::create("/dev/full").expect("Linux has /dev/full");
+    let out = dir.path().join("full");
+    let o = command(
+        &["--threads", "1", "selfcal", s(&cfg), "--out", s(&out)],
+        &[],
+    )
+    .stdout(full)
+    .output()
+    .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("standard output"), "{}", stderr(&o));
+    assert!(out.join("selfcal.json").is_file(), "the files come first");
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = dir.path().join("pipe");
+    let status = command(
+        &["--threads", "1", "selfcal", s(&cfg), "--out", s(&out)],
+        &[],
+    )
+    .stdout(writer)
+    .stderr(Stdio::null())
+    .status()
+    .unwrap();
+    assert_eq!(status.code(), Some(0));
+}
