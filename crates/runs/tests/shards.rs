@@ -563,7 +563,29 @@ fn merge_refuses_shards_whose_configs_differ_in_sections_the_hash_leaves_out() {
         .0
         .unwrap();
     let why = merge_refusal(&out);
-    assert!(why.contains("differ in [selfcal]"), "{why}");
+    assert!(
+        why.contains("differ in [selfcal], which the hash leaves out"),
+        "{why}"
+    );
+    // A section the hash covers edited into a shard's config text (its hash kept): not said
+    // to be one the hash leaves out, but an edit after the run.
+    let p = out.join("shard-1-of-2.json");
+    let kept = std::fs::read(&p).unwrap();
+    let mut m = json(&p);
+    let text = m["config_toml"]
+        .as_str()
+        .unwrap()
+        .replace("q = 1000.0", "q = 1100.0");
+    assert!(text.contains("q = 1100.0"));
+    m["config_toml"] = text.into();
+    std::fs::write(&p, serde_json::to_string(&m).unwrap()).unwrap();
+    let why = merge_refusal(&out);
+    assert!(
+        why.contains("differ in [device], which the hash covers"),
+        "{why}"
+    );
+    assert!(why.contains("edited after its run"), "{why}");
+    std::fs::write(&p, kept).unwrap();
     // One config for both: merged.
     run_shard(&plain, &out, Some(parse_shard("1/2").unwrap()))
         .0
