@@ -131,9 +131,18 @@ fn count_of_flag(n: usize) -> Result<i64, RunError> {
 }
 
 fn int(name: &str, text: &str) -> Result<i64, RunError> {
-    text.trim().parse().map_err(|_| {
+    let t = text.trim();
+    t.parse().map_err(|_| {
+        // Digits alone are an integer, only too large (it was called "not an integer").
+        let digits = t.strip_prefix(['-', '+']).unwrap_or(t);
+        let what = if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) {
+            "an integer out of range"
+        } else {
+            "not an integer"
+        };
         RunError::BadInput(format!(
-            "{name} = `{text}`: not an integer (at most {})",
+            "{name} = `{text}`: {what} (from {} to at most {})",
+            i64::MIN,
             i64::MAX
         ))
     })
@@ -165,7 +174,15 @@ pub fn resolve_shard(
     env: &dyn Fn(&str) -> Option<String>,
 ) -> Result<Option<Shard>, RunError> {
     if let Some(f) = flag {
-        return parse_shard(f).map(Some);
+        let shard = parse_shard(f)?;
+        // `--shard I/N` says its count: another --shard-count beside it was ignored unsaid.
+        if let Some(n) = count_flag.filter(|&n| n != shard.count) {
+            return Err(RunError::BadInput(format!(
+                "--shard {f} splits into {} shards but --shard-count = {n}: give the count once (--shard I/N alone)",
+                shard.count
+            )));
+        }
+        return Ok(Some(shard));
     }
     if let Some(id) = env("SLURM_ARRAY_TASK_ID") {
         let id = int("SLURM_ARRAY_TASK_ID", &id)?;
@@ -525,6 +542,26 @@ mod tests {
             Err(RunError::BadInput(m)) => m,
             other => panic!("not refused: {other:?}"),
         }
+    }
+
+    #[test]
+    fn a_shard_count_beside_a_shard_must_agree_with_it() {
+        let none = |_: &str| None;
+        let s = resolve_shard(Some("0/3"), Some(3), &none).unwrap().unwrap();
+        assert_eq!((s.index, s.count), (0, 3));
+        for n in [4, 0] {
+            let m = refusal(Some("0/3"), Some(n), &none);
+            assert!(
+                m.contains("splits into 3 shards but --shard-count = ")
+                    && m.contains("--shard I/N alone"),
+                "{n}: {m}"
+            );
+        }
+        // Digits past the range are an integer, too large; letters are not an integer.
+        let m = refusal(Some("0/18446744073709551615"), None, &none);
+        assert!(m.contains("an integer out of range"), "{m}");
+        let m = refusal(Some("0/x"), None, &none);
+        assert!(m.contains("`x`: not an integer"), "{m}");
     }
 
     #[test]
