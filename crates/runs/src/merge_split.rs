@@ -51,7 +51,17 @@ pub(crate) fn read_split(dir: &Path) -> Result<Split, RunError> {
             .unwrap_or_default()
             .to_string_lossy()
             .into_owned();
-        let m = read_manifest(p).map_err(|e| bad(format!("`{}`: {e}", p.display())))?;
+        let m = read_manifest(p).map_err(|e| {
+            // Its name says which shard it was: that shard's rerun writes it again.
+            let rerun = name
+                .strip_prefix("shard-")
+                .and_then(|n| n.strip_suffix(".json"))
+                .and_then(|n| n.split_once("-of-"))
+                .map_or(String::new(), |(i, n)| {
+                    format!(": rerun its shard with --shard {i}/{n} to write it again")
+                });
+            bad(format!("`{}` cannot be read ({e}){rerun}", p.display()))
+        })?;
         let Some(id) = m.shard else {
             return Err(bad(format!("`{}` is not a shard manifest", p.display())));
         };
@@ -186,7 +196,12 @@ pub(crate) fn read_split(dir: &Path) -> Result<Split, RunError> {
     // they do: merging them put back the shards' [dump], lot size or spec with exit 0.
     let whole = dir.join(RUN_MANIFEST);
     if whole.exists() {
-        let m = read_manifest(&whole).map_err(|e| bad(format!("`{}`: {e}", whole.display())))?;
+        let m = read_manifest(&whole).map_err(|e| {
+            bad(format!(
+                "`{}` cannot be read ({e}), so whether a run without --shard was written over the shards is unknown: if it is an earlier merge's manifest, delete it and merge again; if a run without --shard wrote it, rerun the shards into this folder with --force",
+                whole.display()
+            ))
+        })?;
         let same = m.kind == first.kind
             && m.config_sha256 == hash
             && m.config_toml == first.config_toml

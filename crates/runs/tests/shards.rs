@@ -730,3 +730,32 @@ fn a_point_file_that_is_a_device_or_a_fifo_is_refused_not_read() {
         merge(&out, &Quiet).unwrap();
     }
 }
+
+/// An unreadable manifest stops a merge with what to do (it gave only the parser's words): a
+/// folder's whole manifest (an earlier merge's, or a run's written over the shards), and a
+/// shard's, whose name says which shard to rerun.
+#[test]
+fn an_unreadable_manifest_stops_merge_saying_what_to_do() {
+    let cfg = config();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    for s in ["0/2", "1/2"] {
+        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
+            .0
+            .unwrap();
+    }
+    merge(&out, &Quiet).unwrap();
+    std::fs::write(out.join("manifest.json"), "{\"format\": \"gyro").unwrap();
+    let why = merge_refusal(&out);
+    assert!(why.contains("manifest.json` cannot be read"), "{why}");
+    assert!(why.contains("delete it and merge again"), "{why}");
+    std::fs::remove_file(out.join("manifest.json")).unwrap();
+    merge(&out, &Quiet).unwrap();
+    std::fs::write(out.join("shard-1-of-2.json"), "x").unwrap();
+    let why = merge_refusal(&out);
+    assert!(why.contains("rerun its shard with --shard 1/2"), "{why}");
+    run_shard(&cfg, &out, Some(parse_shard("1/2").unwrap()))
+        .0
+        .unwrap();
+    merge(&out, &Quiet).unwrap();
+}
