@@ -425,6 +425,27 @@ impl Probe {
             .collect()
     }
 
+    /// The files a dump of `nodes` always writes for `stem`: each recorded rate's CSV and
+    /// SigMF pair (its WAV depends on the samples' range, so it is not among them). A folder
+    /// missing one of them holds a dump with a part lost.
+    pub fn required_file_names(nodes: &[String], stem: &str) -> Vec<String> {
+        let any = |table: &[(&str, Channels)]| {
+            table
+                .iter()
+                .any(|(node, _)| nodes.iter().any(|n| n == node))
+        };
+        [
+            ("fullrate", any(&FULL_NODES)),
+            ("decimated", any(&DEC_NODES)),
+        ]
+        .into_iter()
+        .filter(|&(_, on)| on)
+        .flat_map(|(rate, _)| {
+            ["csv", "sigmf-data", "sigmf-meta"].map(|e| format!("{stem}_{rate}.{e}"))
+        })
+        .collect()
+    }
+
     /// Why a recording of this probe gets no WAV though its rate fits one (a sample outside
     /// float32's normal range: [`SignalRecorder::wav_range_problem`]), one sentence each.
     pub fn wav_notes(&self) -> Vec<String> {
@@ -469,6 +490,40 @@ impl Probe {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// What a dump always writes is what `write` writes but the WAV, rate by rate.
+    #[test]
+    fn a_dumps_required_files_are_those_write_gives_but_the_wav() {
+        let dir = tempfile::tempdir().unwrap();
+        for nodes in [
+            &["tia"][..],
+            &["stage2"],
+            &["drive", "lowpass"],
+            &DUMP_NODES,
+        ] {
+            let nodes: Vec<String> = nodes.iter().map(|n| n.to_string()).collect();
+            let mut p = Probe::new(&nodes, 240_000.0, 100, 0.0, 0.01, 0);
+            // A sample outside float32's range in each recording: no WAV anywhere.
+            for r in [&mut p.full, &mut p.decimated] {
+                let ch = r.names().len();
+                for n in 0..4 {
+                    r.record(r.start() + n, &vec![1e300; ch]);
+                }
+            }
+            let sub = dir.path().join(nodes.join("-"));
+            std::fs::create_dir(&sub).unwrap();
+            let mut written: Vec<String> = p
+                .write(&sub, "dump")
+                .unwrap()
+                .iter()
+                .map(|f| f.file_name().unwrap().to_string_lossy().into_owned())
+                .collect();
+            written.sort();
+            let mut required = Probe::required_file_names(&nodes, "dump");
+            required.sort();
+            assert_eq!(written, required, "{nodes:?}");
+        }
+    }
 
     #[test]
     fn the_channel_tables_follow_the_node_order_and_give_every_channel_its_unit() {

@@ -57,7 +57,7 @@ pub(crate) fn reconcile_dump(
         .ok()
         .map(|m| dump_table(&m.config_toml));
     if last.as_ref() == Some(&dump_table(config_toml)) {
-        return Ok(());
+        return recompute_lost_dump(cfg, out, mine, owns_files, prev, reporter);
     }
     let stale = dump_files(out);
     if owns_files && !stale.is_empty() {
@@ -87,5 +87,44 @@ pub(crate) fn reconcile_dump(
             ));
         }
     }
+    Ok(())
+}
+
+/// The last run recorded this same `[dump]`, but a file it always writes is gone (deleted by
+/// hand): every point was reused and the folder kept a dump with a part lost, said nowhere.
+/// If this run owns the dumped point and reuses it, the point is computed again, which
+/// records the dump whole; the dump's other files go first (a WAV the new recording may not
+/// write must not stay beside it).
+fn recompute_lost_dump(
+    cfg: &Config,
+    out: &Path,
+    mine: &[usize],
+    owns_files: bool,
+    prev: &mut BTreeMap<usize, LaneResult>,
+    reporter: &dyn Reporter,
+) -> Result<(), RunError> {
+    let (Some(d), Some(i)) = (cfg.dump_resolved(), dump_point(cfg)) else {
+        return Ok(());
+    };
+    if !owns_files || !mine.contains(&i) || !prev.contains_key(&i) {
+        return Ok(());
+    }
+    let nodes = d.nodes.unwrap_or_default();
+    let lost: Vec<String> = Probe::required_file_names(&nodes, DUMP_STEM)
+        .into_iter()
+        .filter(|n| !out.join(n).exists())
+        .collect();
+    if lost.is_empty() {
+        return Ok(());
+    }
+    remove_files(&dump_files(out))?;
+    prev.remove(&i);
+    remove_files(&[out.join(POINTS_DIR).join(PointFile::file_name(i))])?;
+    reporter.note(&format!(
+        "the dump in `{}` lacks {}: recomputing point {i} ({} deg/s) to record it again",
+        out.display(),
+        lost.join(", "),
+        cfg.emulated_rates_dps()[i]
+    ));
     Ok(())
 }

@@ -180,6 +180,28 @@ fn a_dump_does_not_change_the_points_identity() {
     let (r, computed, _) = run_into(&dumped, &out, false);
     assert!(r.is_ok() && computed == 0);
     assert_eq!(names(&out).len(), 8);
+    // A file of the dump deleted by hand: the dumped point alone computed again, the dump
+    // whole and the same bytes (it had reused every point and kept the dump with a part lost).
+    let kept: Vec<Vec<u8>> = dump_files(&out)
+        .iter()
+        .map(|p| std::fs::read(p).unwrap())
+        .collect();
+    for lost in ["dump_decimated.sigmf-meta", "dump_fullrate.csv"] {
+        std::fs::remove_file(out.join(lost)).unwrap();
+        let (r, computed, notes) = run_into(&dumped, &out, false);
+        assert!(r.is_ok(), "{notes}");
+        assert_eq!(computed, 1, "{notes}");
+        assert!(
+            notes.contains(&format!("lacks {lost}: recomputing point 1 (50 deg/s)")),
+            "{notes}"
+        );
+        let now: Vec<Vec<u8>> = dump_files(&out)
+            .iter()
+            .map(|p| std::fs::read(p).unwrap())
+            .collect();
+        assert!(now == kept, "{lost}: {:?}", names(&out));
+        assert_eq!(std::fs::read(out.join("results.csv")).unwrap(), results);
+    }
 
     // The dump removed: its files deleted (and said), nothing recomputed.
     let (r, computed, notes) = run_into(&plain, &out, false);

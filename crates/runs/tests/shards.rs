@@ -759,3 +759,41 @@ fn an_unreadable_manifest_stops_merge_saying_what_to_do() {
         .unwrap();
     merge(&out, &Quiet).unwrap();
 }
+
+/// The shard of the dumped point records the dump into the shared folder: a file of it lost
+/// since is refused by merge naming that shard (it merged with exit 0, the folder's [dump]
+/// without its files), whose rerun records it again.
+#[test]
+fn merge_refuses_a_dump_with_a_file_lost_naming_its_shard() {
+    let cfg = parse_config(&format!(
+        "{NOISY}\n[dump]\nrate_dps = 200.0\nnodes = [\"tia\", \"stage2\"]\n"
+    ))
+    .unwrap();
+    cfg.validate().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    for s in ["0/3", "1/3", "2/3"] {
+        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
+            .0
+            .unwrap();
+    }
+    merge(&out, &Quiet).unwrap();
+    // Shard k of 3 holds the points k, k + 3, ...
+    let i = cfg
+        .emulated_rates_dps()
+        .iter()
+        .position(|&r| r == 200.0)
+        .unwrap();
+    let own = i % 3;
+    std::fs::remove_file(out.join("dump_decimated.csv")).unwrap();
+    let why = merge_refusal(&out);
+    assert!(
+        why.contains("lacks dump_decimated.csv") && why.contains(&format!("--shard {own}/3")),
+        "{why}"
+    );
+    let (r, notes) = run_shard(&cfg, &out, Some(parse_shard(&format!("{own}/3")).unwrap()));
+    r.unwrap();
+    assert!(notes.contains(&format!("recomputing point {i}")), "{notes}");
+    merge(&out, &Quiet).unwrap();
+    assert!(out.join("dump_decimated.csv").is_file());
+}
