@@ -7,7 +7,7 @@ use crate::config_diff::{config_diff_for, describe_diff};
 use crate::dumps::dump_table;
 use crate::error::RunError;
 use crate::manifest::{read_manifest, shard_manifest_paths, Manifest, RunKind, RUN_MANIFEST};
-use crate::points::short_sha;
+use crate::points::{short_sha, SECTIONS_OUTSIDE_HASH};
 use crate::records::{scan_records, RecordFile};
 use crate::shard::absent_shards;
 use gyroemu_config::parse_config;
@@ -149,10 +149,9 @@ pub(crate) fn read_split(dir: &Path) -> Result<Split, RunError> {
                 .collect();
             // A section the hash covers cannot differ under one hash: a manifest's config
             // text edited by hand (it had been said to be a section the hash leaves out).
-            let hashed_out = ["dump", "selfcal", "sweep", "montecarlo"];
             let covered: Vec<String> = differ
                 .iter()
-                .filter(|k| !hashed_out.contains(&k.as_str()))
+                .filter(|k| !SECTIONS_OUTSIDE_HASH.contains(&k.as_str()))
                 .map(|k| format!("[{k}]"))
                 .collect();
             if !covered.is_empty() {

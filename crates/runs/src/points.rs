@@ -26,6 +26,9 @@ pub fn canonical_toml(cfg: &Config) -> String {
     toml::to_string(cfg).expect("a config always serialises to TOML")
 }
 
+/// The sections [`result_config`] leaves out of a sweep's identity, by their TOML names.
+pub(crate) const SECTIONS_OUTSIDE_HASH: [&str; 4] = ["dump", "selfcal", "sweep", "montecarlo"];
+
 /// The part of a config that decides a sweep's results: all but `[dump]` (what is recorded
 /// on the way), `[selfcal]` (what `selfcal` adds), `[sweep]` (what `sweep` measures) and
 /// `[montecarlo]` (what a lot draws), so a config differing only there reuses the saved
@@ -269,6 +272,29 @@ pub fn scan_points(out: &Path) -> Result<PointScan, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The sections named outside the hash are exactly those `result_config` drops.
+    #[test]
+    fn the_sections_outside_the_hash_are_those_result_config_drops() {
+        let text = "[device]\nf0_hz = 15000.0\nq = 1000.0\nangular_gain = 1.0\n[drive]\nf1 = 1.0\n\
+                    [experiment]\nkind = \"coriolis\"\nrates_dps = [50.0]\naverage_s = 0.1\n\
+                    [dump]\n[selfcal]\n[sweep]\n[montecarlo]\nspec_abs_relative_error = 0.01\n";
+        let cfg = gyroemu_config::parse_config(text).unwrap();
+        let keys = |c: &Config| -> std::collections::BTreeSet<String> {
+            toml::from_str::<toml::Table>(&canonical_toml(c))
+                .unwrap()
+                .keys()
+                .cloned()
+                .collect()
+        };
+        let dropped: Vec<String> = keys(&cfg)
+            .difference(&keys(&result_config(&cfg)))
+            .cloned()
+            .collect();
+        let mut named = SECTIONS_OUTSIDE_HASH.map(String::from).to_vec();
+        named.sort();
+        assert_eq!(dropped, named);
+    }
 
     #[test]
     fn lane_bits_round_trip_exactly() {
