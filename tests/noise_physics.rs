@@ -417,3 +417,61 @@ fn with_a_pll_the_warned_scatter_is_that_of_the_locked_carrier() {
         "scatter {got} deg, stated {sigma:?}"
     );
 }
+
+/// The Brownian force seen at a reading's own rate: rotation splits the modes to about
+/// f0 +- lambda Omega / 2 pi, and a carrier detuned 10 Hz above f0 (40 half-bandwidths) sits
+/// on the upper one at 3600 deg/s. The stated scatter takes the plant rotating at the rate
+/// (it took the modes at rest: 13 mdeg stated where 118 were read); against the read-out over
+/// seeds, and the rate's density against an independent solve of eq. 1.
+#[test]
+fn the_stated_brownian_scatter_is_that_of_the_plant_rotating_at_the_rate() {
+    let text = "[device]\nf0_hz = 1000.0\nq = 2000.0\nangular_gain = 1.0\n[drive]\nf1 = 1.0\n\
+                carrier_hz = 1010.0\n[board]\nfs_hz = 16000.0\n[experiment]\nkind = \"coriolis\"\n\
+                rates_dps = [3600.0]\naverage_s = 5.0\n";
+    let mut cfg = gyroemu::config::parse_config(text).unwrap();
+    cfg.noise = Some(noise(Some(1e-11), 0.0, 0.0));
+    cfg.validate().unwrap();
+    let stated = cfg.noise_phase().unwrap()[0];
+    // The density at 3600 deg/s over the density at rest, per mode, from eq. 1 in phasors:
+    // [(w0^2 - w^2 + j w w0 / Q) I + j w 2 lambda Omega J] q = a, v = j w q, each mode's
+    // force white and alike (equal modes).
+    let density_ratio = {
+        use gyroemu::Complex64 as C;
+        let (w0, q) = (2.0 * PI * 1000.0, 2000.0);
+        let w = 2.0 * PI * 1010.0;
+        let v2 = |omega: f64| {
+            let d = C::new(w0 * w0 - w * w, w * w0 / q);
+            let b = C::new(0.0, w * 2.0 * omega);
+            // [[d, -b], [b, d]]^-1 = [[d, b], [-b, d]] / (d^2 + b^2)
+            let det = d * d + b * b;
+            let (h11, h12) = (d / det, b / det);
+            // |v_k| summed over both forces: |w|^2 (|h11|^2 + |h12|^2), alike for both modes.
+            w * w * (h11.norm_sqr() + h12.norm_sqr())
+        };
+        v2(3600f64.to_radians()) / v2(0.0)
+    };
+    let mut at_rest = cfg.clone();
+    at_rest.experiment.rates_dps = vec![1e-9];
+    let rest = at_rest.noise_phase().unwrap()[0].density_v2_per_hz;
+    for k in 0..2 {
+        let r = stated.density_v2_per_hz[k] / rest[k];
+        assert!(
+            (r / density_ratio - 1.0).abs() < 1e-6,
+            "mode {}: {r} against {density_ratio}",
+            k + 1
+        );
+    }
+    assert!(
+        density_ratio > 100.0,
+        "the split mode on the carrier: {density_ratio}"
+    );
+    // The read-out's scatter over seeds (both modes: 128 draws) against the stated sigma.
+    let sigma = stated.sigma_rad.map(f64::to_degrees);
+    let errors = seeded_errors(&cfg, 64);
+    let all: Vec<f64> = errors.iter().flatten().copied().collect();
+    let got = std_dev(&all);
+    assert!(
+        (got / sigma[0] - 1.0).abs() < 0.2,
+        "scatter {got} deg, stated {sigma:?}"
+    );
+}

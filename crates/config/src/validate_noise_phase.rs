@@ -34,6 +34,9 @@ pub struct NoisePhase {
     pub sigma_rad: [f64; 2],
     pub theory_rad: [f64; 2],
     pub amplitude_v: [f64; 2],
+    /// The noise density at the ADC input near the carrier at this rate (V^2/Hz): the
+    /// Brownian part depends on the rate, which splits the modes.
+    pub density_v2_per_hz: [f64; 2],
 }
 
 impl Config {
@@ -59,14 +62,15 @@ impl Config {
     /// Per mode, the one-sided density at the ADC input near the carrier (V^2/Hz) of the
     /// white sources, and of the TIA's voltage flicker at its design's density there (a
     /// corner above the carrier made the readings scatter 3.27 times the white-only figure):
-    /// the TIA's input noise (current and e_n / tia_gain_ohm), the Brownian
-    /// force through the mode's velocity response and transduction (uncoupled modes), both
-    /// through the TIA at the carrier, and an ADC's rounding (step^2/12 a sample) where that
+    /// the TIA's input noise (current and e_n / tia_gain_ohm) through the TIA at the carrier,
+    /// and an ADC's rounding (step^2/12 a sample) where that
     /// noise dithers it (its RMS at the ADC input at least an LSB; an undithered ADC's error
     /// is systematic, and the ADC-LSB rule states it). The wide-band parts (the TIA's input
     /// noise and the ADC's) count what the decimation folds onto the averaged output too
-    /// ([`Config::decimation_fold`]). `None` without `[noise]`.
-    pub(crate) fn carrier_noise_density(&self) -> Option<[f64; 2]> {
+    /// ([`Config::decimation_fold`]). `None` without `[noise]`. All but the Brownian force's
+    /// density, which depends on the rate a reading is taken at
+    /// ([`Config::brownian_density_at`]); its RMS still decides whether the ADC is dithered.
+    fn carrier_noise_but_brownian(&self) -> Option<[f64; 2]> {
         let n = self.noise.as_ref()?;
         let b = &self.board;
         let chain = ChainResponse::new(&self.board_params()).ok()?;
@@ -76,7 +80,6 @@ impl Config {
         let (i_n, band) = self.tia_white_noise()?;
         let tia_rms2 = i_n * i_n * tia * band;
         let plant = self.resonator_params();
-        let w = core::f64::consts::TAU * fc;
         let t = self.device.transduction_a_s_per_m;
         let (fold_tia, fold_white) = self.decimation_fold(&chain);
         // The TIA's voltage flicker near the carrier, as its design realises it (input
@@ -87,17 +90,16 @@ impl Config {
         });
         Some([plant.mode1, plant.mode2].map(|m| {
             let w0 = core::f64::consts::TAU * m.f0_hz;
-            // Its density at the carrier and its RMS (equipartition, S_a Q / (4 w0)), as
-            // current at the TIA's input.
-            let (brownian, brownian_rms2) = n.effective_mass_kg.map_or((0.0, 0.0), |mass| {
+            // The Brownian motion's RMS (equipartition, S_a Q / (4 w0)), as current at the
+            // TIA's input: it dithers the ADC too.
+            let brownian_rms2 = n.effective_mass_kg.map_or(0.0, |mass| {
                 let s_a = gyroemu_resonator::thermomechanical_accel_psd(
                     n.temperature_k,
                     mass,
                     m.f0_hz,
                     m.q,
                 );
-                let h_v2 = w * w / ((w0 * w0 - w * w).powi(2) + (w * w0 / m.q).powi(2));
-                (s_a * h_v2 * t * t, s_a * m.q / (4.0 * w0) * t * t)
+                s_a * m.q / (4.0 * w0) * t * t
             });
             let rms = (tia_rms2 + brownian_rms2 * tia).sqrt();
             let adc = b.adc_bits.map_or(0.0, |bits| {
@@ -108,8 +110,40 @@ impl Config {
                     0.0
                 }
             });
-            i_n * i_n * tia * fold_tia + flicker + brownian * tia + adc * fold_white
+            i_n * i_n * tia * fold_tia + flicker + adc * fold_white
         }))
+    }
+
+    /// Per mode, the Brownian force's density at the ADC input near the carrier (V^2/Hz) at
+    /// the constant rate `omega_rad_s`: each mode's white force (of its own f0 and Q) through
+    /// the rotating plant's velocity response at the carrier (the Coriolis coupling, the
+    /// quadrature coupling and the mode split all in it), transduction and the TIA; 0 without
+    /// a Brownian source. Rotation splits the modes to about f0 +- lambda Omega / 2 pi, so a
+    /// carrier detuned onto one of them sees its resonance: the uncoupled modes' density had
+    /// stated 28 times less scatter than a detuned Coriolis run at 3600 deg/s read.
+    pub(crate) fn brownian_density_at(&self, omega_rad_s: f64) -> [f64; 2] {
+        let Some(mass) = self.noise.as_ref().and_then(|n| n.effective_mass_kg) else {
+            return [0.0; 2];
+        };
+        let Ok(chain) = ChainResponse::new(&self.board_params()) else {
+            return [f64::NAN; 2];
+        };
+        let temperature_k = self.noise.as_ref().map_or(0.0, |n| n.temperature_k);
+        let plant = self.resonator_params();
+        let fc = self.carrier_hz();
+        let s_a = [plant.mode1, plant.mode2].map(|m| {
+            gyroemu_resonator::thermomechanical_accel_psd(temperature_k, mass, m.f0_hz, m.q)
+        });
+        // Mode j's unit force alone, then mode k's velocity phasor at the carrier.
+        let unit = |j: usize| {
+            let mut f = [gyroemu_core::Complex64::new(0.0, 0.0); 2];
+            f[j] = gyroemu_core::Complex64::new(1.0, 0.0);
+            gyroemu_resonator::continuous_steady_state(&plant, omega_rad_s, fc, f)
+        };
+        let x = [unit(0), unit(1)];
+        let t = self.device.transduction_a_s_per_m;
+        let tia = chain.tia(fc).norm_sqr();
+        [0, 1].map(|k| (0..2).map(|j| s_a[j] * x[j][2 + k].norm_sqr()).sum::<f64>() * t * t * tia)
     }
 
     /// The TIA voltage flicker's design (input-referred: `(e_n / tia_gain_ohm)^2 corner / f`
@@ -216,7 +250,25 @@ impl Config {
         if let Some(held) = self.expected_lock() {
             return held.noise_phase();
         }
-        let density = self.carrier_noise_density()?;
+        let rest = self.carrier_noise_but_brownian()?;
+        let shape = self.shape();
+        // The density at a reading's rate: the Brownian part through the plant rotating at
+        // it (a rate table's the largest over its swing, a bound; a rotating run's plant does
+        // not rotate), the rest as at rest. By rate, once: a sweep may list 1e5 rates.
+        let mut density_by_rate: std::collections::HashMap<u64, [f64; 2]> = Default::default();
+        for &rate in self.experiment.rates_dps.iter().chain(&[0.0]) {
+            density_by_rate.entry(rate.to_bits()).or_insert_with(|| {
+                let b = match shape {
+                    Shape::Coriolis => self.brownian_density_at(rate * DEG),
+                    Shape::Rotating => self.brownian_density_at(0.0),
+                    Shape::RateTable { .. } => (-16..=16)
+                        .map(|i| self.brownian_density_at(rate * DEG * i as f64 / 16.0))
+                        .fold([0.0f64; 2], |m, d| [m[0].max(d[0]), m[1].max(d[1])]),
+                };
+                [0, 1].map(|k| rest[k] + b[k])
+            });
+        }
+        let density = |rate: f64| density_by_rate[&rate.to_bits()];
         // By rate: a sweep may list 1e5 rates, too many to search each time.
         let per_rate: std::collections::HashMap<u64, [LoHi; 2]> = self
             .tia_output_per_rate()?
@@ -232,12 +284,11 @@ impl Config {
         let variance = |rate: f64, k: usize| {
             let a = amps(rate)?;
             let span_s = self.plan_point(rate).span_samples() / fs_out;
-            Some(phase_variance_rad2(density[k], enbw, span_s, a[k].0))
+            Some(phase_variance_rad2(density(rate)[k], enbw, span_s, a[k].0))
         };
         // The zero-rate reference a Coriolis reading is taken against, once for every rate.
         let reference = [0, 1].map(|k| variance(0.0, k).unwrap_or(f64::NAN));
         let dev = self.driven_device();
-        let shape = self.shape();
         // The slow flicker sources' share of a reading over `span_s` (rad^2 per mode), under
         // the window's own weight (not its white-noise bandwidth: a Hann window takes 1.06 to
         // 1.12 times the boxcar's of the drive's 1/f phase, not 1.5).
@@ -291,6 +342,7 @@ impl Config {
                     sigma_rad,
                     theory_rad,
                     amplitude_v,
+                    density_v2_per_hz: density(rate),
                 }
             })
             .collect();
@@ -302,11 +354,10 @@ impl Config {
     /// measured there (the worst rate is named): those readings are the noise's more than
     /// the device's.
     pub(crate) fn validate_noise_phase(&self, warnings: &mut Vec<String>) {
-        let (Some(density), Some(points)) = (self.carrier_noise_density(), self.noise_phase())
-        else {
+        let Some(points) = self.noise_phase() else {
             return;
         };
-        for (k, density) in density.iter().enumerate() {
+        for k in 0..2 {
             // The worst ratio; a NaN (a dead signal, which other rules name) says nothing.
             let worst = points
                 .iter()
@@ -319,7 +370,8 @@ impl Config {
             if ratio <= WARN_NOISE_PHASE_FRACTION {
                 continue;
             }
-            let (sigma, amplitude) = (p.sigma_rad[k], p.amplitude_v[k]);
+            let (sigma, amplitude, density) =
+                (p.sigma_rad[k], p.amplitude_v[k], p.density_v2_per_hz[k]);
             // The averaged noise against the signal, per reading (sqrt(2) of one phase's).
             let noise_to_signal = sigma / core::f64::consts::SQRT_2;
             let scatter = if noise_to_signal >= 1.0 {
