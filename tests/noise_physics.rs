@@ -453,8 +453,8 @@ fn the_stated_brownian_scatter_is_that_of_the_plant_rotating_at_the_rate() {
     let mut at_rest = cfg.clone();
     at_rest.experiment.rates_dps = vec![1e-9];
     let rest = at_rest.noise_phase().unwrap()[0].density_v2_per_hz;
-    for k in 0..2 {
-        let r = stated.density_v2_per_hz[k] / rest[k];
+    for (k, rest) in rest.iter().enumerate() {
+        let r = stated.density_v2_per_hz[k] / rest;
         assert!(
             (r / density_ratio - 1.0).abs() < 1e-6,
             "mode {}: {r} against {density_ratio}",
