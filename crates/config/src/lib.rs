@@ -7,6 +7,7 @@
 mod config;
 mod document;
 mod error;
+mod noise_table;
 mod parse;
 mod plan;
 pub mod presets;

@@ -6,6 +6,7 @@ use crate::config::{Config, WindowKind};
 use crate::plan::DEG;
 use crate::validate_regime::LoHi;
 use gyroemu_board::{ChainResponse, Shape};
+use gyroemu_core::Complex64;
 
 /// The noise is said to dominate when a reading's standard deviation passes this fraction of
 /// the phase it measures.
@@ -313,6 +314,51 @@ impl Config {
                 .or_insert_with(|| slow_of(s));
         }
         let slow = |rate: f64| slow_by_span[&span(rate).to_bits()];
+        // A rate table's reading: how its harmonics' noise reaches the amplitude read
+        // ([`crate::noise_table`]), per span the harmonics' noise gains (the TIA's gain across
+        // them included), per rate and mode the envelope's weights.
+        let chain = ChainResponse::new(&self.board_params()).ok();
+        // The harmonics' gains depend on the span alone: once per span.
+        let gains_by_span: std::cell::RefCell<std::collections::HashMap<u64, Vec<f64>>> =
+            Default::default();
+        let table_gain = |rate: f64| -> [(f64, f64); 2] {
+            let (Shape::RateTable { freq_hz }, Some(chain)) = (shape, chain.as_ref()) else {
+                return [(2.0, 0.0); 2];
+            };
+            let n = self.table_harmonics();
+            let fc = self.carrier_hz();
+            let tia0 = chain.tia(fc);
+            let gains: Vec<f64> = gains_by_span
+                .borrow_mut()
+                .entry(span(rate).to_bits())
+                .or_insert_with(|| {
+                    self.table_harmonic_noise_gains(chain, freq_hz, n, span(rate), hann)
+                        .iter()
+                        .enumerate()
+                        .map(|(i, g)| {
+                            let f = (i as f64 - n as f64) * freq_hz;
+                            g * (tia0 / chain.tia(fc + f)).norm_sqr()
+                        })
+                        .collect()
+                })
+                .clone();
+            const M: usize = 24;
+            let env = dev.rate_table_envelopes(rate * DEG, freq_hz, M);
+            let g = |f: f64| chain.dac_hold(f) * self.device.transduction_a_s_per_m;
+            [0, 1].map(|k| {
+                let Some(lo) = amps(rate).map(|a| a[k].0) else {
+                    return (f64::NAN, f64::NAN);
+                };
+                // The envelope the read-out forms, in volts at the ADC at the carrier's TIA
+                // gain (it divides out each harmonic's own).
+                let v: Vec<Complex64> = env[k]
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &x)| x * g(fc + (i as f64 - M as f64) * freq_hz) * tia0)
+                    .collect();
+                crate::noise_table::table_reading_gains(&v, lo, &gains)
+            })
+        };
         let reference_flicker = slow(0.0);
         let points = self
             .experiment
@@ -327,13 +373,17 @@ impl Config {
                     Shape::Rotating => dev.rotating_psi_rad(omega),
                 };
                 let flicker = slow(rate);
+                let gain = match shape {
+                    Shape::RateTable { .. } => table_gain(rate),
+                    _ => [(2.0, 0.0); 2],
+                };
                 let sigma_rad = [0, 1].map(|k| {
                     let own = variance(rate, k).unwrap_or(f64::NAN);
                     match shape {
                         Shape::Coriolis => {
                             (own + reference[k] + flicker[k] + reference_flicker[k]).sqrt()
                         }
-                        _ => (2.0 * own + flicker[k]).sqrt(),
+                        _ => (gain[k].0 * own + gain[k].1 * own * own + flicker[k]).sqrt(),
                     }
                 });
                 let amplitude_v = [0, 1].map(|k| amps(rate).map_or(f64::NAN, |a| a[k].0));
@@ -357,6 +407,7 @@ impl Config {
         let Some(points) = self.noise_phase() else {
             return;
         };
+        self.validate_table_noise_skirt(warnings);
         for k in 0..2 {
             // The worst ratio; a NaN (a dead signal, which other rules name) says nothing.
             let worst = points
@@ -405,6 +456,58 @@ impl Config {
     }
 }
 
+impl Config {
+    /// A noisy rate table whose read-out divides a harmonic by a low-pass gain so small that
+    /// the noise the window's sidelobes and the decimation bring to it comes back more than
+    /// [`WARN_TABLE_NOISE_GAIN`] times the DC reading's in power. The stated scatter
+    /// ([`Config::noise_phase`]) counts it, to second order, as independent between the
+    /// harmonics; the noise leaked from near DC is not (each harmonic's window sidelobe takes
+    /// the same noise), and readings can scatter several times the figure: a 200 deg/s point
+    /// read with 15 harmonics of a 9 Hz table behind a 10 Hz low-pass, 3.1 times.
+    fn validate_table_noise_skirt(&self, warnings: &mut Vec<String>) {
+        let Shape::RateTable { freq_hz } = self.shape() else {
+            return;
+        };
+        let Ok(chain) = ChainResponse::new(&self.board_params()) else {
+            return;
+        };
+        let n = self.table_harmonics();
+        let hann = self.experiment.window == WindowKind::Hann;
+        let fs_out = self.fs_out_hz();
+        let mut spans: Vec<f64> = self
+            .experiment
+            .rates_dps
+            .iter()
+            .map(|&r| self.plan_point(r).span_samples() / fs_out)
+            .collect();
+        spans.sort_by(f64::total_cmp);
+        spans.dedup();
+        // The largest gain of a read harmonic over the spans, with its harmonic.
+        let mut worst = (0.0f64, 0usize);
+        for span in spans {
+            let gains = self.table_harmonic_noise_gains(&chain, freq_hz, n, span, hann);
+            for (i, &g) in gains.iter().enumerate() {
+                if g > worst.0 {
+                    worst = (g, i.abs_diff(n));
+                }
+            }
+        }
+        let (gain, h) = worst;
+        if gain <= WARN_TABLE_NOISE_GAIN {
+            return;
+        }
+        let f = h as f64 * freq_hz;
+        warnings.push(format!(
+            "experiment.table_freq_hz = {freq_hz}: the read-out divides the table's {h}th harmonic ({f} Hz) by the low-pass's gain there ({:.3e} of its DC gain), and the noise the averaging window's sidelobes and the decimation bring to it comes back {gain:.3e} times the DC reading's in power; the stated scatter counts it as independent between the harmonics, which noise leaked from near DC is not, so the readings can scatter several times the figure stated (a 200 deg/s point read with 15 harmonics of a 9 Hz table behind a 10 Hz low-pass: 3.1 times); raise board.lpf_cutoff_hz above {f} Hz, or sweep rates that need fewer harmonics",
+            chain.lowpass(f).norm() / chain.lowpass(0.0).norm()
+        ));
+    }
+}
+
+/// A rate table's read harmonic whose noise power comes back above this many times the DC
+/// reading's is warned ([`Config::validate_table_noise_skirt`]).
+pub const WARN_TABLE_NOISE_GAIN: f64 = 100.0;
+
 /// How a reading weighs a slow phase fluctuation over frequency: `K(u)` at `u = f T` is the
 /// boxcar's `sinc^2(pi u)` or, with `hann`, the mean-normalised Hann window's
 /// `(sinc(u) + sinc(u - 1) / 2 + sinc(u + 1) / 2)^2`.
@@ -424,7 +527,7 @@ pub(crate) enum SlowReading {
 /// The window's weight `K(u)` (see [`SlowReading`]), or its mean from |u| = 4 on, where a
 /// quadrature grid would alias its oscillation: `1 / (2 pi^2 u^2)` for the boxcar,
 /// `1 / (2 pi^2 u^2 (u^2 - 1)^2)` for Hann.
-fn window_weight(u: f64, hann: bool) -> f64 {
+pub(crate) fn window_weight(u: f64, hann: bool) -> f64 {
     use core::f64::consts::PI;
     let u = u.abs();
     match (u >= 4.0, hann) {
