@@ -23,6 +23,7 @@ mod validate_regime;
 mod validate_settling;
 mod validate_sweep;
 mod validate_sweep_dac;
+mod window_weight;
 
 pub use config::{
     BoardConfig, Config, DeviceConfig, Distribution, DriveConfig, DumpConfig, ExperimentConfig,

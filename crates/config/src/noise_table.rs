@@ -15,7 +15,7 @@
 //! small-swing count (21 times past the output's Nyquist frequency).
 
 use crate::config::Config;
-use crate::validate_noise_phase::window_weight;
+use crate::window_weight::window_weight;
 use gyroemu_board::ChainResponse;
 use gyroemu_core::Complex64;
 

@@ -5,6 +5,7 @@
 use crate::config::{Config, WindowKind};
 use crate::plan::DEG;
 use crate::validate_regime::LoHi;
+use crate::window_weight::window_weight;
 use gyroemu_board::{ChainResponse, Shape};
 use gyroemu_core::Complex64;
 
@@ -522,30 +523,6 @@ pub(crate) enum SlowReading {
         span_s: f64,
         hann: bool,
     },
-}
-
-/// The window's weight `K(u)` (see [`SlowReading`]), or its mean from |u| = 4 on, where a
-/// quadrature grid would alias its oscillation: `1 / (2 pi^2 u^2)` for the boxcar,
-/// `1 / (2 pi^2 u^2 (u^2 - 1)^2)` for Hann.
-pub(crate) fn window_weight(u: f64, hann: bool) -> f64 {
-    use core::f64::consts::PI;
-    let u = u.abs();
-    match (u >= 4.0, hann) {
-        (true, false) => 1.0 / (2.0 * PI.powi(2) * u * u),
-        (true, true) => 1.0 / (2.0 * PI.powi(2) * u * u * (u * u - 1.0).powi(2)),
-        (false, false) => sinc(u).powi(2),
-        (false, true) => (sinc(u) + 0.5 * sinc(u - 1.0) + 0.5 * sinc(u + 1.0)).powi(2),
-    }
-}
-
-/// `sin(pi u) / (pi u)`, 1 at 0.
-fn sinc(u: f64) -> f64 {
-    if u.abs() < 1e-9 {
-        1.0
-    } else {
-        let x = core::f64::consts::PI * u;
-        x.sin() / x
-    }
 }
 
 impl SlowReading {
