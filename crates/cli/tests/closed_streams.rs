@@ -77,25 +77,12 @@ fn a_full_standard_output_and_a_dangling_out_link_are_named() {
 /// two lines were lost); a reader gone (`| head -1`) still ends quietly with exit 0.
 #[test]
 fn selfcal_headline_lost_to_a_full_stdout_is_an_error_but_not_to_a_closed_pipe() {
-    const SELFCAL: &str = r#"
-[device]
-f0_hz = 15000.0
-q = 1000.0
-angular_gain = 1.0
-[drive]
-f1 = 1.0
-[board]
-fs_hz = 240000.0
-lpf_cutoff_hz = 200.0
-decimation = 100
-[experiment]
-kind = "rotating"
-rates_dps = [200.0, 300.0, 400.0]
-average_s = 0.9
-settle_s = 0.05
-"#;
+    // Three distinct rates (selfcal's minimum), short windows.
+    let text = small_board(
+        "[experiment]\nkind = \"rotating\"\nrates_dps = [200.0, 300.0, 400.0]\naverage_s = 0.9\nsettle_s = 0.05\n",
+    );
     let dir = tempfile::tempdir().unwrap();
-    let cfg = config(dir.path(), "sc.toml", SELFCAL);
+    let cfg = config(dir.path(), "sc.toml", &text);
     let full = std::fs::File::create("/dev/full").expect("Linux has /dev/full");
     let out = dir.path().join("full");
     let o = command(

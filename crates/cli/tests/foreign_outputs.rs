@@ -9,23 +9,10 @@ use common::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-const GOOD: &str = r#"
-[device]
-f0_hz = 15000.0
-q = 1000.0
-angular_gain = 1.0
-[drive]
-f1 = 1.0
-f2 = 1.0
-[board]
-fs_hz = 240000.0
-lpf_cutoff_hz = 200.0
-decimation = 100
-[experiment]
-kind = "coriolis"
-rates_dps = [50.0]
-average_s = 0.1
-"#;
+/// One Coriolis point of 0.1 s on the small board.
+fn good() -> String {
+    small_board("[experiment]\nkind = \"coriolis\"\nrates_dps = [50.0]\naverage_s = 0.1\n")
+}
 
 /// Every file below `dir` and its bytes.
 fn tree(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
@@ -55,7 +42,7 @@ fn refused(o: &std::process::Output, needles: &[&str]) {
 #[test]
 fn reproduce_refuses_a_folder_holding_a_run() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = config(dir.path(), "good.toml", GOOD);
+    let cfg = config(dir.path(), "good.toml", &good());
     // A run at the top, and one in a preset's folder.
     for out in [
         dir.path().join("top"),
@@ -83,7 +70,7 @@ fn reproduce_refuses_a_folder_holding_a_run() {
 #[test]
 fn run_refuses_a_summary_no_run_wrote_unless_forced() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = config(dir.path(), "good.toml", GOOD);
+    let cfg = config(dir.path(), "good.toml", &good());
     let out = dir.path().join("figs");
     std::fs::create_dir(&out).unwrap();
     // What reproduce writes at its top.
@@ -116,11 +103,11 @@ fn run_refuses_a_summary_no_run_wrote_unless_forced() {
 #[test]
 fn what_force_cannot_delete_is_refused_as_bad_input() {
     let dir = tempfile::tempdir().unwrap();
-    let a = config(dir.path(), "a.toml", GOOD);
+    let a = config(dir.path(), "a.toml", &good());
     let b = config(
         dir.path(),
         "b.toml",
-        &GOOD.replace("q = 1000.0", "q = 1200.0"),
+        &good().replace("q = 1000.0", "q = 1200.0"),
     );
     let out = dir.path().join("o");
     ok(gyroemu(&["run", s(&a), "--out", s(&out)], &[]));

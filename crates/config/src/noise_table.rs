@@ -15,7 +15,7 @@
 //! small-swing count (21 times past the output's Nyquist frequency).
 
 use crate::config::Config;
-use crate::window_weight::window_weight;
+use crate::window_weight::{integrate_over_decades, window_weight};
 use gyroemu_board::ChainResponse;
 use gyroemu_core::Complex64;
 
@@ -65,19 +65,10 @@ impl Config {
                 let w = if i == 0 || i == steps { 0.5 } else { 1.0 };
                 sum += w * s_dec(f + d) * window_weight(d * span_s, hann) * dd;
             }
-            if half > near {
-                let decades = (half / near).log10();
-                let n = (decades * 64.0).ceil().max(1.0) as usize;
-                let dl = (half / near).ln() / n as f64;
-                for sign in [1.0, -1.0] {
-                    let g = |d: f64| s_dec(f + sign * d) * window_weight(d * span_s, hann) * d;
-                    let mut prev = g(near);
-                    for i in 1..=n {
-                        let cur = g(near * (dl * i as f64).exp());
-                        sum += 0.5 * (prev + cur) * dl;
-                        prev = cur;
-                    }
-                }
+            for sign in [1.0, -1.0] {
+                sum = integrate_over_decades(sum, near, half, |d| {
+                    s_dec(f + sign * d) * window_weight(d * span_s, hann)
+                });
             }
             sum
         };

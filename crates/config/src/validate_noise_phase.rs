@@ -5,7 +5,7 @@
 use crate::config::{Config, WindowKind};
 use crate::plan::DEG;
 use crate::validate_regime::LoHi;
-use crate::window_weight::window_weight;
+use crate::window_weight::{integrate_over_decades, window_weight};
 use gyroemu_board::{ChainResponse, Shape};
 use gyroemu_core::Complex64;
 
@@ -536,17 +536,9 @@ impl SlowReading {
                 if !(a > 0.0 && f_top > a) {
                     return 0.0;
                 }
-                let g = |f: f64| density(f) * window_weight(f * span_s, hann) * f;
-                let steps = ((f_top / a).log10() * 64.0).ceil().max(1.0) as usize;
-                let dl = (f_top / a).ln() / steps as f64;
-                let mut sum = density(a) * a;
-                let mut prev = g(a);
-                for i in 1..=steps {
-                    let cur = g(a * (dl * i as f64).exp());
-                    sum += 0.5 * (prev + cur) * dl;
-                    prev = cur;
-                }
-                sum
+                integrate_over_decades(density(a) * a, a, f_top, |f| {
+                    density(f) * window_weight(f * span_s, hann)
+                })
             }
             SlowReading::Tone {
                 freq_hz,

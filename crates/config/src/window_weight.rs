@@ -1,5 +1,6 @@
 //! How an averaging window of span `T` weighs a fluctuation `u / T` away from what it reads,
-//! shared by the noise rules (the slow flicker's, a rate table's harmonics' noise).
+//! and the quadrature over decades the noise rules integrate such weights with; shared by
+//! the slow flicker's rule and a rate table's harmonics' noise.
 
 /// The window's weight `K(u)`: the boxcar's `sinc^2(u)`, or with `hann` the mean-normalised
 /// Hann window's `(sinc(u) + sinc(u - 1) / 2 + sinc(u + 1) / 2)^2` (1 at 0; its integral is
@@ -25,4 +26,25 @@ fn sinc(u: f64) -> f64 {
         let x = core::f64::consts::PI * u;
         x.sin() / x
     }
+}
+
+/// `start + int_a^b f(x) dx` by the trapezoid rule in ln x, 64 points a decade (`f(x) x`
+/// against `ln x`), each step added to `start` in turn: for integrands over decades of
+/// frequency, such as a window's `1/u^2` sidelobes or a `1/f` density. `start` unless
+/// `0 < a < b`.
+pub(crate) fn integrate_over_decades(start: f64, a: f64, b: f64, f: impl Fn(f64) -> f64) -> f64 {
+    if !(a > 0.0 && b > a) {
+        return start;
+    }
+    let g = |x: f64| f(x) * x;
+    let steps = ((b / a).log10() * 64.0).ceil().max(1.0) as usize;
+    let dl = (b / a).ln() / steps as f64;
+    let mut sum = start;
+    let mut prev = g(a);
+    for i in 1..=steps {
+        let cur = g(a * (dl * i as f64).exp());
+        sum += 0.5 * (prev + cur) * dl;
+        prev = cur;
+    }
+    sum
 }

@@ -42,6 +42,14 @@ fn run_shard(
     (r, rec.0.into_inner().unwrap().join("\n"))
 }
 
+/// Runs every shard of a split of `count` of `cfg` into `out`, each to completion.
+fn run_shards(cfg: &Config, out: &Path, count: usize) {
+    for i in 0..count {
+        let shard = parse_shard(&format!("{i}/{count}")).unwrap();
+        run_shard(cfg, out, Some(shard)).0.unwrap();
+    }
+}
+
 /// The shard a Slurm array task gets from its variables (no `--shard`).
 fn slurm(id: &str, min: &str, max: &str, count: &str) -> Shard {
     let vars: BTreeMap<&str, &str> = [
@@ -251,11 +259,7 @@ fn merge_lists_the_missing_shards_of_a_huge_split_briefly() {
     let cfg = config();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("two");
-    for s in ["0/2", "1/2"] {
-        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
-            .0
-            .unwrap();
-    }
+    run_shards(&cfg, &out, 2);
     // A manifest edited (or written by an older gyroemu) to claim a huge split: before, merge
     // built a line naming each of its missing shards (16 MB for a million; without end for
     // the largest).
@@ -298,11 +302,7 @@ fn a_damaged_point_file_is_recomputed_by_its_shard_and_blocks_no_other() {
     let whole = dir.path().join("whole");
     run_shard(&cfg, &whole, None).0.unwrap();
     let out = dir.path().join("c2");
-    for s in ["0/2", "1/2"] {
-        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
-            .0
-            .unwrap();
-    }
+    run_shards(&cfg, &out, 2);
     let p3 = out.join("points/point-3.json");
     let mut f = json(&p3);
     f["z"][0] = "xyz".into();
@@ -438,11 +438,7 @@ fn results_of_another_build_are_neither_resumed_nor_merged() {
     let cfg = config();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("split");
-    for s in ["0/2", "1/2"] {
-        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
-            .0
-            .unwrap();
-    }
+    run_shards(&cfg, &out, 2);
     as_other_build(&out.join("shard-1-of-2.json"));
     let why = merge_refusal(&out);
     assert!(
@@ -470,11 +466,7 @@ fn a_point_file_edited_by_one_bit_is_caught_by_its_checksum() {
     let cfg = config();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("bit");
-    for s in ["0/2", "1/2"] {
-        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
-            .0
-            .unwrap();
-    }
+    run_shards(&cfg, &out, 2);
     let p4 = out.join("points/point-4.json");
     let mut f = json(&p4);
     let z = f["z"][0].as_str().unwrap().to_string();
@@ -630,11 +622,7 @@ fn a_hash_edited_into_non_ascii_is_refused_not_a_panic() {
     let cfg = config();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("utf8");
-    for s in ["0/2", "1/2"] {
-        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
-            .0
-            .unwrap();
-    }
+    run_shards(&cfg, &out, 2);
     let p = out.join("shard-1-of-2.json");
     let mut m = json(&p);
     m["config_sha256"] = "a\u{e9}\u{e9}\u{e9}\u{e9}\u{e9}\u{e9}\u{e9}\u{e9}\u{e9}\u{e9}".into();
@@ -650,11 +638,7 @@ fn a_hash_edited_into_non_ascii_is_refused_not_a_panic() {
 fn merge_says_it_locks_the_carrier_again_and_how_long() {
     // Runs `cfg` as two shards into `out`, merges them, and returns what merge said.
     let split_and_merge = |cfg: &Config, out: &Path| {
-        for s in ["0/2", "1/2"] {
-            run_shard(cfg, out, Some(parse_shard(s).unwrap()))
-                .0
-                .unwrap();
-        }
+        run_shards(cfg, out, 2);
         let rec = Record::default();
         merge(out, &rec).unwrap();
         rec.0.into_inner().unwrap()
@@ -696,11 +680,7 @@ fn a_point_file_that_is_a_device_or_a_fifo_is_refused_not_read() {
     let cfg = config();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    for s in ["0/2", "1/2"] {
-        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
-            .0
-            .unwrap();
-    }
+    run_shards(&cfg, &out, 2);
     let p4 = out.join("points").join("point-4.json");
     let fifo = |p: &Path| {
         let made = std::process::Command::new("mkfifo").arg(p).status();
@@ -739,11 +719,7 @@ fn an_unreadable_manifest_stops_merge_saying_what_to_do() {
     let cfg = config();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    for s in ["0/2", "1/2"] {
-        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
-            .0
-            .unwrap();
-    }
+    run_shards(&cfg, &out, 2);
     merge(&out, &Quiet).unwrap();
     std::fs::write(out.join("manifest.json"), "{\"format\": \"gyro").unwrap();
     let why = merge_refusal(&out);
@@ -772,11 +748,7 @@ fn merge_refuses_a_dump_with_a_file_lost_naming_its_shard() {
     cfg.validate().unwrap();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    for s in ["0/3", "1/3", "2/3"] {
-        run_shard(&cfg, &out, Some(parse_shard(s).unwrap()))
-            .0
-            .unwrap();
-    }
+    run_shards(&cfg, &out, 3);
     merge(&out, &Quiet).unwrap();
     // Shard k of 3 holds the points k, k + 3, ...
     let i = cfg
