@@ -103,28 +103,49 @@ pub(crate) fn table_reading_gains(v: &[Complex64], lo: f64, gains: &[f64]) -> (f
     let m = v.len() / 2;
     let n = (gains.len() / 2) as i64;
     let points = (16 * v.len()).next_power_of_two().max(1024);
-    let theta = |g: usize| core::f64::consts::TAU * g as f64 / points as f64;
-    let inv: Vec<Complex64> = (0..points)
-        .map(|g| {
-            let t = theta(g);
-            let x: Complex64 = v
+    // e^{j theta_g} on the grid; powers by repeated products (a validation estimate: the
+    // roundings of 2N + 3 products are far below what it states), not a sine per term.
+    let step: Vec<Complex64> = (0..points)
+        .map(|g| Complex64::from_polar(1.0, core::f64::consts::TAU * g as f64 / points as f64))
+        .collect();
+    let power = |e: Complex64, k: i64| -> Complex64 {
+        let mut p = Complex64::new(1.0, 0.0);
+        let b = if k < 0 { e.conj() } else { e };
+        for _ in 0..k.unsigned_abs() {
+            p *= b;
+        }
+        p
+    };
+    // 1 / V(theta_g), V = sum_i v_i e^{j (i - M) theta}, by Horner's rule in e^{j theta}.
+    let inv: Vec<Complex64> = step
+        .iter()
+        .map(|&e| {
+            let x = v
                 .iter()
-                .enumerate()
-                .map(|(i, &h)| h * Complex64::from_polar(1.0, (i as f64 - m as f64) * t))
-                .sum();
-            1.0 / x
+                .rev()
+                .fold(Complex64::new(0.0, 0.0), |acc, &h| acc * e + h);
+            1.0 / (x * power(e, -(m as i64)))
         })
         .collect();
-    let coefficient = |f: &dyn Fn(Complex64) -> Complex64, q: i64| -> Complex64 {
-        inv.iter()
-            .enumerate()
-            .map(|(g, &y)| f(y) * Complex64::from_polar(1.0, -(q as f64) * theta(g)))
-            .sum::<Complex64>()
-            / points as f64
+    // The Fourier coefficients q = -Q ..= Q of y(theta_g): running phasors e^{-j q theta_g}.
+    let coefficients = |y: &[Complex64], q_max: i64| -> Vec<Complex64> {
+        let mut p: Vec<Complex64> = step.iter().map(|&e| power(e, q_max)).collect();
+        (-q_max..=q_max)
+            .map(|_| {
+                let c = y.iter().zip(&p).map(|(&a, &b)| a * b).sum::<Complex64>() / points as f64;
+                for (pg, &e) in p.iter_mut().zip(&step) {
+                    *pg *= e.conj();
+                }
+                c
+            })
+            .collect()
     };
-    let u = |q: i64| coefficient(&|y| y, q);
-    let w: Vec<f64> = (-2 * n - 1..=2 * n + 1)
-        .map(|q| coefficient(&|y| y * y, q).norm_sqr())
+    let u_all = coefficients(&inv, n + 1);
+    let u = |q: i64| u_all[(q + n + 1) as usize];
+    let inv2: Vec<Complex64> = inv.iter().map(|&y| y * y).collect();
+    let w: Vec<f64> = coefficients(&inv2, 2 * n + 1)
+        .iter()
+        .map(|c| c.norm_sqr())
         .collect();
     let w2 = |q: i64| w[(q + 2 * n + 1) as usize];
     let g = |k: i64| gains[(k + n) as usize];
