@@ -163,7 +163,27 @@ impl Config {
     /// amplitude the in-phase part of its fundamental. A rotating psi keeps neither to first
     /// order (the slow part turns both sidebands alike, into alpha), so it is not asked. The
     /// drive's amplitude flicker moves no phase to first order.
+    ///
+    /// The response follows its drives' phase through the plant rotating at `omega_rad_s` (the
+    /// reading's rate; a rate table's and the rotating runs' at rest): per mode k and drive j,
+    /// with `X0_k` the mode's carrier phasor and `X_kj(+-f)` its response to drive j's
+    /// sidebands `j F_j / 2` at `fc +- f`, the phase moves by `T_kj(f) = (X_kj(f) / X0_k -
+    /// conj(X_kj(-f) / X0_k)) / j` per radian of drive j's phase. The drives' flicker is
+    /// independent between them (`sum_j |T_kj|^2`); the carrier's turns both and the
+    /// reference (`|1 - sum_j T_kj|^2`). On resonance and uncoupled this is the envelope's
+    /// low-pass above; detuned, a drive's phase flicker at the offset from a mode lands on
+    /// that mode and comes back amplified (a carrier 10 Hz above f0 at 3000 deg/s, one split
+    /// mode 1.7 Hz from it, scattered 5 times the low-pass's figure).
     pub(crate) fn slow_flicker_variance(&self, reading: SlowReading) -> [f64; 2] {
+        self.slow_flicker_variance_at(reading, 0.0)
+    }
+
+    /// [`Config::slow_flicker_variance`] of a reading at the constant rate `omega_rad_s`.
+    pub(crate) fn slow_flicker_variance_at(
+        &self,
+        reading: SlowReading,
+        omega_rad_s: f64,
+    ) -> [f64; 2] {
         let fs_out = self.fs_out_hz();
         // As the board draws them: once per decimation block, up to fs_out / 2.
         let [_, _, drive_s1, carrier_s1] = self.flicker_psds_at_1hz();
@@ -181,12 +201,37 @@ impl Config {
                 .map_or(1.0, |c| (c.lowpass(f) / c.lowpass(0.0)).norm_sqr())
         };
         let f_top = 0.5 * fs_out;
-        // Each mode's envelope corner f0 / (2 Q) is its half-bandwidth.
-        self.mode_resonances_hz().map(|(_, f_env)| {
+        let fc = self.carrier_hz();
+        let plant = self.resonator_params();
+        let force = self.driven_device().coriolis_force();
+        let respond = |f: f64, j: usize| {
+            let mut u = [Complex64::new(0.0, 0.0); 2];
+            u[j] = force[j];
+            gyroemu_resonator::continuous_steady_state(&plant, omega_rad_s, fc + f, u)
+        };
+        let carrier_x = gyroemu_resonator::continuous_steady_state(&plant, omega_rad_s, fc, force);
+        let j_unit = Complex64::new(0.0, 1.0);
+        // Per mode, the phase transfer of each drive's phase at f (Hz).
+        let follow = |f: f64| -> [[Complex64; 2]; 2] {
+            let up = [respond(f, 0), respond(f, 1)];
+            let down = [respond(-f, 0), respond(-f, 1)];
+            core::array::from_fn(|k| {
+                core::array::from_fn(|j| {
+                    // Sidebands j F_j / 2: the responses to F_j, times j / 2.
+                    let x0 = carrier_x[2 + k];
+                    let a = up[j][2 + k] * (0.5 * j_unit) / x0;
+                    let b = down[j][2 + k] * (0.5 * j_unit) / x0;
+                    (a - b.conj()) / j_unit
+                })
+            })
+        };
+        [0, 1].map(|k| {
             let density = |f: f64| {
-                let h = 1.0 / (1.0 + (f / f_env).powi(2));
-                let d = drive.as_ref().map_or(0.0, |d| d.psd(f)) * h;
-                let c = carrier.as_ref().map_or(0.0, |d| d.psd(f)) * (1.0 - h);
+                let t = follow(f)[k];
+                let d =
+                    drive.as_ref().map_or(0.0, |d| d.psd(f)) * (t[0].norm_sqr() + t[1].norm_sqr());
+                let c = carrier.as_ref().map_or(0.0, |d| d.psd(f))
+                    * (Complex64::new(1.0, 0.0) - t[0] - t[1]).norm_sqr();
                 (d + c) * low(f)
             };
             reading.variance(&density, self.flicker_f_lo_hz(), f_top)
@@ -295,8 +340,11 @@ impl Config {
         // the window's own weight (not its white-noise bandwidth: a Hann window takes 1.06 to
         // 1.12 times the boxcar's of the drive's 1/f phase, not 1.5).
         let hann = self.experiment.window == WindowKind::Hann;
-        let slow_of = |span_s: f64| match shape {
-            Shape::Coriolis => self.slow_flicker_variance(SlowReading::Mean { span_s, hann }),
+        let slow_of = |span_s: f64, rate: f64| match shape {
+            // The plant rotates at a Coriolis reading's rate (a rate table's swings: at rest).
+            Shape::Coriolis => {
+                self.slow_flicker_variance_at(SlowReading::Mean { span_s, hann }, rate * DEG)
+            }
             Shape::RateTable { freq_hz } => self.slow_flicker_variance(SlowReading::Tone {
                 freq_hz,
                 span_s,
@@ -304,17 +352,28 @@ impl Config {
             }),
             Shape::Rotating => [0.0; 2],
         };
-        // Once per span, not per rate: a sweep may list 1e5 rates of one span, and each is a
-        // quadrature of hundreds of points (the zero-rate reference's span among them).
+        // Once per span (and per rate for a Coriolis reading, whose plant rotates at it): a
+        // sweep may list 1e5 rates of one span, and each is a quadrature of hundreds of
+        // points (the zero-rate reference's span among them). Only with flicker.
         let span = |rate: f64| self.plan_point(rate).span_samples() / fs_out;
-        let mut slow_by_span: std::collections::HashMap<u64, [f64; 2]> = Default::default();
+        let flicker_on = self.noise.as_ref().is_some_and(|n| {
+            n.drive_phase_flicker_rad_per_rthz > 0.0 || n.carrier_phase_flicker_rad_per_rthz > 0.0
+        });
+        let key = |rate: f64| {
+            let r = if shape == Shape::Coriolis { rate } else { 0.0 };
+            (span(rate).to_bits(), r.to_bits())
+        };
+        let mut slow_by_key: std::collections::HashMap<(u64, u64), [f64; 2]> = Default::default();
         for &rate in self.experiment.rates_dps.iter().chain(&[0.0]) {
-            let s = span(rate);
-            slow_by_span
-                .entry(s.to_bits())
-                .or_insert_with(|| slow_of(s));
+            slow_by_key.entry(key(rate)).or_insert_with(|| {
+                if flicker_on {
+                    slow_of(span(rate), rate)
+                } else {
+                    [0.0; 2]
+                }
+            });
         }
-        let slow = |rate: f64| slow_by_span[&span(rate).to_bits()];
+        let slow = |rate: f64| slow_by_key[&key(rate)];
         // A rate table's reading: how its harmonics' noise reaches the amplitude read
         // ([`crate::noise_table`]), per span the harmonics' noise gains (the TIA's gain across
         // them included), per rate and mode the envelope's weights.
