@@ -173,7 +173,7 @@ impl Config {
     /// reference (`|1 - sum_j T_kj|^2`). On resonance and uncoupled this is the envelope's
     /// low-pass above; detuned, a drive's phase flicker at the offset from a mode lands on
     /// that mode and comes back amplified (a carrier 10 Hz above f0 at 3000 deg/s, one split
-    /// mode 1.7 Hz from it, scattered 5 times the low-pass's figure).
+    /// mode 1.7 Hz from it, scattered 7.5 times the low-pass's figure).
     pub(crate) fn slow_flicker_variance(&self, reading: SlowReading) -> [f64; 2] {
         self.slow_flicker_variance_at(reading, 0.0)
     }
@@ -219,6 +219,10 @@ impl Config {
                 core::array::from_fn(|j| {
                     // Sidebands j F_j / 2: the responses to F_j, times j / 2.
                     let x0 = carrier_x[2 + k];
+                    if x0.norm() == 0.0 {
+                        // An undriven mode has no phase to turn (other rules name it).
+                        return Complex64::new(0.0, 0.0);
+                    }
                     let a = up[j][2 + k] * (0.5 * j_unit) / x0;
                     let b = down[j][2 + k] * (0.5 * j_unit) / x0;
                     (a - b.conj()) / j_unit
