@@ -418,6 +418,18 @@ fn with_a_pll_the_warned_scatter_is_that_of_the_locked_carrier() {
     );
 }
 
+/// A Coriolis point at `rate_dps` averaged `average_s` on f0 = 1 kHz, Q = 2000 (half-bandwidth
+/// 0.25 Hz) driven at a carrier 10 Hz above f0, on a 16 kHz board: at about 3600 deg/s one of
+/// the modes rotation splits (f0 +- lambda Omega / 2 pi) sits on the carrier.
+fn detuned_coriolis(rate_dps: f64, average_s: f64) -> Config {
+    let text = format!(
+        "[device]\nf0_hz = 1000.0\nq = 2000.0\nangular_gain = 1.0\n[drive]\nf1 = 1.0\n\
+         carrier_hz = 1010.0\n[board]\nfs_hz = 16000.0\n[experiment]\nkind = \"coriolis\"\n\
+         rates_dps = [{rate_dps:?}]\naverage_s = {average_s:?}\n"
+    );
+    gyroemu::config::parse_config(&text).unwrap()
+}
+
 /// The Brownian force seen at a reading's own rate: rotation splits the modes to about
 /// f0 +- lambda Omega / 2 pi, and a carrier detuned 10 Hz above f0 (40 half-bandwidths) sits
 /// on the upper one at 3600 deg/s. The stated scatter takes the plant rotating at the rate
@@ -425,10 +437,7 @@ fn with_a_pll_the_warned_scatter_is_that_of_the_locked_carrier() {
 /// seeds, and the rate's density against an independent solve of eq. 1.
 #[test]
 fn the_stated_brownian_scatter_is_that_of_the_plant_rotating_at_the_rate() {
-    let text = "[device]\nf0_hz = 1000.0\nq = 2000.0\nangular_gain = 1.0\n[drive]\nf1 = 1.0\n\
-                carrier_hz = 1010.0\n[board]\nfs_hz = 16000.0\n[experiment]\nkind = \"coriolis\"\n\
-                rates_dps = [3600.0]\naverage_s = 5.0\n";
-    let mut cfg = gyroemu::config::parse_config(text).unwrap();
+    let mut cfg = detuned_coriolis(3600.0, 5.0);
     cfg.noise = Some(noise(Some(1e-11), 0.0, 0.0));
     cfg.validate().unwrap();
     let stated = cfg.noise_phase().unwrap()[0];
@@ -554,10 +563,7 @@ fn a_rate_table_reading_scatters_as_its_harmonics_noise_through_the_read_out_say
 /// Now stated from each drive's phase transfer through the rotating plant; over 32 seeds.
 #[test]
 fn a_drives_phase_flicker_is_stated_through_the_rotating_detuned_plant() {
-    let text = "[device]\nf0_hz = 1000.0\nq = 2000.0\nangular_gain = 1.0\n[drive]\nf1 = 1.0\n\
-                carrier_hz = 1010.0\n[board]\nfs_hz = 16000.0\n[experiment]\nkind = \"coriolis\"\n\
-                rates_dps = [3000.0]\naverage_s = 0.1\n";
-    let mut cfg = gyroemu::config::parse_config(text).unwrap();
+    let mut cfg = detuned_coriolis(3000.0, 0.1);
     cfg.noise = Some(NoiseConfig {
         drive_phase_flicker_rad_per_rthz: 1e-3,
         ..noise(None, 0.0, 0.0)
