@@ -1,6 +1,7 @@
 //! Reading a signal dump back: a SigMF recording (`.sigmf-meta` + `.sigmf-data`, `rf64_le`) or
 //! the CSV beside it (`sample, time_s, <channels...>`).
 
+use crate::own_file::{read_bounded, Unread};
 use crate::sigmf::{unit_from_name, SigmfChannel, SIGMF_DATATYPE_REAL_F64};
 use crate::IoError;
 use serde_json::Value;
@@ -223,38 +224,27 @@ const MAX_META_BYTES: u64 = 16 << 20;
 const MAX_CSV_BYTES: u64 = MAX_DUMP_FRAMES * 16 * 25;
 
 #[cfg(unix)]
-fn is_fifo(t: &std::fs::FileType) -> bool {
+pub(crate) fn is_fifo(t: &std::fs::FileType) -> bool {
     std::os::unix::fs::FileTypeExt::is_fifo(t)
 }
 
 #[cfg(not(unix))]
-fn is_fifo(_: &std::fs::FileType) -> bool {
+pub(crate) fn is_fifo(_: &std::fs::FileType) -> bool {
     false
 }
 
 /// Reads `path` whole if it holds at most `cap` bytes, else refuses saying `beyond`. Only a
-/// regular file or a FIFO (`<(...)`) is read: a device such as /dev/zero never ends. A FIFO's
-/// size is unknown until it ends, hence the cap on the bytes read as well as on the size.
+/// regular file or a FIFO (`<(...)`) is read ([`read_bounded`]): a device such as /dev/zero
+/// never ends.
 fn read_bytes(path: &Path, cap: u64, beyond: &str) -> Result<Vec<u8>, IoError> {
-    let io = |e: std::io::Error| read_err(path, e.to_string());
-    let too_big = || read_err(path, format!("more than {cap} bytes: {beyond}"));
-    // Stat before opening: opening a device may block or act.
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !(meta.is_file() || is_fifo(&meta.file_type())) {
-        return Err(read_err(
+    read_bounded(path, cap, true).map_err(|e| match e {
+        Unread::Io(e) => read_err(path, e.to_string()),
+        Unread::NotRegular { .. } => read_err(
             path,
             "not a regular file (nor a FIFO): a device such as /dev/zero may never end",
-        ));
-    }
-    // A regular file is refused by its size, unread.
-    if meta.len() > cap {
-        return Err(too_big());
-    }
-    let bytes = read_capped(path, cap).map_err(io)?;
-    if bytes.len() as u64 > cap {
-        return Err(too_big());
-    }
-    Ok(bytes)
+        ),
+        Unread::TooBig(_) => read_err(path, format!("more than {cap} bytes: {beyond}")),
+    })
 }
 
 /// Reads `path` up to `cap` + 1 bytes: a longer file, or a stream that never ends, comes back

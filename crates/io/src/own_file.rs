@@ -1,8 +1,10 @@
-//! Reading back files gyroemu wrote itself (a run's manifest, its point and device files, a
-//! folder's lock). They are small and regular; what stands under their names may not be: a
-//! symlink to /dev/zero was read until memory ran out, and a FIFO blocked `run` and `merge`
-//! forever. So only a regular file of bounded size is read, and anything else is an error
-//! naming what it is.
+//! Reading a file whole only if it is what it should be and within a bound ([`read_bounded`]):
+//! a dump a user hands `inspect` (which may come through a FIFO), and files gyroemu wrote
+//! itself ([`read_own_text`]: a run's manifest, its point and device files, a folder's lock).
+//! Those are small and regular; what stands under their names may not be: a symlink to
+//! /dev/zero was read until memory ran out, and a FIFO blocked `run` and `merge` forever. So
+//! only a regular file of bounded size is read there, and anything else is an error naming
+//! what it is.
 
 use std::io::{Error, ErrorKind};
 use std::path::Path;
@@ -15,38 +17,57 @@ pub const MAX_RECORD_BYTES: u64 = 1 << 20;
 /// The largest folder lock read (a pid, a host and the command line).
 pub const MAX_LOCK_BYTES: u64 = 4 << 20;
 
+/// Why [`read_bounded`] read nothing, or all it read.
+pub(crate) enum Unread {
+    /// The file system's own error (a missing file keeps its `NotFound` kind).
+    Io(Error),
+    /// Not a file it reads: a folder (`true`), or a device or (when not taken) a FIFO.
+    NotRegular { folder: bool },
+    /// Longer than the cap: its size when a regular file says it, `None` when the bytes read
+    /// passed it (a FIFO, or a file that grew).
+    TooBig(Option<u64>),
+}
+
+/// `path`'s bytes if it is a regular file (symlinks followed), or with `fifo` a FIFO (`<(...)`),
+/// of at most `cap` bytes. Stats before opening: opening a FIFO blocks until a writer comes,
+/// and a device such as /dev/zero may never end. A regular file is refused by its size,
+/// unread; a FIFO's size is unknown until it ends, hence the cap on the bytes read too.
+pub(crate) fn read_bounded(path: &Path, cap: u64, fifo: bool) -> Result<Vec<u8>, Unread> {
+    let meta = std::fs::metadata(path).map_err(Unread::Io)?;
+    if !(meta.is_file() || fifo && crate::dump::is_fifo(&meta.file_type())) {
+        return Err(Unread::NotRegular {
+            folder: meta.is_dir(),
+        });
+    }
+    if meta.len() > cap {
+        return Err(Unread::TooBig(Some(meta.len())));
+    }
+    let bytes = crate::read_capped(path, cap).map_err(Unread::Io)?;
+    if bytes.len() as u64 > cap {
+        return Err(Unread::TooBig(None));
+    }
+    Ok(bytes)
+}
+
 /// `path` as UTF-8 text if it is a regular file (symlinks followed) of at most `cap` bytes.
 /// A missing file keeps its `NotFound` kind; anything else under the name (a FIFO, a device,
 /// a folder) or a longer file is an `InvalidData` error saying so, unread.
 pub fn read_own_text(path: &Path, cap: u64) -> std::io::Result<String> {
-    // Stat before opening: opening a FIFO blocks until a writer comes, a device may never end.
-    let meta = std::fs::metadata(path)?;
-    if !meta.is_file() {
-        let what = if meta.is_dir() {
-            "a folder"
-        } else {
-            "not a regular file, but a FIFO or a device, which gyroemu never writes there"
-        };
-        return Err(Error::new(ErrorKind::InvalidData, what));
-    }
-    if meta.len() > cap {
-        return Err(Error::new(
-            ErrorKind::InvalidData,
-            format!(
-                "{} bytes, more than the {cap} such a file of gyroemu holds",
-                meta.len()
-            ),
-        ));
-    }
-    // The file may grow between the stat and the read: read one byte past the cap at most.
-    let bytes = crate::read_capped(path, cap)?;
-    if bytes.len() as u64 > cap {
-        return Err(Error::new(
-            ErrorKind::InvalidData,
-            format!("more than the {cap} bytes such a file of gyroemu holds"),
-        ));
-    }
-    String::from_utf8(bytes).map_err(|_| Error::new(ErrorKind::InvalidData, "not UTF-8 text"))
+    let invalid = |what: String| Error::new(ErrorKind::InvalidData, what);
+    let bytes = read_bounded(path, cap, false).map_err(|e| match e {
+        Unread::Io(e) => e,
+        Unread::NotRegular { folder: true } => invalid("a folder".into()),
+        Unread::NotRegular { folder: false } => invalid(
+            "not a regular file, but a FIFO or a device, which gyroemu never writes there".into(),
+        ),
+        Unread::TooBig(Some(len)) => invalid(format!(
+            "{len} bytes, more than the {cap} such a file of gyroemu holds"
+        )),
+        Unread::TooBig(None) => invalid(format!(
+            "more than the {cap} bytes such a file of gyroemu holds"
+        )),
+    })?;
+    String::from_utf8(bytes).map_err(|_| invalid("not UTF-8 text".into()))
 }
 
 #[cfg(test)]
