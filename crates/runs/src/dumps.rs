@@ -78,9 +78,7 @@ pub(crate) fn reconcile_dump(
         ));
     }
     if let Some(i) = dump_point(cfg).filter(|i| mine.contains(i)) {
-        if prev.remove(&i).is_some() {
-            let f = out.join(POINTS_DIR).join(PointFile::file_name(i));
-            remove_files(&[f])?;
+        if forget_point(out, prev, i)? {
             reporter.note(&format!(
                 "recomputing point {i} ({} deg/s) to record the dump",
                 cfg.emulated_rates_dps()[i]
@@ -88,6 +86,32 @@ pub(crate) fn reconcile_dump(
         }
     }
     Ok(())
+}
+
+/// Drops point `i` from the reused points `prev` and deletes its file, so it runs again;
+/// whether it was reused.
+fn forget_point(
+    out: &Path,
+    prev: &mut BTreeMap<usize, LaneResult>,
+    i: usize,
+) -> Result<bool, RunError> {
+    if prev.remove(&i).is_none() {
+        return Ok(false);
+    }
+    remove_files(&[out.join(POINTS_DIR).join(PointFile::file_name(i))])?;
+    Ok(true)
+}
+
+/// The dumped point of `cfg`'s `[dump]` and the files of its dump that `dir` lacks of those
+/// a dump always writes ([`Probe::required_file_names`]: each recorded rate's CSV and SigMF
+/// pair); `None` without a `[dump]`.
+pub(crate) fn lost_dump_files(cfg: &Config, dir: &Path) -> Option<(usize, Vec<String>)> {
+    let (d, i) = (cfg.dump_resolved()?, dump_point(cfg)?);
+    let lost = Probe::required_file_names(&d.nodes.unwrap_or_default(), DUMP_STEM)
+        .into_iter()
+        .filter(|n| !dir.join(n).exists())
+        .collect();
+    Some((i, lost))
 }
 
 /// The last run recorded this same `[dump]`, but a file it always writes is gone (deleted by
@@ -103,23 +127,14 @@ fn recompute_lost_dump(
     prev: &mut BTreeMap<usize, LaneResult>,
     reporter: &dyn Reporter,
 ) -> Result<(), RunError> {
-    let (Some(d), Some(i)) = (cfg.dump_resolved(), dump_point(cfg)) else {
+    let Some((i, lost)) = lost_dump_files(cfg, out) else {
         return Ok(());
     };
-    if !owns_files || !mine.contains(&i) || !prev.contains_key(&i) {
-        return Ok(());
-    }
-    let nodes = d.nodes.unwrap_or_default();
-    let lost: Vec<String> = Probe::required_file_names(&nodes, DUMP_STEM)
-        .into_iter()
-        .filter(|n| !out.join(n).exists())
-        .collect();
-    if lost.is_empty() {
+    if !owns_files || !mine.contains(&i) || !prev.contains_key(&i) || lost.is_empty() {
         return Ok(());
     }
     remove_files(&dump_files(out))?;
-    prev.remove(&i);
-    remove_files(&[out.join(POINTS_DIR).join(PointFile::file_name(i))])?;
+    forget_point(out, prev, i)?;
     reporter.note(&format!(
         "the dump in `{}` lacks {}: recomputing point {i} ({} deg/s) to record it again",
         out.display(),

@@ -8,10 +8,9 @@ use crate::manifest::RunKind;
 use crate::merge_split::{bad, read_split, Split};
 use crate::points::{config_hash, PointFile};
 use gyroemu_analysis::montecarlo::LotSummary;
-use gyroemu_board::Probe;
 use gyroemu_config::parse_config;
 use gyroemu_experiment::work::{lock_work, measured_lock_rate};
-use gyroemu_experiment::{dump_point, finish_sweep, resolve_lock, Reporter, DUMP_STEM};
+use gyroemu_experiment::{finish_sweep, resolve_lock, Reporter};
 use gyroemu_report::{check_problems, run_title, write_run};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -80,11 +79,7 @@ fn merge_run(dir: &Path, split: Split, reporter: &dyn Reporter) -> Result<Vec<Pa
         .collect::<Result<BTreeMap<_, _>, RunError>>()?;
     // The shard of the dumped point recorded the dump into this folder: a file of it lost
     // since (deleted by hand) would leave the merged folder with part of its dump missing.
-    if let (Some(d), Some(i)) = (cfg.dump_resolved(), dump_point(&cfg)) {
-        let lost: Vec<String> = Probe::required_file_names(&d.nodes.unwrap_or_default(), DUMP_STEM)
-            .into_iter()
-            .filter(|f| !dir.join(f).exists())
-            .collect();
+    if let Some((i, lost)) = crate::dumps::lost_dump_files(&cfg, dir) {
         if !lost.is_empty() {
             return Err(bad(format!(
                 "the [dump] of this config records point {i}, but `{}` lacks {}: rerun its shard with --shard {}/{} to record the dump again",
