@@ -149,7 +149,24 @@ pub(crate) fn table_reading_gains(v: &[Complex64], lo: f64, gains: &[f64]) -> (f
         .collect();
     let w2 = |q: i64| w[(q + 2 * n + 1) as usize];
     let g = |k: i64| gains[(k + n) as usize];
-    let psi = gyroemu_mixer::phase_fundamental_fine(v).arg();
+    // psi from the phase -arg V = arg(1 / V) on the same grid, unwrapped: its fundamental
+    // (1 / pi) int phi e^{-j theta} d theta by the rectangle rule. A direction to project
+    // onto, so this grid serves; the theory's read-out refines its own.
+    let mut phase = Vec::with_capacity(points);
+    let mut last = inv[0].arg();
+    for y in &inv {
+        let p = y.arg();
+        let turned = p - last;
+        last += turned - core::f64::consts::TAU * (turned / core::f64::consts::TAU).round();
+        phase.push(last);
+    }
+    let fundamental: Complex64 = phase
+        .iter()
+        .zip(&step)
+        .map(|(&p, &e)| p * e.conj())
+        .sum::<Complex64>()
+        * (2.0 / points as f64);
+    let psi = fundamental.arg();
     let e = Complex64::from_polar(1.0, -psi);
     let first = (-n..=n)
         .map(|k| g(k) * (lo * (u(1 - k) * e + u(-1 - k) * e.conj())).norm_sqr())

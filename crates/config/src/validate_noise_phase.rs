@@ -39,6 +39,10 @@ pub struct NoisePhase {
     /// The noise density at the ADC input near the carrier at this rate (V^2/Hz): the
     /// Brownian part depends on the rate, which splits the modes.
     pub density_v2_per_hz: [f64; 2],
+    /// A rate table's read harmonic whose noise comes back the most through the read-out
+    /// (`Config::table_harmonic_noise_gains`), as `(|n|, noise power per unit of the DC
+    /// reading's)`; `None` for other readings.
+    pub table_noise_gain_peak: Option<(usize, f64)>,
 }
 
 impl Config {
@@ -71,7 +75,7 @@ impl Config {
     /// noise and the ADC's) count what the decimation folds onto the averaged output too
     /// ([`Config::decimation_fold`]). `None` without `[noise]`. All but the Brownian force's
     /// density, which depends on the rate a reading is taken at
-    /// ([`Config::brownian_density_at`]); its RMS still decides whether the ADC is dithered.
+    /// ([`Config::brownian_density`]); its RMS still decides whether the ADC is dithered.
     fn carrier_noise_but_brownian(&self) -> Option<[f64; 2]> {
         let n = self.noise.as_ref()?;
         let b = &self.board;
@@ -116,36 +120,45 @@ impl Config {
         }))
     }
 
-    /// Per mode, the Brownian force's density at the ADC input near the carrier (V^2/Hz) at
-    /// the constant rate `omega_rad_s`: each mode's white force (of its own f0 and Q) through
-    /// the rotating plant's velocity response at the carrier (the Coriolis coupling, the
-    /// quadrature coupling and the mode split all in it), transduction and the TIA; 0 without
-    /// a Brownian source. Rotation splits the modes to about f0 +- lambda Omega / 2 pi, so a
-    /// carrier detuned onto one of them sees its resonance: the uncoupled modes' density had
-    /// stated 28 times less scatter than a detuned Coriolis run at 3600 deg/s read.
-    pub(crate) fn brownian_density_at(&self, omega_rad_s: f64) -> [f64; 2] {
-        let Some(mass) = self.noise.as_ref().and_then(|n| n.effective_mass_kg) else {
-            return [0.0; 2];
-        };
-        let Ok(chain) = ChainResponse::new(&self.board_params()) else {
-            return [f64::NAN; 2];
-        };
+    /// Per mode, the Brownian force's density at the ADC input near the carrier (V^2/Hz) as a
+    /// function of the constant rate (rad/s): each mode's white force (of its own f0 and Q)
+    /// through the rotating plant's velocity response at the carrier (the Coriolis coupling,
+    /// the quadrature coupling and the mode split all in it), transduction and the TIA; 0
+    /// without a Brownian source. What does not depend on the rate is found once (a rate
+    /// table takes it at 33 rates over its swing). Rotation splits the modes to about
+    /// f0 +- lambda Omega / 2 pi, so a carrier detuned onto one of them sees its resonance: the
+    /// uncoupled modes' density had stated 28 times less scatter than a detuned Coriolis run
+    /// at 3600 deg/s read.
+    pub(crate) fn brownian_density(&self) -> impl Fn(f64) -> [f64; 2] + '_ {
+        let mass = self.noise.as_ref().and_then(|n| n.effective_mass_kg);
+        let chain = ChainResponse::new(&self.board_params()).ok();
         let temperature_k = self.noise.as_ref().map_or(0.0, |n| n.temperature_k);
         let plant = self.resonator_params();
         let fc = self.carrier_hz();
-        let s_a = [plant.mode1, plant.mode2].map(|m| {
-            gyroemu_resonator::thermomechanical_accel_psd(temperature_k, mass, m.f0_hz, m.q)
+        let s_a = mass.map(|mass| {
+            [plant.mode1, plant.mode2].map(|m| {
+                gyroemu_resonator::thermomechanical_accel_psd(temperature_k, mass, m.f0_hz, m.q)
+            })
         });
-        // Mode j's unit force alone, then mode k's velocity phasor at the carrier.
-        let unit = |j: usize| {
-            let mut f = [gyroemu_core::Complex64::new(0.0, 0.0); 2];
-            f[j] = gyroemu_core::Complex64::new(1.0, 0.0);
-            gyroemu_resonator::continuous_steady_state(&plant, omega_rad_s, fc, f)
-        };
-        let x = [unit(0), unit(1)];
         let t = self.device.transduction_a_s_per_m;
-        let tia = chain.tia(fc).norm_sqr();
-        [0, 1].map(|k| (0..2).map(|j| s_a[j] * x[j][2 + k].norm_sqr()).sum::<f64>() * t * t * tia)
+        let tia = chain.as_ref().map(|c| c.tia(fc).norm_sqr());
+        move |omega_rad_s: f64| {
+            let Some(s_a) = s_a else {
+                return [0.0; 2];
+            };
+            let Some(tia) = tia else {
+                return [f64::NAN; 2];
+            };
+            // Mode j's unit force alone, then mode k's velocity phasor at the carrier.
+            let unit = |j: usize| {
+                let mut f = [Complex64::new(0.0, 0.0); 2];
+                f[j] = Complex64::new(1.0, 0.0);
+                gyroemu_resonator::continuous_steady_state(&plant, omega_rad_s, fc, f)
+            };
+            let x = [unit(0), unit(1)];
+            [0, 1]
+                .map(|k| (0..2).map(|j| s_a[j] * x[j][2 + k].norm_sqr()).sum::<f64>() * t * t * tia)
+        }
     }
 
     /// The TIA voltage flicker's design (input-referred: `(e_n / tia_gain_ohm)^2 corner / f`
@@ -306,14 +319,15 @@ impl Config {
         // The density at a reading's rate: the Brownian part through the plant rotating at
         // it (a rate table's the largest over its swing, a bound; a rotating run's plant does
         // not rotate), the rest as at rest. By rate, once: a sweep may list 1e5 rates.
+        let brownian = self.brownian_density();
         let mut density_by_rate: std::collections::HashMap<u64, [f64; 2]> = Default::default();
         for &rate in self.experiment.rates_dps.iter().chain(&[0.0]) {
             density_by_rate.entry(rate.to_bits()).or_insert_with(|| {
                 let b = match shape {
-                    Shape::Coriolis => self.brownian_density_at(rate * DEG),
-                    Shape::Rotating => self.brownian_density_at(0.0),
+                    Shape::Coriolis => brownian(rate * DEG),
+                    Shape::Rotating => brownian(0.0),
                     Shape::RateTable { .. } => (-16..=16)
-                        .map(|i| self.brownian_density_at(rate * DEG * i as f64 / 16.0))
+                        .map(|i| brownian(rate * DEG * i as f64 / 16.0))
                         .fold([0.0f64; 2], |m, d| [m[0].max(d[0]), m[1].max(d[1])]),
                 };
                 [0, 1].map(|k| rest[k] + b[k])
@@ -382,34 +396,46 @@ impl Config {
         // ([`crate::noise_table`]), per span the harmonics' noise gains (the TIA's gain across
         // them included), per rate and mode the envelope's weights.
         let chain = ChainResponse::new(&self.board_params()).ok();
-        // The harmonics' gains depend on the span alone: once per span.
-        let gains_by_span: std::cell::RefCell<std::collections::HashMap<u64, Vec<f64>>> =
+        let (n, fc) = (self.table_harmonics(), self.carrier_hz());
+        // The harmonics' gains depend on the span alone: once per span, as the read-out
+        // takes them (the TIA's gain across the harmonics included), with their peak.
+        type Gains = (Vec<f64>, (usize, f64));
+        // Per mode the variance's factors over one harmonic's own (first and second order),
+        // and the peak harmonic's gain.
+        type Reading = ([(f64, f64); 2], Option<(usize, f64)>);
+        let gains_by_span: std::cell::RefCell<std::collections::HashMap<u64, Gains>> =
             Default::default();
-        let table_gain = |rate: f64| -> [(f64, f64); 2] {
+        let table_gain = |rate: f64| -> Reading {
             let (Shape::RateTable { freq_hz }, Some(chain)) = (shape, chain.as_ref()) else {
-                return [(2.0, 0.0); 2];
+                return ([(2.0, 0.0); 2], None);
             };
-            let n = self.table_harmonics();
-            let fc = self.carrier_hz();
             let tia0 = chain.tia(fc);
-            let gains: Vec<f64> = gains_by_span
+            let (gains, peak) = gains_by_span
                 .borrow_mut()
                 .entry(span(rate).to_bits())
                 .or_insert_with(|| {
-                    self.table_harmonic_noise_gains(chain, freq_hz, n, span(rate), hann)
+                    let raw = self.table_harmonic_noise_gains(chain, freq_hz, n, span(rate), hann);
+                    let mut peak = (0, 0.0f64);
+                    for (i, &g) in raw.iter().enumerate() {
+                        if g > peak.1 {
+                            peak = (i.abs_diff(n), g);
+                        }
+                    }
+                    let read = raw
                         .iter()
                         .enumerate()
                         .map(|(i, g)| {
                             let f = (i as f64 - n as f64) * freq_hz;
                             g * (tia0 / chain.tia(fc + f)).norm_sqr()
                         })
-                        .collect()
+                        .collect();
+                    (read, peak)
                 })
                 .clone();
             const M: usize = 24;
             let env = dev.rate_table_envelopes(rate * DEG, freq_hz, M);
             let g = |f: f64| chain.dac_hold(f) * self.device.transduction_a_s_per_m;
-            [0, 1].map(|k| {
+            let factors = [0, 1].map(|k| {
                 let Some(lo) = amps(rate).map(|a| a[k].0) else {
                     return (f64::NAN, f64::NAN);
                 };
@@ -421,7 +447,8 @@ impl Config {
                     .map(|(i, &x)| x * g(fc + (i as f64 - M as f64) * freq_hz) * tia0)
                     .collect();
                 crate::noise_table::table_reading_gains(&v, lo, &gains)
-            })
+            });
+            (factors, Some(peak))
         };
         let reference_flicker = slow(0.0);
         let points = self
@@ -437,9 +464,9 @@ impl Config {
                     Shape::Rotating => dev.rotating_psi_rad(omega),
                 };
                 let flicker = slow(rate);
-                let gain = match shape {
+                let (gain, table_noise_gain_peak) = match shape {
                     Shape::RateTable { .. } => table_gain(rate),
-                    _ => [(2.0, 0.0); 2],
+                    _ => ([(2.0, 0.0); 2], None),
                 };
                 let sigma_rad = [0, 1].map(|k| {
                     let own = variance(rate, k).unwrap_or(f64::NAN);
@@ -457,6 +484,7 @@ impl Config {
                     theory_rad,
                     amplitude_v,
                     density_v2_per_hz: density(rate),
+                    table_noise_gain_peak,
                 }
             })
             .collect();
@@ -471,7 +499,7 @@ impl Config {
         let Some(points) = self.noise_phase() else {
             return;
         };
-        self.validate_table_noise_skirt(warnings);
+        self.validate_table_noise_skirt(&points, warnings);
         for k in 0..2 {
             // The worst ratio; a NaN (a dead signal, which other rules name) says nothing.
             let worst = points
@@ -528,32 +556,21 @@ impl Config {
     /// harmonics; the noise leaked from near DC is not (each harmonic's window sidelobe takes
     /// the same noise), and readings can scatter several times the figure: a 200 deg/s point
     /// read with 15 harmonics of a 9 Hz table behind a 10 Hz low-pass, 3.1 times.
-    fn validate_table_noise_skirt(&self, warnings: &mut Vec<String>) {
+    fn validate_table_noise_skirt(&self, points: &[NoisePhase], warnings: &mut Vec<String>) {
         let Shape::RateTable { freq_hz } = self.shape() else {
             return;
         };
         let Ok(chain) = ChainResponse::new(&self.board_params()) else {
             return;
         };
-        let n = self.table_harmonics();
-        let hann = self.experiment.window == WindowKind::Hann;
-        let fs_out = self.fs_out_hz();
-        let mut spans: Vec<f64> = self
-            .experiment
-            .rates_dps
-            .iter()
-            .map(|&r| self.plan_point(r).span_samples() / fs_out)
-            .collect();
-        spans.sort_by(f64::total_cmp);
-        spans.dedup();
-        // The largest gain of a read harmonic over the spans, with its harmonic.
+        // The largest gain of a read harmonic over the readings, with its harmonic.
         let mut worst = (0.0f64, 0usize);
-        for span in spans {
-            let gains = self.table_harmonic_noise_gains(&chain, freq_hz, n, span, hann);
-            for (i, &g) in gains.iter().enumerate() {
-                if g > worst.0 {
-                    worst = (g, i.abs_diff(n));
-                }
+        for &(h, g) in points
+            .iter()
+            .filter_map(|p| p.table_noise_gain_peak.as_ref())
+        {
+            if g > worst.0 {
+                worst = (g, h);
             }
         }
         let (gain, h) = worst;
