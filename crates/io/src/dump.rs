@@ -1,7 +1,7 @@
 //! Reading a signal dump back: a SigMF recording (`.sigmf-meta` + `.sigmf-data`, `rf64_le`) or
 //! the CSV beside it (`sample, time_s, <channels...>`).
 
-use crate::own_file::{read_bounded, Unread};
+use crate::bounded_read::{read_bounded, Unread};
 use crate::sigmf::{unit_from_name, SigmfChannel, SIGMF_DATATYPE_REAL_F64};
 use crate::IoError;
 use serde_json::Value;
@@ -223,16 +223,6 @@ const MAX_META_BYTES: u64 = 16 << 20;
 /// (`-2.2250738585072014e-308,`): 20 GB.
 const MAX_CSV_BYTES: u64 = MAX_DUMP_FRAMES * 16 * 25;
 
-#[cfg(unix)]
-pub(crate) fn is_fifo(t: &std::fs::FileType) -> bool {
-    std::os::unix::fs::FileTypeExt::is_fifo(t)
-}
-
-#[cfg(not(unix))]
-pub(crate) fn is_fifo(_: &std::fs::FileType) -> bool {
-    false
-}
-
 /// Reads `path` whole if it holds at most `cap` bytes, else refuses saying `beyond`. Only a
 /// regular file or a FIFO (`<(...)`) is read ([`read_bounded`]): a device such as /dev/zero
 /// never ends.
@@ -245,26 +235,6 @@ fn read_bytes(path: &Path, cap: u64, beyond: &str) -> Result<Vec<u8>, IoError> {
         ),
         Unread::TooBig(_) => read_err(path, format!("more than {cap} bytes: {beyond}")),
     })
-}
-
-/// Reads `path` up to `cap` + 1 bytes: a longer file, or a stream that never ends, comes back
-/// one byte over `cap`, which tells the caller it is too long without reading the rest. Room
-/// for a regular file's bytes is reserved at once (out of memory is an error, not an abort).
-pub fn read_capped(path: &Path, cap: u64) -> std::io::Result<Vec<u8>> {
-    use std::io::Read;
-    let file = std::fs::File::open(path)?;
-    let want = file.metadata()?.len().min(cap.saturating_add(1));
-    let mut bytes = Vec::new();
-    bytes
-        .try_reserve_exact(usize::try_from(want).unwrap_or(usize::MAX))
-        .map_err(|_| {
-            std::io::Error::new(
-                std::io::ErrorKind::OutOfMemory,
-                format!("{want} bytes do not fit in memory"),
-            )
-        })?;
-    file.take(cap.saturating_add(1)).read_to_end(&mut bytes)?;
-    Ok(bytes)
 }
 
 /// An optional metadata field: `default` when absent (SigMF's), else `read` of it, or why not

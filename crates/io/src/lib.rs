@@ -7,22 +7,24 @@
 //! `numpy.fromfile(.., dtype="<f8")`).
 
 mod atomic;
+mod bounded_read;
 mod csv_table;
 mod dump;
 mod error;
 mod fast_text;
 mod json;
-mod own_file;
 mod recorder;
 mod sigmf;
 mod wav;
 
 pub use atomic::{remove_temporaries, write_atomic, write_atomic_via};
+pub use bounded_read::{
+    read_capped, read_own_text, MAX_LOCK_BYTES, MAX_MANIFEST_BYTES, MAX_RECORD_BYTES,
+};
 pub use csv_table::{format_f64, write_csv, CsvCell, CsvTable};
-pub use dump::{dump_source, read_capped, read_csv_dump, read_dump, read_sigmf, Dump, DumpSource};
+pub use dump::{dump_source, read_csv_dump, read_dump, read_sigmf, Dump, DumpSource};
 pub use error::IoError;
 pub use json::write_json;
-pub use own_file::{read_own_text, MAX_LOCK_BYTES, MAX_MANIFEST_BYTES, MAX_RECORD_BYTES};
 pub use recorder::SignalRecorder;
 pub use sigmf::{
     write_sigmf, SigmfChannel, SigmfFiles, SigmfMeta, DEFAULT_HW, GYROEMU_EXTENSION_VERSION,

@@ -17,6 +17,36 @@ pub const MAX_RECORD_BYTES: u64 = 1 << 20;
 /// The largest folder lock read (a pid, a host and the command line).
 pub const MAX_LOCK_BYTES: u64 = 4 << 20;
 
+/// Reads `path` up to `cap` + 1 bytes: a longer file, or a stream that never ends, comes back
+/// one byte over `cap`, which tells the caller it is too long without reading the rest. Room
+/// for a regular file's bytes is reserved at once (out of memory is an error, not an abort).
+pub fn read_capped(path: &Path, cap: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let file = std::fs::File::open(path)?;
+    let want = file.metadata()?.len().min(cap.saturating_add(1));
+    let mut bytes = Vec::new();
+    bytes
+        .try_reserve_exact(usize::try_from(want).unwrap_or(usize::MAX))
+        .map_err(|_| {
+            std::io::Error::new(
+                std::io::ErrorKind::OutOfMemory,
+                format!("{want} bytes do not fit in memory"),
+            )
+        })?;
+    file.take(cap.saturating_add(1)).read_to_end(&mut bytes)?;
+    Ok(bytes)
+}
+
+#[cfg(unix)]
+fn is_fifo(t: &std::fs::FileType) -> bool {
+    std::os::unix::fs::FileTypeExt::is_fifo(t)
+}
+
+#[cfg(not(unix))]
+fn is_fifo(_: &std::fs::FileType) -> bool {
+    false
+}
+
 /// Why [`read_bounded`] read nothing, or all it read.
 pub(crate) enum Unread {
     /// The file system's own error (a missing file keeps its `NotFound` kind).
@@ -34,7 +64,7 @@ pub(crate) enum Unread {
 /// unread; a FIFO's size is unknown until it ends, hence the cap on the bytes read too.
 pub(crate) fn read_bounded(path: &Path, cap: u64, fifo: bool) -> Result<Vec<u8>, Unread> {
     let meta = std::fs::metadata(path).map_err(Unread::Io)?;
-    if !(meta.is_file() || fifo && crate::dump::is_fifo(&meta.file_type())) {
+    if !(meta.is_file() || fifo && is_fifo(&meta.file_type())) {
         return Err(Unread::NotRegular {
             folder: meta.is_dir(),
         });
@@ -42,7 +72,7 @@ pub(crate) fn read_bounded(path: &Path, cap: u64, fifo: bool) -> Result<Vec<u8>,
     if meta.len() > cap {
         return Err(Unread::TooBig(Some(meta.len())));
     }
-    let bytes = crate::read_capped(path, cap).map_err(Unread::Io)?;
+    let bytes = read_capped(path, cap).map_err(Unread::Io)?;
     if bytes.len() as u64 > cap {
         return Err(Unread::TooBig(None));
     }
