@@ -327,14 +327,27 @@ impl<S: Sample> Board<S> {
         // In runs that the drawn-ahead normals cover: drawing more is a call, kept out of the
         // per-sample loop.
         while j0 < m {
-            let run = if noisy {
+            let mut run = if noisy {
                 self.noise.normals.ready(m - j0)
             } else {
                 m - j0
             };
+            // Nor do the oscillators' exact re-sets run inside it: with no call in the loop
+            // the compiler keeps the states in registers (on a CPU with half the 512-bit
+            // store rate, as Intel's, the spills bounded eight lanes).
+            run = run.min(u64::from(self.carrier.ready()));
+            if K == ROTATING {
+                run = run.min(u64::from(self.modulation.ready()));
+            }
+            if is_table(K) {
+                run = run.min(u64::from(match &mut self.table_lanes {
+                    Some(t) if K == RATE_TABLE_LANES => t.ready(),
+                    _ => self.table_nco.ready(),
+                }));
+            }
             let base = self.noise.normals.pos();
             for j in j0..j0 + run {
-                let (c_re, c_im) = self.carrier.tick(());
+                let (c_re, c_im) = self.carrier.tick_ready();
                 // The rotating drive uses only the in-phase carrier.
                 let cq = if K == ROTATING {
                     0.0
@@ -342,7 +355,7 @@ impl<S: Sample> Board<S> {
                     self.shifter.apply(Complex64::new(c_re, c_im)).re
                 };
                 let (mod_cos, mod_sin) = if K == ROTATING {
-                    self.modulation.tick(())
+                    self.modulation.tick_ready()
                 } else {
                     (zero, zero)
                 };
@@ -398,8 +411,8 @@ impl<S: Sample> Board<S> {
                     // The shared table is the cheaper in the loop; the lanes' only where
                     // they differ.
                     let sin_t = match &mut self.table_lanes {
-                        Some(t) if K == RATE_TABLE_LANES => t.tick(()).1,
-                        _ => S::splat(self.table_nco.tick(()).1),
+                        Some(t) if K == RATE_TABLE_LANES => t.tick_ready().1,
+                        _ => S::splat(self.table_nco.tick_ready().1),
                     };
                     let rate = self.rate * sin_t;
                     if DECOUPLED {
@@ -475,9 +488,14 @@ impl<S: Sample> Board<S> {
                     Some(lp) => lp.tick(zs),
                     None => self.lp.tick(zs),
                 };
-                out = ([Iq::new(i1, q1), Iq::new(i2, q2)], [mod_cos, mod_sin]);
+                let lp = [Iq::new(i1, q1), Iq::new(i2, q2)];
                 if let Some(pr) = probe.as_deref_mut() {
-                    pr.check_lowpass(n0 + j, &out.0);
+                    pr.check_lowpass(n0 + j, &lp);
+                }
+                // Only the block's last sample is the decimated output: kept on every sample,
+                // it cost six stores a sample (the loop holds no register for it).
+                if j + 1 == m {
+                    out = (lp, [mod_cos, mod_sin]);
                 }
             }
             if noisy {

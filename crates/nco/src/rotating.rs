@@ -95,6 +95,31 @@ impl<S: Sample> RotatingNco<S> {
         self.phase[lane].wrapping_sub(self.step[lane].wrapping_mul(u64::from(self.count)))
     }
 
+    /// The ticks left before the next exact re-set, at least 1: a re-set that is due runs
+    /// now. A loop that ticks at most this many times with [`RotatingNco::tick_ready`] has no
+    /// call in it, so the compiler may keep the whole chain's states in registers.
+    #[inline(always)]
+    pub fn ready(&mut self) -> u32 {
+        if self.count == 0 {
+            self.resync();
+        }
+        self.count
+    }
+
+    /// [`Stage::tick`] without the re-set's check: at most [`RotatingNco::ready`] times
+    /// after it (a wrapped count would skip the re-sets; the tick-against-stage test holds
+    /// both to the same bits).
+    #[inline(always)]
+    pub fn tick_ready(&mut self) -> (S, S) {
+        debug_assert!(self.count > 0, "tick_ready past the re-set");
+        let out = (self.re, self.im);
+        let re = self.re * self.rot_re - self.im * self.rot_im;
+        self.im = self.im * self.rot_re + self.re * self.rot_im;
+        self.re = re;
+        self.count -= 1;
+        out
+    }
+
     /// Sets the phasor exactly from the accumulator and advances the accumulator by one
     /// re-set interval. Out of line and cold: it runs once per 64 samples, and keeping it
     /// out of the sample loop leaves the loop's registers to the recursions.
@@ -138,15 +163,8 @@ impl<S: Sample> Stage for RotatingNco<S> {
     /// The phasor at the current sample, then one step of rotation.
     #[inline(always)]
     fn tick(&mut self, _: ()) -> (S, S) {
-        if self.count == 0 {
-            self.resync();
-        }
-        let out = (self.re, self.im);
-        let re = self.re * self.rot_re - self.im * self.rot_im;
-        self.im = self.im * self.rot_re + self.re * self.rot_im;
-        self.re = re;
-        self.count -= 1;
-        out
+        self.ready();
+        self.tick_ready()
     }
 
     fn reset(&mut self) {
