@@ -184,6 +184,37 @@ mod tests {
     use super::*;
 
     #[test]
+    fn runs_within_ready_give_the_ticks_bits() {
+        // Runs of every length up to past a re-set interval, cut short by `ready` as the
+        // board's block loop cuts them: the same bits as ticking one sample at a time.
+        let ncos: Vec<Nco> = [15_000.0, 0.0607, -12_345.678_9, 0.486]
+            .iter()
+            .map(|&f| Nco::new(f, 240_000.0, 0.3).unwrap())
+            .collect();
+        let mut by_tick = RotatingNco::<f64x4>::new(&ncos);
+        let mut by_run = by_tick.clone();
+        let (mut want, mut ticked) = (1u32, 0u64);
+        for _ in 0..400 {
+            let run = by_run.ready().min(want);
+            ticked += u64::from(run);
+            assert!(run >= 1);
+            for _ in 0..run {
+                let (a, b) = (by_tick.tick(()), by_run.tick_ready());
+                for l in 0..4 {
+                    assert_eq!(a.0.lane(l).to_bits(), b.0.lane(l).to_bits());
+                    assert_eq!(a.1.lane(l).to_bits(), b.1.lane(l).to_bits());
+                }
+            }
+            want = want % (RESYNC + 3) + 1;
+        }
+        // The runs crossed many re-sets, and the exact phase followed.
+        assert!(ticked > 100 * u64::from(RESYNC), "{ticked}");
+        let step = ncos[1].step_word();
+        let want_word = ncos[1].phase_word().wrapping_add(step.wrapping_mul(ticked));
+        assert_eq!(by_run.next_phase_word(1), want_word);
+    }
+
+    #[test]
     fn follows_the_exact_nco_within_1e_14_over_many_resyncs() {
         let fs = 240_000.0;
         let freqs = [15_000.0, 0.0607_f64, -12_345.678_9, 0.486];
