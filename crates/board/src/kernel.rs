@@ -18,6 +18,10 @@ use gyroemu_mixer::{
 };
 use std::sync::atomic::Ordering;
 
+/// The longest run of the block loop: the second pass's buffer ([`Board::block`]). The
+/// oscillators' re-sets cut runs at 64 samples already (`gyroemu_nco::RESYNC`).
+const RUN: usize = 64;
+
 /// Input samples between progress reports (and cancel checks).
 const REPORT_EVERY_IN: u64 = 65_536;
 
@@ -323,6 +327,13 @@ impl<S: Sample> Board<S> {
         };
         // The presets' low-pass (two biquads) runs the block with its states in registers.
         let mut pair = self.lp.hold_pair();
+        // In eight lanes with no probe, the pair runs as a second pass over each run's mixer
+        // outputs, its 16 states in registers: in one pass they did not fit beside the
+        // chain's, and their spills (16 stores a sample) bounded eight lanes where a 512-bit
+        // store takes two 256-bit slots (Intel's cores; the `lane_ceiling` example). Four
+        // lanes have 16 registers, too few for the pair alone: they keep one pass.
+        let two_pass = S::LANES == 8 && probe.is_none() && pair.is_some();
+        let mut zbuf = [[zero; 4]; RUN];
         let mut j0 = 0;
         // In runs that the drawn-ahead normals cover: drawing more is a call, kept out of the
         // per-sample loop.
@@ -345,6 +356,7 @@ impl<S: Sample> Board<S> {
                     _ => self.table_nco.ready(),
                 }));
             }
+            run = run.min(RUN as u64);
             let base = self.noise.normals.pos();
             for j in j0..j0 + run {
                 let (c_re, c_im) = self.carrier.tick_ready();
@@ -484,6 +496,13 @@ impl<S: Sample> Board<S> {
                     pr.record_full(n0 + j, &u, &p, &y, &z);
                 }
                 let zs = [z[0].i, z[0].q, z[1].i, z[1].q];
+                if two_pass {
+                    zbuf[(j - j0) as usize] = zs;
+                    if j + 1 == m {
+                        out.1 = [mod_cos, mod_sin];
+                    }
+                    continue;
+                }
                 let [i1, q1, i2, q2] = match &mut pair {
                     Some(lp) => lp.tick(zs),
                     None => self.lp.tick(zs),
@@ -496,6 +515,12 @@ impl<S: Sample> Board<S> {
                 // it cost six stores a sample (the loop holds no register for it).
                 if j + 1 == m {
                     out = (lp, [mod_cos, mod_sin]);
+                }
+            }
+            if let (true, Some(lp)) = (two_pass, &mut pair) {
+                for zs in &zbuf[..run as usize] {
+                    let [i1, q1, i2, q2] = lp.tick(*zs);
+                    out.0 = [Iq::new(i1, q1), Iq::new(i2, q2)];
                 }
             }
             if noisy {
