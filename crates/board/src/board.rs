@@ -159,6 +159,10 @@ fn check_starts(p: &BoardParams, starts: &[u64]) -> Result<(), ParamError> {
     Ok(())
 }
 
+/// The longest run of the block loop ([`Board::block`]'s second pass buffers one). The
+/// oscillators' re-sets cut runs at 64 samples already (`gyroemu_nco::RESYNC`).
+pub(crate) const RUN: usize = 64;
+
 /// Per-sample work shared by every lane; all fields are built before the first sample.
 #[derive(Clone)]
 pub struct Board<S: Sample> {
@@ -184,6 +188,9 @@ pub struct Board<S: Sample> {
     pub(crate) mix1_same_ref: bool,
     /// Stage-1 low-pass of I1, Q1, I2, Q2 (one design).
     pub(crate) lp: LowPassBank<S, 4>,
+    /// A run's mixer outputs, for the eight-lane low-pass pass (`Board::block`): a field, so
+    /// the block does not clear a buffer each time (16 KB in eight lanes).
+    pub(crate) lp_run: [[S; 4]; RUN],
     pub(crate) decimation: usize,
     pub(crate) mix2: Stage2Mixer<S>,
     /// Demodulation at the table harmonics (rate-table runs).
@@ -340,6 +347,7 @@ impl<S: Sample> Board<S> {
             mix1_same_ref: mix1[0].ref_phase_rad() == mix1[1].ref_phase_rad(),
             mix1,
             lp: LowPassBank::new(&build_lowpass(p)?),
+            lp_run: [[S::splat(0.0); 4]; RUN],
             decimation: p.decimation,
             mix2: Stage2Mixer::default(),
             table_mix: TableMixer::new(table_harmonics(p))?,

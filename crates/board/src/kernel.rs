@@ -1,8 +1,9 @@
-//! The fused sample loop: every stage on every input sample with no buffers in between, one
-//! monomorphised loop per experiment shape, noise shape and plant step. Its results equal the
+//! The fused sample loop: every stage on every input sample with no buffers in between (but
+//! the eight-lane low-pass pass, [`Board::block`]), one monomorphised loop per experiment
+//! shape, noise shape and plant step. Its results equal the
 //! reference board's (`reference.rs`, plain `Stage::tick` calls) bit for bit.
 
-use crate::board::{is_table, Board, CORIOLIS, RATE_TABLE, RATE_TABLE_LANES, ROTATING};
+use crate::board::{is_table, Board, CORIOLIS, RATE_TABLE, RATE_TABLE_LANES, ROTATING, RUN};
 use crate::fault::NonFinite;
 use crate::flicker::{turn, BlockFlicker};
 use crate::health::{Counters, Health, ADC_CLIP, ADC_ZERO, DAC_CLIP, DAC_ZERO, TIA_RAIL};
@@ -17,10 +18,6 @@ use gyroemu_mixer::{
     TABLE_HARMONICS,
 };
 use std::sync::atomic::Ordering;
-
-/// The longest run of the block loop: the second pass's buffer ([`Board::block`]). The
-/// oscillators' re-sets cut runs at 64 samples already (`gyroemu_nco::RESYNC`).
-const RUN: usize = 64;
 
 /// Input samples between progress reports (and cancel checks).
 const REPORT_EVERY_IN: u64 = 65_536;
@@ -299,8 +296,9 @@ impl<S: Sample> Board<S> {
     }
 
     /// One decimation block of input samples `n0 .. n0 + M` through the whole chain, fused
-    /// (every stage on every sample, no buffers: a two-pass variant through an L1 buffer
-    /// measured slower). Returns the low-passed stage-1 outputs at the block's last sample
+    /// (every stage on every sample; a two-pass variant of the whole chain through an L1
+    /// buffer measured slower), in runs of at most [`RUN`] samples with no call inside. In
+    /// eight lanes the presets' low-pass pair runs as each run's second pass. Returns the low-passed stage-1 outputs at the block's last sample
     /// (the decimated output) and the modulation references (cos, sin of Omega t) at that
     /// same sample.
     #[inline(always)]
@@ -333,7 +331,6 @@ impl<S: Sample> Board<S> {
         // store takes two 256-bit slots (Intel's cores; the `lane_ceiling` example). Four
         // lanes have 16 registers, too few for the pair alone: they keep one pass.
         let two_pass = S::LANES == 8 && probe.is_none() && pair.is_some();
-        let mut zbuf = [[zero; 4]; RUN];
         let mut j0 = 0;
         // In runs that the drawn-ahead normals cover: drawing more is a call, kept out of the
         // per-sample loop.
@@ -497,7 +494,7 @@ impl<S: Sample> Board<S> {
                 }
                 let zs = [z[0].i, z[0].q, z[1].i, z[1].q];
                 if two_pass {
-                    zbuf[(j - j0) as usize] = zs;
+                    self.lp_run[(j - j0) as usize] = zs;
                     if j + 1 == m {
                         out.1 = [mod_cos, mod_sin];
                     }
@@ -518,7 +515,7 @@ impl<S: Sample> Board<S> {
                 }
             }
             if let (true, Some(lp)) = (two_pass, &mut pair) {
-                for zs in &zbuf[..run as usize] {
+                for zs in &self.lp_run[..run as usize] {
                     let [i1, q1, i2, q2] = lp.tick(*zs);
                     out.0 = [Iq::new(i1, q1), Iq::new(i2, q2)];
                 }
