@@ -1,7 +1,7 @@
 //! The fused sample loop: every stage on every input sample with no buffers in between (but
 //! the eight-lane low-pass pass, [`Board::block`]), one monomorphised loop per experiment
-//! shape, noise shape and plant step. Its results equal the
-//! reference board's (`reference.rs`, plain `Stage::tick` calls) bit for bit.
+//! shape, noise shape and plant step. Its results equal the reference board's
+//! (`reference.rs`, plain `Stage::tick` calls) bit for bit.
 
 use crate::board::{is_table, Board, CORIOLIS, RATE_TABLE, RATE_TABLE_LANES, ROTATING, RUN};
 use crate::fault::NonFinite;
@@ -298,9 +298,9 @@ impl<S: Sample> Board<S> {
     /// One decimation block of input samples `n0 .. n0 + M` through the whole chain, fused
     /// (every stage on every sample; a two-pass variant of the whole chain through an L1
     /// buffer measured slower), in runs of at most [`RUN`] samples with no call inside. In
-    /// eight lanes the presets' low-pass pair runs as each run's second pass. Returns the low-passed stage-1 outputs at the block's last sample
-    /// (the decimated output) and the modulation references (cos, sin of Omega t) at that
-    /// same sample.
+    /// eight lanes the presets' low-pass pair runs as each run's second pass. Returns the
+    /// low-passed stage-1 outputs at the block's last sample (the decimated output) and the
+    /// modulation references (cos, sin of Omega t) at that same sample.
     #[inline(always)]
     pub(crate) fn block<const K: u8, const NOISY: bool, const DECOUPLED: bool>(
         &mut self,
