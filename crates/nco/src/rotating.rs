@@ -97,7 +97,7 @@ impl<S: Sample> RotatingNco<S> {
 
     /// The ticks left before the next exact re-set, at least 1: a re-set that is due runs
     /// now. A loop that ticks at most this many times with [`RotatingNco::tick_ready`] has no
-    /// call in it, so the compiler may keep the whole chain's states in registers.
+    /// call in it, so the compiler may keep the loop's states in registers.
     #[inline(always)]
     pub fn ready(&mut self) -> u32 {
         if self.count == 0 {
@@ -107,8 +107,8 @@ impl<S: Sample> RotatingNco<S> {
     }
 
     /// [`Stage::tick`] without the re-set's check: at most [`RotatingNco::ready`] times
-    /// after it (a wrapped count would skip the re-sets; the tick-against-stage test holds
-    /// both to the same bits).
+    /// after it (a wrapped count would skip the re-sets; the test
+    /// `runs_within_ready_give_the_ticks_bits` holds both to the same bits).
     #[inline(always)]
     pub fn tick_ready(&mut self) -> (S, S) {
         debug_assert!(self.count > 0, "tick_ready past the re-set");
