@@ -81,15 +81,37 @@ fn lane_draw(s: &mut [u64x4; 4], lane: usize) -> u64 {
     w.as_array()[lane]
 }
 
+/// How the AVX-512F fast path fetches its eight table entries: the same entries, so the same
+/// bits, either way; a speed choice ([`Lookup::this_cpu`]). Without AVX-512F it is ignored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lookup {
+    /// Eight 128-bit loads, assembled by shuffles.
+    Loads,
+    /// Two 512-bit gathers (widths, then bounds).
+    Gather,
+}
+
+impl Lookup {
+    /// The faster on this CPU: gathers on an Intel core with AVX512-FP16 (Sapphire Rapids and
+    /// later), else loads (`gauss_avx512::gathers_fast` gives the measurements).
+    pub fn this_cpu() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        if crate::gauss_avx512::gathers_fast() {
+            return Self::Gather;
+        }
+        Self::Loads
+    }
+}
+
 /// Fills `out` (of even length) with the next normals of stream a and stream b of four
 /// lanes in turn, with AVX-512F when the CPU has it (the same bits).
 #[inline]
-pub(crate) fn fill_one(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
+pub(crate) fn fill_one(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4], lookup: Lookup) {
     assert!(out.len().is_multiple_of(2), "normals come in pairs");
     #[cfg(target_arch = "x86_64")]
     if crate::gauss_avx512::available() {
         // SAFETY: the CPU has AVX-512F (checked just above).
-        unsafe { crate::gauss_avx512::fill_one(s, out) };
+        unsafe { crate::gauss_avx512::fill_one(s, out, lookup) };
         return;
     }
     fill_one_portable(s, out);
@@ -109,12 +131,12 @@ pub(crate) fn fill_one_portable(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
 /// `s[0][0], s[0][1], s[1][0], s[1][1]` in turn (stream a of lanes 0-3 and 4-7, then stream
 /// b of lanes 0-3 and 4-7: rows of eight lanes), with AVX-512F when the CPU has it.
 #[inline]
-pub(crate) fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4]) {
+pub(crate) fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4], lookup: Lookup) {
     assert!(out.len().is_multiple_of(4), "whole rows of eight lanes");
     #[cfg(target_arch = "x86_64")]
     if crate::gauss_avx512::available() {
         // SAFETY: the CPU has AVX-512F (checked just above).
-        unsafe { crate::gauss_avx512::fill_two(s, out) };
+        unsafe { crate::gauss_avx512::fill_two(s, out, lookup) };
         return;
     }
     fill_two_portable(s, out);
@@ -144,7 +166,7 @@ impl NoiseRng {
     /// Fills `out` (of even length) with the next pairs: `out[2k]` and `out[2k + 1]` are what
     /// the k-th call of [`NoiseRng::normal_pair`] gives (the same bits).
     pub fn fill_pairs(&mut self, out: &mut [f64x4]) {
-        fill_one(&mut self.s, out);
+        fill_one(&mut self.s, out, Lookup::this_cpu());
     }
 }
 
@@ -160,6 +182,8 @@ pub struct NormalBlock {
     s: [[[u64x4; 4]; 2]; 2],
     /// Lanes per row: 4 or 8.
     width: usize,
+    /// How the AVX-512F fill looks its table up.
+    lookup: Lookup,
     buf: Box<Rows>,
     /// The next unread row (`LEN`: all read).
     pos: usize,
@@ -191,6 +215,7 @@ impl NormalBlock {
         Self {
             s,
             width,
+            lookup: Lookup::this_cpu(),
             buf: Box::new(Rows([f64x4::ZERO; 2 * Self::LEN])),
             pos: Self::LEN,
         }
@@ -199,6 +224,13 @@ impl NormalBlock {
     /// Lanes per row (4 or 8).
     pub fn width(&self) -> usize {
         self.width
+    }
+
+    /// The block with its further draws looked up by `lookup` in place of this CPU's choice
+    /// ([`Lookup::this_cpu`]): the same normals, for benchmarks and tests.
+    pub fn with_lookup(mut self, lookup: Lookup) -> Self {
+        self.lookup = lookup;
+        self
     }
 
     /// Makes the normals of up to `samples` samples (four rows each) ready, drawing more if
@@ -239,9 +271,9 @@ impl NormalBlock {
     fn refill(&mut self) {
         let rows = &mut self.buf.0[..Self::LEN * self.width / 4];
         if self.width == 8 {
-            fill_two(&mut self.s, rows);
+            fill_two(&mut self.s, rows, self.lookup);
         } else {
-            fill_one(&mut self.s[0], rows);
+            fill_one(&mut self.s[0], rows, self.lookup);
         }
         self.pos = 0;
     }

@@ -5,7 +5,12 @@
 //! subtraction and one rounded product per normal, exact comparisons), and draws that miss
 //! their piece's core finish in the portable code's scalar ziggurat, each lane's further
 //! draws stepped in the register, so the bits are the same on either path (tested).
+//!
+//! The eight pieces' table entries come in one of two ways ([`Lookup`]), the same entries
+//! either way: eight 128-bit loads assembled by shuffles, or two 512-bit gathers where the CPU
+//! runs gathers fast.
 
+use crate::gauss::Lookup;
 use crate::gauss_scalar::{lane_normal, ONE_BITS, SIGN_BIT, SIGN_SHIFT};
 use crate::gauss_tables::{FAST, N};
 use core::arch::x86_64::*;
@@ -15,6 +20,22 @@ use wide::{f64x4, u64x4};
 #[inline]
 pub(crate) fn available() -> bool {
     std::arch::is_x86_feature_detected!("avx512f")
+}
+
+/// Gathers are the faster look-up on this CPU: an Intel core with AVX512-FP16 (Sapphire
+/// Rapids and later). Measured on a Sapphire Rapids-class Xeon, eight-lane blocks: 1.87
+/// against 1.54 G normals/s (docs/performance.md, thirty-second session). Elsewhere the loads:
+/// on AMD Zen 4 and Zen 5 a 512-bit gather measured 1.65 to 2.2 times slower, and Intel's
+/// earlier AVX-512 cores (Skylake-SP to Ice Lake) run gathers under the microcode mitigation
+/// of Gather Data Sampling, which slows them severalfold; FP16 arrived after them.
+pub(crate) fn gathers_fast() -> bool {
+    static FAST: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *FAST.get_or_init(|| {
+        // Leaf 0 exists on every x86-64 CPU: "GenuineIntel" in EBX, EDX, ECX.
+        let v = core::arch::x86_64::__cpuid(0);
+        let intel = (v.ebx, v.edx, v.ecx) == (0x756e_6547, 0x4965_6e69, 0x6c65_746e);
+        available() && intel && std::arch::is_x86_feature_detected!("avx512fp16")
+    })
 }
 
 /// Stream a of the four lanes in the low half, stream b in the high half.
@@ -38,6 +59,22 @@ fn halves(v: __m512i) -> [u64x4; 2] {
 
 // A piece's byte offset in the table fits the 16-bit words [`draw`] moves it in.
 const _: () = assert!(16 * N <= 1 << 16);
+
+/// [`FAST`] as two tables, widths and bounds, for the gathers (a gather's scale is at most
+/// 8 bytes, so the index is the piece itself). Built from `FAST` at compile time: the same
+/// entries.
+#[repr(C, align(64))]
+struct Split([f64; N], [f64; N]);
+
+static SPLIT: Split = {
+    let (mut width, mut bound) = ([0.0; N], [0.0; N]);
+    let mut i = 0;
+    while i < N {
+        [width[i], bound[i]] = FAST.0[i];
+        i += 1;
+    }
+    Split(width, bound)
+};
 
 /// The constants of [`draw`].
 #[derive(Clone, Copy)]
@@ -75,15 +112,11 @@ fn step(st: [__m512i; 4]) -> (__m512i, [__m512i; 4]) {
     (w, [s0, s1, s2, s3])
 }
 
-/// The next normal of the eight streams in `st` (two sets of four joined) into `pair` (two
-/// f64x4: the low set's lanes, then the high set's); returns the streams' new state. By value
-/// in and out, so the caller's state stays in registers.
+/// The eight pieces' widths and bounds of draws `w` by loads: each entry's 16 bytes, then
+/// shuffles into two registers.
 #[inline]
 #[target_feature(enable = "avx512f")]
-fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
-    // Taken apart and rebuilt below: with the array passed on whole, LLVM kept the state in
-    // memory on the common path (a fifth slower).
-    let (w, [s0, s1, s2, s3]) = step(st);
+fn pieces(w: __m512i, k: Consts) -> (__m512d, __m512d) {
     // Each stream's piece: the byte offset of its [width, bound] pair, as eight 16-bit words
     // in one register, then in two general registers. A store and eight reloads instead
     // (the look-ups then wait on store-to-load forwarding) gave 7 % fewer normals per second.
@@ -103,6 +136,31 @@ fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
     let odd = _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(lo(1, 3)), lo(5, 7));
     let width = _mm512_unpacklo_pd(even, odd);
     let bound = _mm512_unpackhi_pd(even, odd);
+    (width, bound)
+}
+
+/// The next normal of the eight streams in `st` (two sets of four joined) into `pair` (two
+/// f64x4: the low set's lanes, then the high set's), the pieces looked up by gathers if
+/// `GATHER`, else by loads; returns the streams' new state. By value
+/// in and out, so the caller's state stays in registers.
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn draw<const GATHER: bool>(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
+    // Taken apart and rebuilt below: with the array passed on whole, LLVM kept the state in
+    // memory on the common path (a fifth slower).
+    let (w, [s0, s1, s2, s3]) = step(st);
+    let (width, bound) = if GATHER {
+        let piece = _mm512_and_si512(w, k.index);
+        // SAFETY: every index is below N (the mask), inside both tables.
+        unsafe {
+            (
+                _mm512_i64gather_pd::<8>(piece, SPLIT.0.as_ptr().cast()),
+                _mm512_i64gather_pd::<8>(piece, SPLIT.1.as_ptr().cast()),
+            )
+        }
+    } else {
+        pieces(w, k)
+    };
     let b = _mm512_castsi512_pd(_mm512_or_si512(_mm512_srli_epi64::<12>(w), k.one));
     let sign = _mm512_sll_epi64(
         _mm512_and_si512(w, k.sign_bit),
@@ -130,11 +188,20 @@ fn draw(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
 /// # Safety
 /// The CPU must have AVX-512F.
 #[target_feature(enable = "avx512f")]
-pub(crate) unsafe fn fill_one(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
+pub(crate) unsafe fn fill_one(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4], lookup: Lookup) {
+    match lookup {
+        Lookup::Gather => fill_one_by::<true>(s, out),
+        Lookup::Loads => fill_one_by::<false>(s, out),
+    }
+}
+
+/// [`fill_one`] with the pieces looked up by gathers if `GATHER`.
+#[target_feature(enable = "avx512f")]
+fn fill_one_by<const GATHER: bool>(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
     let mut st: [__m512i; 4] = core::array::from_fn(|w| join(s[0][w], s[1][w]));
     let k = Consts::new();
     for pair in out.chunks_exact_mut(2) {
-        st = draw(st, pair, k);
+        st = draw::<GATHER>(st, pair, k);
     }
     for (w, v) in st.iter().enumerate() {
         [s[0][w], s[1][w]] = halves(*v);
@@ -147,14 +214,23 @@ pub(crate) unsafe fn fill_one(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
 /// # Safety
 /// The CPU must have AVX-512F.
 #[target_feature(enable = "avx512f")]
-pub(crate) unsafe fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4]) {
+pub(crate) unsafe fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4], lookup: Lookup) {
+    match lookup {
+        Lookup::Gather => fill_two_by::<true>(s, out),
+        Lookup::Loads => fill_two_by::<false>(s, out),
+    }
+}
+
+/// [`fill_two`] with the pieces looked up by gathers if `GATHER`.
+#[target_feature(enable = "avx512f")]
+fn fill_two_by<const GATHER: bool>(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4]) {
     let [mut sa, mut sb]: [[__m512i; 4]; 2] =
         core::array::from_fn(|j| core::array::from_fn(|w| join(s[j][0][w], s[j][1][w])));
     let k = Consts::new();
     for round in out.chunks_exact_mut(4) {
         let (a, b) = round.split_at_mut(2);
-        sa = draw(sa, a, k);
-        sb = draw(sb, b, k);
+        sa = draw::<GATHER>(sa, a, k);
+        sb = draw::<GATHER>(sb, b, k);
     }
     for (j, st) in [sa, sb].iter().enumerate() {
         for (w, v) in st.iter().enumerate() {

@@ -172,20 +172,22 @@ fn the_avx512_path_gives_the_portable_bits() {
             v.iter().map(|x| x.to_array().map(f64::to_bits)).collect()
         };
         let words = |s: &[[u64x4; 4]; 2]| s.map(|h| h.map(|w| w.to_array()));
-        let (mut a, mut b) = (sets(1), sets(1));
-        let (mut fa, mut fb) = (vec![f64x4::ZERO; 4096], vec![f64x4::ZERO; 4096]);
-        for _ in 0..64 {
-            // One register pair (stream a and b of four lanes), then two (eight lanes).
-            // SAFETY: AVX-512F checked above.
-            unsafe { crate::gauss_avx512::fill_one(&mut a[0], &mut fa) };
-            fill_one_portable(&mut b[0], &mut fb);
-            assert_eq!(bits(&fa), bits(&fb));
-            assert_eq!(words(&a[0]), words(&b[0]));
-            // SAFETY: as above.
-            unsafe { crate::gauss_avx512::fill_two(&mut a, &mut fa) };
-            fill_two_portable(&mut b, &mut fb);
-            assert_eq!(bits(&fa), bits(&fb));
-            assert_eq!(a.map(|s| words(&s)), b.map(|s| words(&s)));
+        for lookup in [Lookup::Loads, Lookup::Gather] {
+            let (mut a, mut b) = (sets(1), sets(1));
+            let (mut fa, mut fb) = (vec![f64x4::ZERO; 4096], vec![f64x4::ZERO; 4096]);
+            for _ in 0..64 {
+                // One register pair (stream a and b of four lanes), then two (eight lanes).
+                // SAFETY: AVX-512F checked above.
+                unsafe { crate::gauss_avx512::fill_one(&mut a[0], &mut fa, lookup) };
+                fill_one_portable(&mut b[0], &mut fb);
+                assert_eq!(bits(&fa), bits(&fb), "{lookup:?}");
+                assert_eq!(words(&a[0]), words(&b[0]), "{lookup:?}");
+                // SAFETY: as above.
+                unsafe { crate::gauss_avx512::fill_two(&mut a, &mut fa, lookup) };
+                fill_two_portable(&mut b, &mut fb);
+                assert_eq!(bits(&fa), bits(&fb), "{lookup:?}");
+                assert_eq!(a.map(|s| words(&s)), b.map(|s| words(&s)), "{lookup:?}");
+            }
         }
         return;
     }
@@ -226,8 +228,10 @@ fn blocks_pairs_and_fills_give_one_sequence() {
 fn a_wide_block_gives_each_lane_the_rows_of_a_four_lane_block() {
     let seeds: [u64; 8] = [5, 6, 7, 8, 9, 10, 0xFFFF, 3];
     let quad = |q: usize| NoiseRng::new(core::array::from_fn(|l| seeds[4 * q + l]));
-    let mut wide = NormalBlock::wide(quad(0), quad(1));
-    let mut four = [NormalBlock::new(quad(0)), NormalBlock::new(quad(1))];
+    // Each look-up on one side (the same entries either way, so the same normals).
+    let mut wide = NormalBlock::wide(quad(0), quad(1)).with_lookup(Lookup::Gather);
+    let four = |q| NormalBlock::new(quad(q)).with_lookup(Lookup::Loads);
+    let mut four = [four(0), four(1)];
     assert_eq!(wide.width(), 8);
     // 20 000 samples: many refills, and every lane through wedges and tails.
     for _ in 0..20_000 {
