@@ -188,9 +188,6 @@ pub struct Board<S: Sample> {
     pub(crate) mix1_same_ref: bool,
     /// Stage-1 low-pass of I1, Q1, I2, Q2 (one design).
     pub(crate) lp: LowPassBank<S, 4>,
-    /// A run's mixer outputs, for the eight-lane low-pass pass (`Board::block`): a field, so
-    /// the block does not clear a buffer each time (16 KB in eight lanes).
-    pub(crate) lp_run: [[S; 4]; RUN],
     pub(crate) decimation: usize,
     pub(crate) mix2: Stage2Mixer<S>,
     /// Demodulation at the table harmonics (rate-table runs).
@@ -347,7 +344,6 @@ impl<S: Sample> Board<S> {
             mix1_same_ref: mix1[0].ref_phase_rad() == mix1[1].ref_phase_rad(),
             mix1,
             lp: LowPassBank::new(&build_lowpass(p)?),
-            lp_run: [[S::splat(0.0); 4]; RUN],
             decimation: p.decimation,
             mix2: Stage2Mixer::default(),
             table_mix: TableMixer::new(table_harmonics(p))?,
