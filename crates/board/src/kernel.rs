@@ -359,6 +359,10 @@ impl<S: Sample> Board<S> {
                     _ => self.table_nco.ready(),
                 }));
             }
+            // Nor does the TIA flicker's next chunk run inside it.
+            if let (Some(f), true) = (&mut self.flicker, fb.is_some()) {
+                run = run.min(f.tia_ready());
+            }
             run = run.min(RUN as u64);
             let base = self.noise.normals.pos();
             for j in j0..j0 + run {
@@ -447,7 +451,7 @@ impl<S: Sample> Board<S> {
                 }
                 if let (Some(f), true) = (&mut self.flicker, fb.is_some()) {
                     // The TIA voltage noise's flicker, referred to the input likewise.
-                    let t = f.tia_current();
+                    let t = f.tia_current_ready();
                     p.current[0] += t[0];
                     p.current[1] += t[1];
                 }

@@ -213,6 +213,39 @@ impl<S: Sample> FlickerSources<S> {
         self.tia_block.as_ref().is_some_and(TiaBlock::joined)
     }
 
+    /// Makes the TIA flicker of up to the rest of the chunk ready (running the block's next
+    /// chunk if the last is used up) and returns how many samples it covers: a loop then
+    /// reads them with [`FlickerSources::tia_current_ready`], with no call per sample.
+    /// `u64::MAX` when the board has no TIA source or draws it per sample (`per_sample`).
+    /// Call only within a decimation block (after `next_block`, before its last sample).
+    #[inline(always)]
+    pub(crate) fn tia_ready(&mut self) -> u64 {
+        if let (Some(b), [Some(f0), Some(f1)]) = (&mut self.tia_block, &mut self.tia) {
+            if b.pos == b.len {
+                b.refill(&mut self.rng, [f0, f1]);
+            }
+            return (b.len - b.pos) as u64;
+        }
+        u64::MAX
+    }
+
+    /// [`FlickerSources::tia_current`] within what [`FlickerSources::tia_ready`] made ready:
+    /// the same values, with no refill (a call) in the loop that reads them. Zero without
+    /// TIA sources; a board that draws them per sample must use `tia_current`.
+    #[inline(always)]
+    pub(crate) fn tia_current_ready(&mut self) -> [S; 2] {
+        debug_assert!(self.tia[0].is_none() || self.tia_block.is_some());
+        match &mut self.tia_block {
+            Some(b) => {
+                debug_assert!(b.pos < b.len, "read past what tia_ready made ready");
+                let i = b.pos;
+                b.pos += 1;
+                b.at(i)
+            }
+            None => [S::splat(0.0); 2],
+        }
+    }
+
     /// This sample's flicker of the TIA's input-referred current, per mode (A).
     #[inline(always)]
     pub(crate) fn tia_current(&mut self) -> [S; 2] {
