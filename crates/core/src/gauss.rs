@@ -111,7 +111,7 @@ pub(crate) fn fill_one(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4], lookup: Looku
     #[cfg(target_arch = "x86_64")]
     if crate::gauss_avx512::available() {
         // SAFETY: the CPU has AVX-512F (checked just above).
-        unsafe { crate::gauss_avx512::fill_one(s, out, lookup) };
+        unsafe { crate::gauss_avx512::fill_one(s, out, lookup == Lookup::Gather) };
         return;
     }
     fill_one_portable(s, out);
@@ -136,7 +136,7 @@ pub(crate) fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4], lookup: 
     #[cfg(target_arch = "x86_64")]
     if crate::gauss_avx512::available() {
         // SAFETY: the CPU has AVX-512F (checked just above).
-        unsafe { crate::gauss_avx512::fill_two(s, out, lookup) };
+        unsafe { crate::gauss_avx512::fill_two(s, out, lookup == Lookup::Gather) };
         return;
     }
     fill_two_portable(s, out);

@@ -6,11 +6,10 @@
 //! their piece's core finish in the portable code's scalar ziggurat, each lane's further
 //! draws stepped in the register, so the bits are the same on either path (tested).
 //!
-//! The eight pieces' table entries come in one of two ways ([`Lookup`]), the same entries
-//! either way: eight 128-bit loads assembled by shuffles, or two 512-bit gathers where the CPU
+//! The eight pieces' table entries come in one of two ways (`gauss::Lookup`; `gather` here),
+//! the same entries either way: eight 128-bit loads assembled by shuffles, or two 512-bit gathers where the CPU
 //! runs gathers fast.
 
-use crate::gauss::Lookup;
 use crate::gauss_scalar::{lane_normal, ONE_BITS, SIGN_BIT, SIGN_SHIFT};
 use crate::gauss_tables::{FAST, N};
 use core::arch::x86_64::*;
@@ -188,10 +187,11 @@ fn draw<const GATHER: bool>(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> 
 /// # Safety
 /// The CPU must have AVX-512F.
 #[target_feature(enable = "avx512f")]
-pub(crate) unsafe fn fill_one(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4], lookup: Lookup) {
-    match lookup {
-        Lookup::Gather => fill_one_by::<true>(s, out),
-        Lookup::Loads => fill_one_by::<false>(s, out),
+pub(crate) unsafe fn fill_one(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4], gather: bool) {
+    if gather {
+        fill_one_by::<true>(s, out)
+    } else {
+        fill_one_by::<false>(s, out)
     }
 }
 
@@ -214,10 +214,11 @@ fn fill_one_by<const GATHER: bool>(s: &mut [[u64x4; 4]; 2], out: &mut [f64x4]) {
 /// # Safety
 /// The CPU must have AVX-512F.
 #[target_feature(enable = "avx512f")]
-pub(crate) unsafe fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4], lookup: Lookup) {
-    match lookup {
-        Lookup::Gather => fill_two_by::<true>(s, out),
-        Lookup::Loads => fill_two_by::<false>(s, out),
+pub(crate) unsafe fn fill_two(s: &mut [[[u64x4; 4]; 2]; 2], out: &mut [f64x4], gather: bool) {
+    if gather {
+        fill_two_by::<true>(s, out)
+    } else {
+        fill_two_by::<false>(s, out)
     }
 }
 
