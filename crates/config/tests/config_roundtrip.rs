@@ -164,7 +164,10 @@ fn build(d: DeviceDraw, b: BoardDraw, e: ExperimentDraw) -> Config {
             // |rate|/360 below the cutoff.
             x.rates_dps = rates.iter().map(|r| r * 360.0 * cutoff).collect();
             let slowest = x.rates_dps.iter().map(|r| r.abs()).fold(f64::MAX, f64::min);
-            x.average_s = avg_mult * (180.0 / slowest).max(out_period);
+            // At least four output samples: a window of one keeps all of the 2 Omega term,
+            // and the sidebands cannot be told apart (refused: a Hann window of 1.76 output
+            // periods, one sample, was drawn at 209785 deg/s).
+            x.average_s = avg_mult * (180.0 / slowest).max(4.0 * out_period);
         }
     }
     c.noise = noise.then_some(NoiseConfig {
