@@ -7,8 +7,8 @@
 //! draws stepped in the register, so the bits are the same on either path (tested).
 //!
 //! The eight pieces' table entries come in one of two ways (`gauss::Lookup`; `gather` here),
-//! the same entries either way: eight 128-bit loads assembled by shuffles, or two 512-bit gathers where the CPU
-//! runs gathers fast.
+//! the same entries either way: eight 128-bit loads assembled by shuffles, or two 512-bit
+//! gathers where the CPU runs gathers fast.
 
 use crate::gauss_scalar::{lane_normal, ONE_BITS, SIGN_BIT, SIGN_SHIFT};
 use crate::gauss_tables::{FAST, N};
@@ -22,8 +22,8 @@ pub(crate) fn available() -> bool {
 }
 
 /// Gathers are the faster look-up on this CPU: an Intel core with AVX512-FP16 (Sapphire
-/// Rapids and later). Measured on a Sapphire Rapids-class Xeon, eight-lane blocks: 1.87
-/// against 1.54 G normals/s (docs/performance.md, thirty-second session). Elsewhere the loads:
+/// Rapids and later). Measured on a Sapphire Rapids-class Xeon, eight-lane blocks: 1.85
+/// against 1.57 G normals/s (docs/performance.md, thirty-second session). Elsewhere the loads:
 /// on AMD Zen 4 and Zen 5 a 512-bit gather measured 1.65 to 2.2 times slower, and Intel's
 /// earlier AVX-512 cores (Skylake-SP to Ice Lake) run gathers under the microcode mitigation
 /// of Gather Data Sampling, which slows them severalfold; FP16 arrived after them.
@@ -140,8 +140,8 @@ fn pieces(w: __m512i, k: Consts) -> (__m512d, __m512d) {
 
 /// The next normal of the eight streams in `st` (two sets of four joined) into `pair` (two
 /// f64x4: the low set's lanes, then the high set's), the pieces looked up by gathers if
-/// `GATHER`, else by loads; returns the streams' new state. By value
-/// in and out, so the caller's state stays in registers.
+/// `GATHER`, else by loads; returns the streams' new state. By value in and out, so the
+/// caller's state stays in registers.
 #[inline]
 #[target_feature(enable = "avx512f")]
 fn draw<const GATHER: bool>(st: [__m512i; 4], pair: &mut [f64x4], k: Consts) -> [__m512i; 4] {
