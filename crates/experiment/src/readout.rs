@@ -9,6 +9,7 @@ use gyroemu_board::{
 };
 use gyroemu_config::Config;
 use gyroemu_core::{Complex64, ParamError};
+use gyroemu_lpf::Window;
 use gyroemu_mixer::{
     paper_i_channel_psi_rad, phase_fundamental_checked, phase_lag_rad, sideband_estimate, wrap_pi,
     Mode, NoFundamental, MAX_TABLE_HARMONIC,
@@ -317,22 +318,21 @@ fn small_rate_slope(cfg: &Config) -> [f64; 2] {
 /// phase cannot be resolved: NaN, and not an overflow). The phase's fundamental is taken on a
 /// grid as fine as its phase needs, as the theory's is (on 1024 points a dip's phase aliased:
 /// 12 mdeg off the theory, unwarned).
+/// `leak`: the window's [`ChainResponse::table_leak`] for `n` harmonics.
 fn table_phase_readout(
     chain: &ChainResponse,
     lr: &LaneResult,
-    point: &Point,
-    n_settle: u64,
+    leak: &[Complex64],
     n: usize,
     phase_deg: &mut [f64; 2],
 ) -> ([f64; 2], [Option<NoFundamental>; 2]) {
     let ft = chain.table_hz();
     let fc = chain.carrier_hz();
-    let leak = chain.table_leak(point, n_settle, n);
     let mut lag = [0.0; 2];
     let mut wound = [None; 2];
     for k in 0..2 {
         let avg = &lr.table_z[k][MAX_TABLE_HARMONIC - n..=MAX_TABLE_HARMONIC + n];
-        let v: Vec<Complex64> = unleak_table_harmonics(avg, &leak)
+        let v: Vec<Complex64> = unleak_table_harmonics(avg, leak)
             .into_iter()
             .enumerate()
             .map(|(i, z)| {
@@ -388,6 +388,10 @@ pub fn post_process_with(
     let mut comp = Vec::new();
     let zero = rates.iter().position(|&r| r == 0.0);
     let averaged = |p: &Point| p.span_samples() / fs_out;
+    // A rate-table point's leak between table harmonics depends on its window alone, which
+    // a sweep's points share: computed once per window (it costs a sin_cos and 2N + 1
+    // complex products per averaged sample, 15 % of a long sweep's run when done per point).
+    let mut table_leaks: Vec<(Window, Vec<Complex64>)> = Vec::new();
     for (i, &rate) in rates.iter().enumerate() {
         if !cfg.experiment.rates_dps.contains(&rate) {
             continue; // the implicit zero-rate reference
@@ -431,11 +435,20 @@ pub fn post_process_with(
             }
             Shape::RateTable { .. } => {
                 r.table_lag_theory_deg = table_theory.map(|(_, lag)| lag.map(|l| l / DEG));
+                let window = points[i].window;
+                let at = match table_leaks.iter().position(|(w, _)| *w == window) {
+                    Some(at) => at,
+                    None => {
+                        let leak =
+                            chain.table_leak(&points[i], cfg.n_settle_out(), table_harmonics);
+                        table_leaks.push((window, leak));
+                        table_leaks.len() - 1
+                    }
+                };
                 let (lag, w) = table_phase_readout(
                     &chain,
                     lr,
-                    &points[i],
-                    cfg.n_settle_out(),
+                    &table_leaks[at].1,
                     table_harmonics,
                     &mut r.phase_deg,
                 );
