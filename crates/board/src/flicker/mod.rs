@@ -252,14 +252,10 @@ impl<S: Sample> FlickerSources<S> {
         if self.tia[0].is_none() {
             return [S::splat(0.0); 2];
         }
-        if let (Some(b), [Some(f0), Some(f1)]) = (&mut self.tia_block, &mut self.tia) {
-            // `next_block` ran the block's first chunk; the kernel takes exactly a block.
-            if b.pos == b.len {
-                b.refill(&mut self.rng, [f0, f1]);
-            }
-            let i = b.pos;
-            b.pos += 1;
-            return b.at(i);
+        if self.tia_block.is_some() {
+            // Drawn a chunk at a time: the kernel's pair, one sample at a time.
+            self.tia_ready();
+            return self.tia_current_ready();
         }
         let (w0, w1) = self.rng.pair::<S>();
         let mut out = [S::splat(0.0); 2];
