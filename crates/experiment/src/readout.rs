@@ -318,7 +318,8 @@ fn small_rate_slope(cfg: &Config) -> [f64; 2] {
 /// phase cannot be resolved: NaN, and not an overflow). The phase's fundamental is taken on a
 /// grid as fine as its phase needs, as the theory's is (on 1024 points a dip's phase aliased:
 /// 12 mdeg off the theory, unwarned).
-/// `leak`: the window's [`ChainResponse::table_leak`] for `n` harmonics.
+///
+/// `leak`: the point's window's [`ChainResponse::table_leak`] for `n` harmonics.
 fn table_phase_readout(
     chain: &ChainResponse,
     lr: &LaneResult,
