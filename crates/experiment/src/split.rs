@@ -58,8 +58,10 @@ pub enum Packing {
 /// - failing that, cutting each point into the fewest segments that fill whole groups of
 ///   four (`4 / gcd(points, 4)`, segments that may share any group) runs at least
 ///   1/[`MIN_IDLE_SAVING`] fewer lane-samples than the whole points do with their groups'
-///   idle lanes ([`lane_samples_in_fours`]): Fig. 5's seven BAW points, 1 s each, run as 28
-///   segments in seven full groups of four instead of groups of four and three.
+///   idle lanes ([`lane_samples_in_fours`]); where those segments leave lanes of groups of
+///   eight idle, the points with the longest segments then take one segment more each to
+///   fill them, every point cut evenly ([`fill_eights`]): Fig. 5's seven BAW points, 1 s each, run as 32 segments (four points
+///   in five, three in four) in four full groups of eight, or eight of four.
 ///
 /// A dump that does not fit keeps the sweep whole: its bits are then a continuous run's, not a
 /// split one's (a dump of the first second, as `reproduce` records, always fits).
@@ -100,8 +102,10 @@ pub fn lanes_of(
     let fill = (MAX_LANES / gcd(todo.len(), MAX_LANES)) as u64;
     let most = longest / (MIN_SEGMENT_SETTLES.saturating_mul(settle));
     let k = fill * (most / fill).min(MAX_SEGMENTS / fill);
-    let (len, packing) = if k >= 2 {
-        segment_length(cfg, longest.div_ceil(k))
+    // The cuts to take, in order of preference: per point, its segment length.
+    let (cuts, packing) = if k >= 2 {
+        let (len, packing) = segment_length(cfg, longest.div_ceil(k));
+        (vec![vec![len; todo.len()]], packing)
     } else {
         // Whole points leave lanes of their groups idle; segments that fill groups of four
         // settle anew. The cut is the same on every machine (groups of four on all).
@@ -118,13 +122,67 @@ pub fn lanes_of(
         if packing != Packing::Free || !saves {
             return whole();
         }
-        (len, packing)
+        let lens = vec![len; todo.len()];
+        let eights = fill_eights(cfg, &windows, &lens);
+        (eights.into_iter().chain([lens]).collect(), packing)
     };
-    let first_end_s = (cfg.n_settle_out() + len) as f64 / cfg.fs_out_hz();
-    if dump_end_s.is_some_and(|e| e > first_end_s) {
-        return whole();
+    // The dump must end within its point's first segment: within the shortest segment (a
+    // point's segments all have its length but its last).
+    let holds_dump = |lens: &[u64]| {
+        let first = lens.iter().copied().min().unwrap_or(0);
+        let first_end_s = (cfg.n_settle_out() + first) as f64 / cfg.fs_out_hz();
+        dump_end_s.is_none_or(|e| e <= first_end_s)
+    };
+    match cuts.iter().find(|lens| holds_dump(lens)) {
+        Some(lens) => (cut_each(todo, &windows, lens), packing),
+        None => whole(),
     }
-    (cut(todo, &windows, len), packing)
+}
+
+/// Per point, the segment lengths of a cut whose lanes fill whole groups of eight, if the cut
+/// at `lens` (per point, decimated samples) leaves lanes of them idle: the points whose
+/// segments are the longest (as many as there are idle lanes, at most one each) take one
+/// segment more, and every point's segments are made even (its window over its count), if
+/// those segments still share any group ([`Packing::Free`]) and the new cut runs at least
+/// 1/[`MIN_IDLE_SAVING`] fewer lane-samples in groups of eight and at most
+/// 1/`MIN_IDLE_SAVING` more in groups of four (the same cut on every machine: a gain where
+/// eight lanes run, no real loss where four do). Fig. 5's 28 segments of 0.255 s ran as three
+/// groups of eight and one of four; as 20 of 0.204 s and 12 of 0.255 s they fill four: 9 %
+/// fewer lane-samples in eights, 1 % more in fours.
+fn fill_eights(cfg: &Config, windows: &[(u64, f64)], lens: &[u64]) -> Option<Vec<u64>> {
+    let count = |n: u64, len: u64| n.div_ceil(len.max(1)).max(1);
+    let mut counts: Vec<u64> = windows
+        .iter()
+        .zip(lens)
+        .map(|(w, &l)| count(w.0, l))
+        .collect();
+    let idle = (8 - counts.iter().sum::<u64>() % 8) % 8;
+    if idle == 0 || idle as usize > windows.len() {
+        return None;
+    }
+    // The longest segments first (of equal ones, the earlier point's).
+    let mut order: Vec<usize> = (0..windows.len()).collect();
+    order.sort_by_key(|&p| core::cmp::Reverse(windows[p].0.div_ceil(counts[p])));
+    for &p in &order[..idle as usize] {
+        counts[p] += 1;
+    }
+    let mut even = Vec::with_capacity(windows.len());
+    for (&(n, _), &c) in windows.iter().zip(&counts) {
+        let (len, packing) = segment_length(cfg, n.div_ceil(c));
+        if packing != Packing::Free || count(n, len) != c {
+            return None;
+        }
+        even.push(len);
+    }
+    let todo: Vec<usize> = (0..windows.len()).collect();
+    let n_settle = cfg.n_settle_out();
+    let cost = |lens: &[u64], width: usize| {
+        lane_samples_in(&cut_each(&todo, windows, lens), n_settle, width)
+    };
+    let (eights, fours) = (cost(lens, 8), cost(lens, 4));
+    let gains = cost(&even, 8).saturating_add(eights / MIN_IDLE_SAVING) <= eights;
+    let fair = cost(&even, 4) <= fours.saturating_add(fours / MIN_IDLE_SAVING);
+    (gains && fair).then_some(even)
 }
 
 /// A split for idle lanes is taken only if it runs at least 1/this fewer lane-samples (a
@@ -134,8 +192,13 @@ pub const MIN_IDLE_SAVING: u64 = 32;
 /// The points `todo` (boxcar windows `windows`: decimated samples and fractional end) cut
 /// into segments of `len` decimated samples, the last of each point shorter.
 fn cut(todo: &[usize], windows: &[(u64, f64)], len: u64) -> Vec<Lane> {
+    cut_each(todo, windows, &vec![len; todo.len()])
+}
+
+/// [`cut`] with each point's own segment length (`lens`, beside `todo`).
+fn cut_each(todo: &[usize], windows: &[(u64, f64)], lens: &[u64]) -> Vec<Lane> {
     let mut lanes = Vec::new();
-    for (&i, &(n, frac)) in todo.iter().zip(windows) {
+    for ((&i, &(n, frac)), &len) in todo.iter().zip(windows).zip(lens) {
         let mut a = 0;
         let mut segment = 0;
         while a < n || (a == n && segment == 0) {
@@ -162,12 +225,17 @@ fn cut(todo: &[usize], windows: &[(u64, f64)], len: u64) -> Vec<Lane> {
 /// `n_settle` plus its longest window, idle lanes included: what they cost where a lane group
 /// of four runs at the cost of four lanes, whatever its lanes do.
 pub fn lane_samples_in_fours(lanes: &[Lane], n_settle: u64) -> u64 {
+    lane_samples_in(lanes, n_settle, 4)
+}
+
+/// [`lane_samples_in_fours`] in groups of `width` lanes.
+pub fn lane_samples_in(lanes: &[Lane], n_settle: u64, width: usize) -> u64 {
     let mut runs: Vec<u64> = lanes
         .iter()
         .map(|l| n_settle + l.window.samples())
         .collect();
     runs.sort_unstable_by(|a, b| b.cmp(a));
-    runs.chunks(4).map(|g| 4 * g[0]).sum()
+    runs.chunks(width.max(1)).map(|g| width as u64 * g[0]).sum()
 }
 
 /// A board `cfg` describes runs segments that start late (constant rate or rotating, no
@@ -387,23 +455,17 @@ mod tests {
     }
 
     #[test]
-    fn fig5s_seven_points_split_into_four_segments_that_fill_groups_of_four() {
+    fn fig5s_seven_points_split_into_segments_that_fill_groups_of_eight() {
         // Seven BAW points of 1.02 s, settling 20 ms: too short for 64 settling times a
         // segment, so they would run whole in groups of four and three (one lane in eight
         // idle). Four segments each settle anew (3 x 20 ms more per point) and fill seven
-        // groups of four: 7.4 % fewer lane-samples.
+        // groups of four; those 28 leave four lanes of groups of eight idle, so the four
+        // longest points take five segments: 32 lanes, four full groups of eight.
         let cfg = preset("baw-rotating").unwrap();
         let (lanes, packing) = lanes(&cfg, true, None);
         assert_eq!(packing, Packing::Free);
         check_tiling(&cfg, &lanes);
-        assert_eq!(lanes.len(), 28);
-        for i in 0..7 {
-            assert_eq!(
-                lanes.iter().filter(|l| l.point == i).count(),
-                4,
-                "point {i}"
-            );
-        }
+        assert_eq!(lanes.len(), 32);
         let settle = cfg.n_settle_out();
         let (whole, _) = lanes_of(
             &cfg,
@@ -412,19 +474,53 @@ mod tests {
             false,
             None,
         );
-        let (before, after) = (
-            lane_samples_in_fours(&whole, settle),
-            lane_samples_in_fours(&lanes, settle),
-        );
-        // 8 (s + L) against 28 (s + L / 4), L = 50.5 s for s the settling.
+        let n = |i: usize| {
+            whole
+                .iter()
+                .find(|l| l.point == i)
+                .unwrap()
+                .window
+                .samples()
+        };
+        let segments = |i: usize| lanes.iter().filter(|l| l.point == i).count();
+        let mut by_length: Vec<usize> = (0..7).collect();
+        by_length.sort_by_key(|&i| core::cmp::Reverse(n(i)));
+        for (rank, &i) in by_length.iter().enumerate() {
+            assert_eq!(segments(i), if rank < 4 { 5 } else { 4 }, "point {i}");
+        }
+        // Lane-samples, L = 50.5 s for s the settling: whole in fours 8 (s + L); cut in fours
+        // 12 (s + L/4) + 20 (s + L/5); cut in eights 16 (s + L/4) + 16 (s + L/5), against
+        // 32 (s + L/4) for the 28 segments (three groups of eight and one of four).
         let (s, l) = (settle as f64, whole[0].window.samples() as f64);
-        let want = 1.0 - (28.0 * (s + l / 4.0)) / (8.0 * (s + l));
-        let got = 1.0 - after as f64 / before as f64;
-        assert!((got - want).abs() < 1e-3 && got > 0.07, "{got} {want}");
+        let (q4, q5) = (s + l / 4.0, s + l / 5.0);
+        let saving = |after: u64, before: f64| 1.0 - after as f64 / before;
+        let fours = saving(lane_samples_in_fours(&lanes, settle), 8.0 * (s + l));
+        let want = 1.0 - (12.0 * q4 + 20.0 * q5) / (8.0 * (s + l));
+        assert!(
+            (fours - want).abs() < 1e-3 && fours > 0.06,
+            "{fours} {want}"
+        );
+        let eights = saving(lane_samples_in(&lanes, settle, 8), 32.0 * q4);
+        let want = 1.0 - (16.0 * q4 + 16.0 * q5) / (32.0 * q4);
+        assert!(
+            (eights - want).abs() < 1e-3 && eights > 0.09,
+            "{eights} {want}"
+        );
         // Every start shares the carrier, so any segments share a group.
         let m = cfg.decimation() as u64;
         let starts: Vec<u64> = lanes.iter().map(|l| l.start_block * m).collect();
         assert!(starts_share_carrier(&cfg.board_params(), &starts));
+    }
+
+    #[test]
+    fn a_dump_past_the_shorter_segments_keeps_the_cut_in_fours() {
+        // Fig. 5's first segments end 0.02 + 0.2 s from the start cut in five, 0.02 + 0.25 s
+        // cut in four: a dump ending between keeps the 28 segments, one beyond them whole.
+        let cfg = preset("baw-rotating").unwrap();
+        let count = |end_s: f64| lanes(&cfg, true, Some(end_s)).0.len();
+        assert_eq!(count(0.2), 32);
+        assert_eq!(count(0.25), 28);
+        assert_eq!(count(0.3), 7);
     }
 
     #[test]
@@ -439,11 +535,12 @@ mod tests {
         let mut eight = base.clone();
         eight.experiment.rates_dps.push(1440.0);
         assert!(whole(&eight));
-        // Six points (groups of four and two) take two segments each, twelve lanes.
+        // Six points (groups of four and two) take two segments each, twelve lanes; those
+        // leave four lanes of groups of eight idle, so the four longest take three: 16 lanes.
         let mut six = base.clone();
         six.experiment.rates_dps.truncate(6);
         let (l, _) = lanes(&six, true, None);
-        assert_eq!(l.len(), 12);
+        assert_eq!(l.len(), 16);
         // Windows of 10 settling times (seven faster rates, so that 0.2 s covers half their
         // modulation period): four segments would add three settlings a point, more than the
         // idle lanes cost (28 x 3.5 against 8 x 11 settling times).
@@ -460,6 +557,17 @@ mod tests {
         assert!(whole(&short));
         short.experiment.average_s = 40.0 * base.settle_s();
         assert!(!whole(&short));
+        // Six of those points at ten settling times: two segments each fill groups of four
+        // (12 x 6 against 8 x 11), but a third for the four longest would cost groups of four
+        // 5.6 % more (4 x 6 + 12 x 13/3 = 76 against 12 x 6), over 1/32: twelve lanes. At
+        // forty, 1.6 % more (4 x 21 + 12 x 43/3 against 12 x 21), and groups of eight run a
+        // sixth less (8 x 21 + 8 x 43/3 against 16 x 21): 16 lanes.
+        let count = |cfg: &Config| lanes(cfg, true, None).0.len();
+        short.experiment.rates_dps.truncate(6);
+        short.experiment.average_s = 10.0 * base.settle_s();
+        assert_eq!(count(&short), 12);
+        short.experiment.average_s = 40.0 * base.settle_s();
+        assert_eq!(count(&short), 16);
         // Fig. 9 --quick (15 s, settling 0.71 s): four segments would save 0.6 %, under 1/32.
         let mut quick = preset("m2tfg-rotating").unwrap();
         quick.experiment.average_s = 15.0;

@@ -141,6 +141,27 @@ fn a_sweep_split_to_fill_its_idle_lanes_reads_the_phases_of_the_whole_one() {
 }
 
 #[test]
+fn a_sweep_cut_to_fill_groups_of_eight_reads_the_phases_of_the_whole_one() {
+    // Six rates of 3 s (whole modulation periods: windows of 1.8 to 2.9 s): two segments
+    // each fill groups of four (twelve lanes, of up to 1.44 s), and the four points with the
+    // longest segments take a third to fill groups of eight: sixteen lanes of 0.75 to 1.03 s,
+    // each point cut evenly.
+    let mut cfg = rotating_three();
+    cfg.experiment.rates_dps = vec![75.0, 100.0, 125.0, 140.0, 160.0, 175.0];
+    cfg.validate().unwrap();
+    let rates = cfg.emulated_rates_dps();
+    let todo: Vec<usize> = (0..rates.len()).collect();
+    let (lanes, _) =
+        gyroemu_experiment::split::lanes_of(&cfg, &todo, &|i| cfg.plan_point(rates[i]), true, None);
+    assert_eq!(lanes.len(), 16);
+    let segments = |i: usize| lanes.iter().filter(|l| l.point == i).count();
+    assert_eq!((0..6).filter(|&i| segments(i) == 3).count(), 4);
+    reads_the_whole_ones_phases(&cfg);
+    let one = sweep(&cfg, split(1));
+    assert_eq!(one.lanes, sweep(&cfg, split(2)).lanes);
+}
+
+#[test]
 fn a_split_sweeps_bits_do_not_depend_on_how_its_lanes_are_grouped() {
     let cfg = rotating();
     let one = sweep(&cfg, split(1));
