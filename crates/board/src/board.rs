@@ -140,16 +140,9 @@ pub fn starts_share_carrier(p: &BoardParams, starts: &[u64]) -> bool {
     starts.iter().all(|&n| word(n) == word(starts[0]))
 }
 
-/// The rules of [`Board::with_starts`]: starts that share the carrier, and none but 0 on a
-/// rate table.
+/// The rule of [`Board::with_starts`]: starts that share the carrier.
 fn check_starts(p: &BoardParams, starts: &[u64]) -> Result<(), ParamError> {
     let bad = |v: String, rule: &str| Err(ParamError::new(crate::params::STAGE, "starts", v, rule));
-    if let (Shape::RateTable { .. }, Some(&n)) = (p.shape, starts.iter().find(|&&n| n != 0)) {
-        return bad(
-            n.to_string(),
-            "a rate table's lanes start at sample 0 (its table phase counts from there)",
-        );
-    }
     if !starts_share_carrier(p, starts) {
         return bad(
             format!("{starts:?}"),
@@ -232,8 +225,9 @@ impl<S: Sample> Board<S> {
     /// of a board built with the single start `starts[i]`, and a long point's window can run
     /// as segments side by side, each settling anew (`gyroemu-experiment`'s split sweeps).
     /// The lanes share one carrier, so the starts must agree on its phase
-    /// ([`starts_share_carrier`]); a rate table counts its phase from sample 0, so its lanes
-    /// start there. A refusal names the rule.
+    /// ([`starts_share_carrier`]); a rate table's phase counts from sample 0 of the time axis,
+    /// so a lane started late has its own table, at its phase there. A refusal names the
+    /// rule.
     pub fn with_starts(
         p: &BoardParams,
         rates_rad_s: &[f64],
@@ -253,6 +247,22 @@ impl<S: Sample> Board<S> {
         table_hz: &[f64],
         streams: &[u64],
     ) -> Result<Self, ParamError> {
+        Self::with_table_hz_starts(p, rates_rad_s, table_hz, streams, &[0])
+    }
+
+    /// [`Board::with_table_hz`] with lane `i` starting at input sample `starts[i]` of the
+    /// time axis ([`Board::with_starts`]; `[0]`: every lane at 0): the segments of the
+    /// bandwidth sweep's long points.
+    pub fn with_table_hz_starts(
+        p: &BoardParams,
+        rates_rad_s: &[f64],
+        table_hz: &[f64],
+        streams: &[u64],
+        starts: &[u64],
+    ) -> Result<Self, ParamError> {
+        if starts != [0] {
+            one_per_point("starts", starts.len(), rates_rad_s.len(), "start")?;
+        }
         let Shape::RateTable { .. } = p.shape else {
             return Err(ParamError::new(
                 crate::params::STAGE,
@@ -265,7 +275,7 @@ impl<S: Sample> Board<S> {
         for &f in table_hz {
             gyroemu_core::error::positive(crate::params::STAGE, "table_freq_hz", f)?;
         }
-        Self::build(p, rates_rad_s, Some(table_hz), streams, &[0])
+        Self::build(p, rates_rad_s, Some(table_hz), streams, starts)
     }
 
     fn build(
@@ -301,15 +311,24 @@ impl<S: Sample> Board<S> {
                 Ok(n)
             })
             .collect::<Result<_, ParamError>>()?;
-        let table: Vec<Nco> = match table_hz {
-            Some(f) => (0..S::LANES)
-                .map(|i| table_nco_at(f[i.min(lanes - 1)], fs))
-                .collect::<Result<_, _>>()?,
-            None => vec![table_nco(p)?],
-        };
+        // Each lane's table, where its lane starts on the time axis (a rate table's phase
+        // counts from sample 0 of that axis).
+        let table: Vec<Nco> = (0..S::LANES)
+            .map(|i| {
+                let mut n = match table_hz {
+                    Some(f) => table_nco_at(f[i.min(lanes - 1)], fs)?,
+                    None => table_nco(p)?,
+                };
+                n.jump(lane_start(i));
+                Ok(n)
+            })
+            .collect::<Result<_, ParamError>>()?;
         let table_f_hz: [f64; MAX_LANES] =
-            core::array::from_fn(|i| table[i.min(table.len() - 1)].f_hz());
-        let table_shared = table_f_hz.iter().all(|&f| f == table_f_hz[0]);
+            core::array::from_fn(|i| table[i.min(S::LANES - 1)].f_hz());
+        let on_table = matches!(p.shape, Shape::RateTable { .. });
+        let table_shared = (0..S::LANES).all(|i| {
+            table_f_hz[i] == table_f_hz[0] && (!on_table || lane_start(i) == lane_start(0))
+        });
         let scalar: Vec<Resonator<f64>> = (0..S::LANES)
             .map(|i| Resonator::<f64>::new(&p.plant, plant_rate(p.shape, lane_rate(i))))
             .collect::<Result<_, _>>()?;

@@ -94,6 +94,21 @@ impl GroupBoard {
         )
     }
 
+    /// [`Board::with_table_hz_starts`] (a rate table per lane, each lane starting at its
+    /// input sample of the time axis) in the lanes [`GroupBoard::new`] picks.
+    pub fn with_table_hz_starts(
+        p: &BoardParams,
+        rates_rad_s: &[f64],
+        table_hz: &[f64],
+        streams: &[u64],
+        starts: &[u64],
+    ) -> Result<Self, ParamError> {
+        in_lanes_for!(
+            rates_rad_s.len(),
+            with_table_hz_starts(p, rates_rad_s, table_hz, streams, starts)
+        )
+    }
+
     /// The board in lanes of `width` (4 or 8) whatever the points (benchmarks, and tests that
     /// compare the widths). Eight lanes on a CPU without AVX-512 are refused.
     pub fn with_width(

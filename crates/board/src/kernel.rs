@@ -547,15 +547,17 @@ impl<S: Sample> Board<S> {
 }
 
 impl<S: Sample> Board<S> {
-    /// `e^{-j theta}` of each lane's table at input sample `n`, as `(re, im)`
-    /// ([`table_reference`]; once for all lanes when they share the table). Out of line (once
-    /// per decimation block) and compiled like the loop.
+    /// `e^{-j theta}` of each lane's table at the run's input sample `n`, as `(re, im)`
+    /// ([`table_reference`] at the lane's sample of the time axis, `n` past its start; once
+    /// for all lanes when they share the table). Out of line (once per decimation block) and
+    /// compiled like the loop.
     #[inline(never)]
     fn table_base(&self, n: u64) -> (S, S) {
         S::with_target_features(
             #[inline(always)]
             || {
-                let at = |i: usize| table_reference(n, self.table_f_hz[i], self.fs_hz);
+                let at =
+                    |i: usize| table_reference(n + self.starts[i], self.table_f_hz[i], self.fs_hz);
                 if self.table_lanes.is_none() {
                     let b = at(0);
                     return (S::splat(b.re), S::splat(b.im));

@@ -47,9 +47,9 @@ pub enum Packing {
 
 /// The lanes of the points `todo` of `cfg`'s sweep (point `i` planned as `plan(i)`), split
 /// when `split` is asked and the sweep can be split, else one whole point per lane. A sweep
-/// is split when: its points have boxcar windows on a constant-rate or rotating board without
-/// noise (a rate table counts its phase from sample 0; a noisy point's segments would draw
-/// other streams than the point), settling at least the default time; the dump (ending at
+/// is split when: its points have boxcar windows on a board without noise (a noisy point's
+/// segments would draw other streams than the point; a rate table's segments each follow
+/// their table from where they start), settling at least the default time; the dump (ending at
 /// `dump_end_s` from the start of its run) fits in its point's first segment; and either
 /// - `k`, the smallest number of segments that fills whole groups of eight lanes
 ///   (`8 / gcd(points, 8)`), times the largest whole factor that keeps the longest point's
@@ -196,7 +196,7 @@ fn cut(todo: &[usize], windows: &[(u64, f64)], len: u64) -> Vec<Lane> {
 }
 
 /// [`cut`] with each point's own segment length (`lens`, beside `todo`).
-fn cut_each(todo: &[usize], windows: &[(u64, f64)], lens: &[u64]) -> Vec<Lane> {
+pub(crate) fn cut_each(todo: &[usize], windows: &[(u64, f64)], lens: &[u64]) -> Vec<Lane> {
     let mut lanes = Vec::new();
     for ((&i, &(n, frac)), &len) in todo.iter().zip(windows).zip(lens) {
         let mut a = 0;
@@ -238,20 +238,94 @@ pub fn lane_samples_in(lanes: &[Lane], n_settle: u64, width: usize) -> u64 {
     runs.chunks(width.max(1)).map(|g| width as u64 * g[0]).sum()
 }
 
-/// A board `cfg` describes runs segments that start late (constant rate or rotating, no
-/// noise), and each settles at least the default time: the start transient a split point
+/// A board `cfg` describes runs segments that start late (no noise: a segment would draw
+/// other normals than its point; a rate table's lanes each follow their table from where they
+/// start), and each settles at least the default time: the start transient a split point
 /// averages is each segment's, so it must be as small as the one a whole run leaves.
-fn splittable(cfg: &Config) -> bool {
-    let p = cfg.board_params();
-    p.noise.is_none()
-        && !matches!(p.shape, gyroemu_board::Shape::RateTable { .. })
-        && cfg.settle_s() >= cfg.default_settle_s()
+pub fn splittable(cfg: &Config) -> bool {
+    cfg.board_params().noise.is_none() && cfg.settle_s() >= cfg.default_settle_s()
+}
+
+/// Per point, the segment length (decimated samples) of the cut of points of boxcar windows
+/// `windows` (decimated samples and fractional end; all settling `n_settle`) whose lanes run
+/// the fewest lane-samples in groups of eight, or `None` to run them whole: a cut is taken
+/// only if it runs at least 1/[`MIN_IDLE_SAVING`] fewer lane-samples in groups of eight than
+/// the whole points and no more than 1/`MIN_IDLE_SAVING` more in groups of four (the same
+/// cut on every machine). The cuts weighed are those that bring every lane within a common
+/// length: each point in the fewest even segments within it, for every length a point's
+/// even cut gives (at most [`MAX_SEGMENTS`] segments a point); `segment` rounds a length up
+/// to one whose segments may share any group, or says they may not ([`Packing::SameStart`]:
+/// that cut is not weighed). The bandwidth sweep's points (settling 12.25 s, windows of 40,
+/// 20, 10, 6.7 and five of 4 s) run as 13 lanes of at most 22.25 s: groups of eight of 22.25
+/// and 16.25 s, against a group of four of 52.25 s and one of eight of 16.25 s whole.
+pub fn cut_to_fill(
+    windows: &[(u64, f64)],
+    n_settle: u64,
+    segment: &dyn Fn(u64) -> (u64, Packing),
+) -> Option<Vec<u64>> {
+    let whole: Vec<u64> = windows.iter().map(|w| w.0.max(1)).collect();
+    let todo: Vec<usize> = (0..windows.len()).collect();
+    let cost = |lens: &[u64], width: usize| {
+        lane_samples_in(&cut_each(&todo, windows, lens), n_settle, width)
+    };
+    let (whole8, whole4) = (cost(&whole, 8), cost(&whole, 4));
+    // Every common length a point's even cut gives.
+    let mut targets: Vec<u64> = windows
+        .iter()
+        .flat_map(|w| (1..=MAX_SEGMENTS).map(move |c| w.0.div_ceil(c)))
+        .filter(|&t| t > 0)
+        .collect();
+    targets.sort_unstable();
+    targets.dedup();
+    let mut best: Option<(u64, usize, Vec<u64>)> = None;
+    for &t in &targets {
+        let Some(lens) = even_cut(windows, t, segment) else {
+            continue;
+        };
+        let lanes: usize = windows
+            .iter()
+            .zip(&lens)
+            .map(|(w, &l)| w.0.div_ceil(l) as usize)
+            .sum();
+        let c8 = cost(&lens, 8);
+        // Of equal costs, the fewer lanes (the less settling).
+        if best.as_ref().is_none_or(|(b, n, _)| (c8, lanes) < (*b, *n)) {
+            best = Some((c8, lanes, lens));
+        }
+    }
+    let (c8, _, lens) = best?;
+    let gains = c8.saturating_add(whole8 / MIN_IDLE_SAVING) <= whole8;
+    let fair = cost(&lens, 4) <= whole4.saturating_add(whole4 / MIN_IDLE_SAVING);
+    (gains && fair && lens != whole).then_some(lens)
+}
+
+/// Per point, the length of its fewest even segments within `t` decimated samples (rounded
+/// up by `segment`), if every point's segments may share any group and stay within `t`.
+fn even_cut(
+    windows: &[(u64, f64)],
+    t: u64,
+    segment: &dyn Fn(u64) -> (u64, Packing),
+) -> Option<Vec<u64>> {
+    windows
+        .iter()
+        .map(|&(n, _)| {
+            let count = n.div_ceil(t).max(1);
+            if count > MAX_SEGMENTS {
+                return None;
+            }
+            if count == 1 {
+                return Some(n.max(1));
+            }
+            let (len, packing) = segment(n.div_ceil(count));
+            (packing == Packing::Free && len <= t && n.div_ceil(len) == count).then_some(len)
+        })
+        .collect()
 }
 
 /// The segment length (decimated samples) for at least `len`: rounded up to a whole number
 /// of the carrier's repeat where that repeat is short (then any segments share a lane group),
 /// else `len` (segments share a group only with those starting with them).
-fn segment_length(cfg: &Config, len: u64) -> (u64, Packing) {
+pub fn segment_length(cfg: &Config, len: u64) -> (u64, Packing) {
     let p = cfg.board_params();
     let m = cfg.decimation() as u64;
     // The carrier's phase word repeats after a power of two of samples: the first power of
@@ -336,6 +410,9 @@ pub fn combine(segments: &[(Window, LaneResult)]) -> LaneResult {
         out.z[k] = mean(&|r| r.z[k]);
         out.c[k] = mean(&|r| r.c[k]);
         out.s[k] = mean(&|r| r.s[k]);
+        for h in 0..out.table_z[k].len() {
+            out.table_z[k][h] = mean(&|r| r.table_z[k][h]);
+        }
     }
     for (_, r) in segments {
         out.health.add(&r.health);
@@ -448,9 +525,15 @@ mod tests {
         // A dump that ends past the first segment.
         assert!(whole(&fig9, Some(100.0)));
         assert!(!whole(&fig9, Some(10.0)));
-        // A rate table counts its phase from sample 0.
+        // A rate table's segments follow their tables from where they start: its preset's
+        // seven 10 s points (settling 12.25 s) gain nothing from segments and run whole, as
+        // `reproduce` runs them; at 2000 s they split.
         let mut table = preset("m2tfg-ratetable").unwrap();
+        assert!(whole(&table, None));
         table.experiment.average_s = 2000.0;
+        assert!(!whole(&table, None));
+        // Noise still keeps a rate table whole.
+        table.noise = noisy.noise;
         assert!(whole(&table, None));
     }
 
@@ -578,6 +661,68 @@ mod tests {
         odd.drive.carrier_hz = Some(odd.device.f0_hz + 0.1);
         odd.validate().unwrap();
         assert!(whole(&odd));
+    }
+
+    /// Any length, segments sharing any group.
+    fn free(len: u64) -> (u64, Packing) {
+        (len, Packing::Free)
+    }
+
+    #[test]
+    fn the_bandwidth_sweeps_long_points_are_cut_to_its_ten_second_lanes() {
+        // Settling 12.25 s and windows of 40, 20, 10, 6.67 and five of 4 s at 2.4 kHz out.
+        let s = 29_412;
+        let mut windows = vec![(96_000, 0.0), (48_000, 0.0), (24_000, 0.0), (16_000, 0.0)];
+        windows.extend([(9_600, 0.0); 5]);
+        let lens = cut_to_fill(&windows, s, &free).expect("cut");
+        // The 40 s point in four, the 20 s one in two: 13 lanes of at most 10 s windows.
+        assert_eq!(
+            lens,
+            [24_000, 24_000, 24_000, 16_000, 9_600, 9_600, 9_600, 9_600, 9_600]
+        );
+        let todo: Vec<usize> = (0..9).collect();
+        let cut = cut_each(&todo, &windows, &lens);
+        assert_eq!(cut.len(), 13);
+        // A boxcar of n runs n + 1 samples. Groups of eight: 8 (s + 10 s) + 8 (s + 4 s),
+        // against 8 (s + 40 s) + 8 (s + 4 s) whole; in fours 4 (2 (s + 10 s) + 2 (s + 4 s))
+        // against 4 (s + 40 s) + 8 (s + 4 s).
+        let (ten, four, forty) = (s + 24_001, s + 9_601, s + 96_001);
+        assert_eq!(lane_samples_in(&cut, s, 8), 8 * ten + 8 * four);
+        assert_eq!(lane_samples_in(&cut, s, 4), 8 * ten + 8 * four);
+        let whole = cut_each(
+            &todo,
+            &windows,
+            &windows.iter().map(|w| w.0).collect::<Vec<_>>(),
+        );
+        assert_eq!(lane_samples_in(&whole, s, 8), 8 * forty + 8 * four);
+        assert_eq!(lane_samples_in(&whole, s, 4), 4 * forty + 8 * four);
+        // Segments that could share a group only with those starting with them: no cut.
+        let by_start = |len: u64| (len, Packing::SameStart);
+        assert_eq!(cut_to_fill(&windows, s, &by_start), None);
+    }
+
+    #[test]
+    fn a_cut_is_taken_only_where_eights_gain_and_fours_do_not_lose() {
+        // Four points of 100 blocks with no settling: two segments each fill a group of eight
+        // (8 x 50 against 8 x 100) and cost groups of four nothing (2 x 4 x 50 = 4 x 100);
+        // four segments cost the same in eights but settle more: two it is.
+        assert_eq!(cut_to_fill(&[(100, 0.0); 4], 0, &free), Some(vec![50; 4]));
+        // Settling 10 blocks: groups of eight still gain (8 x 60 against 8 x 110), but
+        // groups of four would run 480 lane-samples against 440 whole: no cut.
+        assert_eq!(cut_to_fill(&[(100, 0.0); 4], 10, &free), None);
+        // Eight equal points fill their group whole.
+        assert_eq!(cut_to_fill(&[(100, 0.0); 8], 10, &free), None);
+        // A cut that saves less than 1/32 in eights is not taken: six points of 100 and one
+        // of 104 (settling 10), the longest cut in two, fill the eighth lane and gain 4 of
+        // 115 lane-samples a lane (3.5 %); with 103, 3 of 114 (2.6 %).
+        let mut w = vec![(100, 0.0); 6];
+        w.push((104, 0.0));
+        assert_eq!(
+            cut_to_fill(&w, 10, &free),
+            Some(vec![100, 100, 100, 100, 100, 100, 52])
+        );
+        w[6] = (103, 0.0);
+        assert_eq!(cut_to_fill(&w, 10, &free), None);
     }
 
     #[test]

@@ -1,10 +1,13 @@
 //! Rate-table sweeps that differ only in their table frequency and averaging time (the
 //! bandwidth sweep: one point per frequency), run in shared lane groups, each lane on its own
 //! table. Run one by one, each would be a group of one point; packed, nine frequencies take
-//! two groups. Every point keeps the bits of its own sweep.
+//! two groups. Every point keeps the bits of its own sweep; asked to split
+//! ([`PreparedTables::new`]), long points run as segments side by side (`split::cut_to_fill`),
+//! each settling anew, within what that settling leaves of a whole run's average.
 
 use crate::mutex::lock;
 use crate::readout::SweepResult;
+use crate::split::{combine, cut_each, cut_to_fill, segment_length, splittable};
 use crate::sweep::{finish_sweep, group_samples, SweepError};
 use gyroemu_board::{group_sizes, BoardParams, GroupBoard, LaneResult, RunOptions, Shape};
 use gyroemu_config::Config;
@@ -13,8 +16,9 @@ use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::Mutex;
 
-/// A finished lane: its sweep, its index there and its result.
-type Finished = (usize, usize, LaneResult);
+/// A finished lane: its sweep, its point's index there, its segment's start and window, and
+/// its result.
+type Finished = (usize, usize, u64, gyroemu_lpf::Window, LaneResult);
 
 /// A group's finished lanes, or why it failed.
 type GroupOutcome = Result<Vec<Finished>, SweepError>;
@@ -25,7 +29,10 @@ struct Job {
     /// The sweep (index in the caller's configs) and the point's index in its rates.
     sweep: usize,
     index: usize,
+    /// The point, with its segment's window when split.
     point: gyroemu_board::Point,
+    /// Where the segment starts on the point's averaging axis, decimated samples (0 whole).
+    start_block: u64,
     table_hz: f64,
     /// The table harmonics its own board would demodulate.
     harmonics: usize,
@@ -51,7 +58,7 @@ pub fn run_table_sweeps(
     cfgs: &[Config],
     group_threads: Option<usize>,
 ) -> Result<Vec<SweepResult>, SweepError> {
-    let tables = PreparedTables::new(cfgs, group_threads)?;
+    let tables = PreparedTables::new(cfgs, group_threads, false)?;
     tables.run_all();
     tables.finish()
 }
@@ -63,7 +70,7 @@ fn run_table_lanes(
     cfgs: &[Config],
     group_threads: Option<usize>,
 ) -> Result<Vec<BTreeMap<usize, LaneResult>>, SweepError> {
-    let tables = PreparedTables::new(cfgs, group_threads)?;
+    let tables = PreparedTables::new(cfgs, group_threads, false)?;
     tables.run_all();
     tables.lanes()
 }
@@ -79,8 +86,14 @@ pub struct PreparedTables<'c> {
 
 impl<'c> PreparedTables<'c> {
     /// Plans the lane groups of `cfgs` and builds every board (so a bad parameter fails
-    /// before any sample is computed).
-    pub fn new(cfgs: &'c [Config], group_threads: Option<usize>) -> Result<Self, SweepError> {
+    /// before any sample is computed). With `split`, the points of configs that can run as
+    /// segments (`split::splittable`, boxcar windows) are cut where that fills lane groups
+    /// (`split::cut_to_fill`); the cut depends on the configs alone.
+    pub fn new(
+        cfgs: &'c [Config],
+        group_threads: Option<usize>,
+        split: bool,
+    ) -> Result<Self, SweepError> {
         // Classes of configs that can share a group, each with its points.
         let mut classes: Vec<((BoardParams, u64), Vec<Job>)> = Vec::new();
         for (sweep, cfg) in cfgs.iter().enumerate() {
@@ -106,12 +119,19 @@ impl<'c> PreparedTables<'c> {
                     sweep,
                     index,
                     point: cfg.plan_point(r),
+                    start_block: 0,
                     table_hz: freq_hz,
                     harmonics: p.table_harmonics,
                 });
             }
         }
+        if split {
+            for ((_, n_settle), jobs) in &mut classes {
+                *jobs = split_jobs(cfgs, jobs, *n_settle);
+            }
+        }
         let threads = group_threads.unwrap_or_else(rayon::current_num_threads);
+        let m_of = |j: &Job| cfgs[j.sweep].decimation() as u64;
         let mut groups = Vec::new();
         for ((key, n_settle), jobs) in &classes {
             let mut order: Vec<&Job> = jobs.iter().collect();
@@ -138,7 +158,9 @@ impl<'c> PreparedTables<'c> {
                 let table_hz: Vec<f64> = g.iter().map(|j| j.table_hz).collect();
                 // Each point draws the stream of its index in its own sweep.
                 let streams: Vec<u64> = g.iter().map(|j| j.index as u64).collect();
-                let board = GroupBoard::with_table_hz(&p, &rates, &table_hz, &streams)?;
+                let starts: Vec<u64> = g.iter().map(|j| j.start_block * m_of(j)).collect();
+                let board =
+                    GroupBoard::with_table_hz_starts(&p, &rates, &table_hz, &streams, &starts)?;
                 let jobs = g.iter().map(|&j| j.clone()).collect();
                 groups.push((Mutex::new(Some(board)), jobs, *n_settle));
             }
@@ -184,7 +206,7 @@ impl<'c> PreparedTables<'c> {
                                 }
                             }
                         }
-                        (j.sweep, j.index, lane)
+                        (j.sweep, j.index, j.start_block, j.point.window, lane)
                     })
                     .collect()
             });
@@ -199,28 +221,91 @@ impl<'c> PreparedTables<'c> {
             .for_each(|g| self.run_group(g));
     }
 
-    /// Each config's lane results by point index, once every group has run (taken: once).
+    /// Each config's lane results by point index, once every group has run (taken: once): a
+    /// split point's from its segments in their order on its axis (`split::combine`).
     fn lanes(&self) -> Result<Vec<BTreeMap<usize, LaneResult>>, SweepError> {
-        let mut lanes: Vec<BTreeMap<usize, LaneResult>> = vec![BTreeMap::new(); self.cfgs.len()];
+        type Segments = Vec<(u64, gyroemu_lpf::Window, LaneResult)>;
+        let mut parts: Vec<BTreeMap<usize, Segments>> = vec![BTreeMap::new(); self.cfgs.len()];
         for o in &self.outcomes {
             let done = lock(o).take();
-            for (sweep, index, lane) in done.unwrap_or_else(|| Ok(Vec::new()))? {
-                lanes[sweep].insert(index, lane);
+            for (sweep, index, start, window, lane) in done.unwrap_or_else(|| Ok(Vec::new()))? {
+                parts[sweep]
+                    .entry(index)
+                    .or_default()
+                    .push((start, window, lane));
             }
         }
-        Ok(lanes)
+        Ok(parts
+            .into_iter()
+            .map(|points| {
+                points
+                    .into_iter()
+                    .map(|(index, mut segs)| {
+                        segs.sort_by_key(|s| s.0);
+                        let segs: Vec<_> = segs.into_iter().map(|(_, w, l)| (w, l)).collect();
+                        (index, combine(&segs))
+                    })
+                    .collect()
+            })
+            .collect())
     }
 
     /// Each config's result, in order, once every group has run: what
     /// [`run_table_sweeps`] returns. Called once.
     pub fn finish(&self) -> Result<Vec<SweepResult>, SweepError> {
+        self.finish_with_lanes().map(|(results, _)| results)
+    }
+
+    /// [`PreparedTables::finish`], with each config's lane results by point index (a split
+    /// point's combined from its segments) beside. Called once.
+    #[allow(clippy::type_complexity)]
+    pub fn finish_with_lanes(
+        &self,
+    ) -> Result<(Vec<SweepResult>, Vec<BTreeMap<usize, LaneResult>>), SweepError> {
         let lanes = self.lanes()?;
-        self.cfgs
+        let results = self
+            .cfgs
             .iter()
             .zip(&lanes)
             .map(|(cfg, l)| finish_sweep(cfg, l))
-            .collect()
+            .collect::<Result<_, _>>()?;
+        Ok((results, lanes))
     }
+}
+
+/// A class's points (`jobs`, of one board and settling `n_settle`) as the segments of their
+/// cut (`split::cut_to_fill`) when every config they come from can run segments and every
+/// window is a boxcar; else as they are.
+fn split_jobs(cfgs: &[Config], jobs: &[Job], n_settle: u64) -> Vec<Job> {
+    let windows: Option<Vec<(u64, f64)>> = jobs
+        .iter()
+        .map(|j| match j.point.window {
+            gyroemu_lpf::Window::Boxcar { n, frac } if splittable(&cfgs[j.sweep]) => {
+                Some((n, frac))
+            }
+            _ => None,
+        })
+        .collect();
+    let (Some(windows), Some(first)) = (windows, jobs.first()) else {
+        return jobs.to_vec();
+    };
+    // The carrier, sample rate and decimation are the class's: any of its configs rounds.
+    let cfg = &cfgs[first.sweep];
+    let Some(lens) = cut_to_fill(&windows, n_settle, &|len| segment_length(cfg, len)) else {
+        return jobs.to_vec();
+    };
+    let todo: Vec<usize> = (0..jobs.len()).collect();
+    cut_each(&todo, &windows, &lens)
+        .into_iter()
+        .map(|lane| Job {
+            point: gyroemu_board::Point {
+                window: lane.window,
+                ..jobs[lane.point].point
+            },
+            start_block: lane.start_block,
+            ..jobs[lane.point].clone()
+        })
+        .collect()
 }
 
 #[cfg(test)]

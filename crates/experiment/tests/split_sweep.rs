@@ -12,6 +12,7 @@ use gyroemu_experiment::table_sweep::PreparedTables;
 use gyroemu_experiment::{
     finish_sweep, run_sweep_with, run_table_sweeps, DumpPlan, SweepOptions, SweepRun,
 };
+use gyroemu_lpf::Window;
 use std::sync::Mutex;
 
 /// The rotating preset at Q = 200 (settling 0.1 s), two rates, 30 s of averaging: each point
@@ -240,7 +241,7 @@ fn sweeps_run_from_one_queue_give_each_sweep_its_own_bits() {
     let table_cfgs = tables();
     let a = PreparedSweep::new(&rot, &|_, _| {}, None, split(1)).unwrap();
     let b = PreparedSweep::new(&coriolis, &|_, _| {}, None, Default::default()).unwrap();
-    let t = PreparedTables::new(&table_cfgs, Some(1)).unwrap();
+    let t = PreparedTables::new(&table_cfgs, Some(1), false).unwrap();
     let mut items = sweep_items(&a, 1.0, None);
     items.extend(sweep_items(&b, 1.0, None));
     items.extend(table_items(&t, 1.35, None));
@@ -327,4 +328,81 @@ fn a_sweep_is_finished_once_right_after_its_last_group_and_its_dump_written_once
     // The dump was written once, by the group that recorded it, before the sweep finished.
     assert_eq!(*hooks.lock().unwrap(), 1);
     assert!(!run.dump_files.is_empty());
+}
+
+/// The rate-table preset at Q = 2000 (default settling 0.71 s, tau = 42 ms), one 100 deg/s
+/// point on a 0.5 Hz table over 8 s (four periods), settling `extra_tau` mechanical time
+/// constants beyond the default.
+fn long_table(extra_tau: f64) -> Config {
+    let mut c = preset("m2tfg-ratetable").unwrap();
+    c.device.q = 2000.0;
+    c.device.q_mode2 = None;
+    c.experiment.settle_s = None;
+    c.experiment.table_freq_hz = Some(0.5);
+    c.experiment.rates_dps = vec![100.0];
+    c.experiment.average_s = 8.0;
+    c.validate().unwrap();
+    let tau = 2000.0 / (std::f64::consts::PI * c.device.f0_hz);
+    c.experiment.settle_s = Some(c.default_settle_s() + extra_tau * tau);
+    c.validate().unwrap();
+    c
+}
+
+/// `|a - b| / |a|` over both modes' table harmonics.
+fn rel_table(a: &LaneResult, b: &LaneResult) -> f64 {
+    let v = |r: &LaneResult| r.table_z.iter().flatten().copied().collect::<Vec<_>>();
+    let norm = |z: &mut dyn Iterator<Item = Complex64>| z.map(|x| x.norm_sqr()).sum::<f64>().sqrt();
+    let (va, vb) = (v(a), v(b));
+    norm(&mut va.iter().zip(&vb).map(|(x, y)| x - y)) / norm(&mut va.iter().copied())
+}
+
+/// A table sweep's lanes and results, its long points split or whole.
+fn tables_of(
+    cfgs: &[Config],
+    split: bool,
+) -> (Vec<LaneResult>, Vec<gyroemu_experiment::SweepResult>) {
+    let t = PreparedTables::new(cfgs, Some(1), split).unwrap();
+    for g in 0..t.groups() {
+        t.run_group(g);
+    }
+    let (r, lanes) = t.finish_with_lanes().unwrap();
+    (lanes.iter().map(|l| l[&0]).collect(), r)
+}
+
+#[test]
+fn a_rate_tables_long_point_split_reads_the_whole_ones_harmonics() {
+    // Whole, the point is one lane of 8.71 s; cut in eight even segments of 1 s (each
+    // settling 0.71 s anew, its table at its start's phase), one full group of eight.
+    let cfg = long_table(0.0);
+    let rates = cfg.emulated_rates_dps();
+    let Window::Boxcar { n, frac } = cfg.plan_point(rates[0]).window else {
+        panic!("boxcar")
+    };
+    let segment = |len| gyroemu_experiment::split::segment_length(&cfg, len);
+    let lens = gyroemu_experiment::split::cut_to_fill(&[(n, frac)], cfg.n_settle_out(), &segment)
+        .expect("cut");
+    assert_eq!(n.div_ceil(lens[0]), 8);
+    let (whole, rw) = tables_of(std::slice::from_ref(&cfg), false);
+    let (parts, rp) = tables_of(std::slice::from_ref(&cfg), true);
+    // What is left is the start transient of each segment: e^-16 of the drive's response
+    // after the default settling, decaying within tau = 42 ms of a 1 s segment.
+    let d = rel_table(&whole[0], &parts[0]);
+    assert!(d > 0.0 && d < 1e-8, "{d:e}");
+    let (a, b) = (&rw[0].points[0], &rp[0].points[0]);
+    for k in 0..2 {
+        let lag = (a.table_lag_deg.unwrap()[k] - b.table_lag_deg.unwrap()[k]).abs();
+        // The phase read is about 0.07 rad of the carrier's response: its relative error
+        // is the harmonics' over that (measured: 1.4e-7 and 1.5e-6 deg).
+        assert!(lag < 3e-6, "mode {k}: the lag moved {lag:e} deg");
+        let phase = (a.phase_deg[k] - b.phase_deg[k]).abs();
+        assert!(phase < 3e-7, "mode {k}: the phase moved {phase:e} deg");
+    }
+    // It is the plant's start transient: three time constants more settling divide it by
+    // e^3 (measured: 20.090 against 20.086).
+    let longer = long_table(3.0);
+    let (w3, _) = tables_of(std::slice::from_ref(&longer), false);
+    let (p3, _) = tables_of(std::slice::from_ref(&longer), true);
+    let d3 = rel_table(&w3[0], &p3[0]);
+    let fold = d / d3 / 3f64.exp();
+    assert!((fold - 1.0).abs() < 0.05, "{d:e} then {d3:e}");
 }

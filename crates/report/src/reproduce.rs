@@ -265,7 +265,7 @@ pub fn reproduce(
             opts,
         )?);
     }
-    let tables = PreparedTables::new(&plan.bandwidth, Some(1))?;
+    let tables = PreparedTables::new(&plan.bandwidth, Some(1), true)?;
     // Every lane group of every experiment and of the bandwidth sweep runs from one queue,
     // the costliest first. The stage-2 leaks depend on the configs alone: items beside the
     // groups compute them, or the read-out that needs them first (an error resurfaces in the
