@@ -140,9 +140,20 @@ pub fn starts_share_carrier(p: &BoardParams, starts: &[u64]) -> bool {
     starts.iter().all(|&n| word(n) == word(starts[0]))
 }
 
-/// The rule of [`Board::with_starts`]: starts that share the carrier.
+/// The latest start [`Board::with_starts`] takes: 2^53 input samples, the longest run a config
+/// may ask for (beyond it a sample index is no longer exact as an f64, and a start plus the
+/// run could pass `u64`).
+pub const MAX_START: u64 = 1 << 53;
+
+/// The rules of [`Board::with_starts`]: starts within [`MAX_START`] that share the carrier.
 fn check_starts(p: &BoardParams, starts: &[u64]) -> Result<(), ParamError> {
     let bad = |v: String, rule: &str| Err(ParamError::new(crate::params::STAGE, "starts", v, rule));
+    if let Some(&n) = starts.iter().find(|&&n| n > MAX_START) {
+        return bad(
+            n.to_string(),
+            "a lane starts at most 2^53 input samples into the time axis",
+        );
+    }
     if !starts_share_carrier(p, starts) {
         return bad(
             format!("{starts:?}"),
@@ -247,12 +258,12 @@ impl<S: Sample> Board<S> {
         table_hz: &[f64],
         streams: &[u64],
     ) -> Result<Self, ParamError> {
-        Self::with_table_hz_starts(p, rates_rad_s, table_hz, streams, &[0])
+        let starts = vec![0; rates_rad_s.len()];
+        Self::with_table_hz_starts(p, rates_rad_s, table_hz, streams, &starts)
     }
 
     /// [`Board::with_table_hz`] with lane `i` starting at input sample `starts[i]` of the
-    /// time axis ([`Board::with_starts`]; `[0]`: every lane at 0): the segments of the
-    /// bandwidth sweep's long points.
+    /// time axis ([`Board::with_starts`]): the segments of the bandwidth sweep's long points.
     pub fn with_table_hz_starts(
         p: &BoardParams,
         rates_rad_s: &[f64],
@@ -260,9 +271,7 @@ impl<S: Sample> Board<S> {
         streams: &[u64],
         starts: &[u64],
     ) -> Result<Self, ParamError> {
-        if starts != [0] {
-            one_per_point("starts", starts.len(), rates_rad_s.len(), "start")?;
-        }
+        one_per_point("starts", starts.len(), rates_rad_s.len(), "start")?;
         let Shape::RateTable { .. } = p.shape else {
             return Err(ParamError::new(
                 crate::params::STAGE,

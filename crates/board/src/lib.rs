@@ -25,7 +25,7 @@ mod probe;
 pub mod reference;
 mod seeding;
 
-pub use board::{drive_shifter, starts_share_carrier, Board};
+pub use board::{drive_shifter, starts_share_carrier, Board, MAX_START};
 pub use chain::{unleak_sidebands, unleak_table_harmonics, ChainResponse, RotatingTerms};
 pub use fault::NonFinite;
 pub use group::GroupBoard;

@@ -9,7 +9,8 @@ mod common;
 
 use common::{m2tfg, noisy, point};
 use gyroemu_board::{
-    max_lanes, starts_share_carrier, Board, GroupBoard, LaneResult, Point, Probe, RunOptions, Shape,
+    max_lanes, starts_share_carrier, Board, GroupBoard, LaneResult, Point, Probe, RunOptions,
+    Shape, MAX_START,
 };
 use gyroemu_core::Complex64;
 use gyroemu_lpf::Window;
@@ -167,6 +168,23 @@ fn starts_the_carrier_cannot_share_are_refused_with_the_rule() {
         .err()
         .unwrap();
     assert!(e.rule.contains("carrier"), "{}", e.rule);
+    let tables = [2.0, 3.0];
+    let e = GroupBoard::with_table_hz_starts(&t, &rad, &tables, &[0, 1], &[0])
+        .err()
+        .unwrap();
+    assert!(e.rule.contains("one start per point"), "{}", e.rule);
+    // Past 2^53 samples a start (and a sample index past it) is no longer exact: refused,
+    // named; the last start allowed, a whole number of carrier turns, is taken.
+    let late = MAX_START + 16;
+    let e = Board::<f64>::with_starts(&p, &rad[..1], &[0], &[late])
+        .err()
+        .unwrap();
+    assert_eq!(
+        (e.param, e.value.as_str()),
+        ("starts", late.to_string().as_str())
+    );
+    assert!(e.rule.contains("2^53"), "{}", e.rule);
+    assert!(Board::<f64>::with_starts(&t, &rad[..1], &[0], &[MAX_START]).is_ok());
 }
 
 #[test]

@@ -199,6 +199,8 @@ fn cut(todo: &[usize], windows: &[(u64, f64)], len: u64) -> Vec<Lane> {
 pub(crate) fn cut_each(todo: &[usize], windows: &[(u64, f64)], lens: &[u64]) -> Vec<Lane> {
     let mut lanes = Vec::new();
     for ((&i, &(n, frac)), &len) in todo.iter().zip(windows).zip(lens) {
+        // A zero length would never end the point.
+        let len = len.max(1);
         let mut a = 0;
         let mut segment = 0;
         while a < n || (a == n && segment == 0) {
@@ -253,11 +255,13 @@ pub fn splittable(cfg: &Config) -> bool {
 /// the whole points and no more than 1/`MIN_IDLE_SAVING` more in groups of four (the same
 /// cut on every machine). The cuts weighed are those that bring every lane within a common
 /// length: each point in the fewest even segments within it, for every length a point's
-/// even cut gives (at most [`MAX_SEGMENTS`] segments a point); `segment` rounds a length up
+/// even cut gives, as it is and rounded by `segment` (at most [`MAX_SEGMENTS`] segments a
+/// point); `segment` rounds a length up
 /// to one whose segments may share any group, or says they may not ([`Packing::SameStart`]:
 /// that cut is not weighed). The bandwidth sweep's points (settling 12.25 s, windows of 40,
 /// 20, 10, 6.7 and five of 4 s) run as 13 lanes of at most 22.25 s: groups of eight of 22.25
-/// and 16.25 s, against a group of four of 52.25 s and one of eight of 16.25 s whole.
+/// and 16.25 s (739 408 lane-samples counted in eights), against 1 315 408 whole (in groups
+/// of eight of 52.25 and 16.25 s; the lane groups a CPU runs may differ, not the cut).
 pub fn cut_to_fill(
     windows: &[(u64, f64)],
     n_settle: u64,
@@ -269,10 +273,11 @@ pub fn cut_to_fill(
         lane_samples_in(&cut_each(&todo, windows, lens), n_settle, width)
     };
     let (whole8, whole4) = (cost(&whole, 8), cost(&whole, 4));
-    // Every common length a point's even cut gives.
+    // Every common length a point's even cut gives, before and after `segment` rounds it.
     let mut targets: Vec<u64> = windows
         .iter()
         .flat_map(|w| (1..=MAX_SEGMENTS).map(move |c| w.0.div_ceil(c)))
+        .flat_map(|t| [t, segment(t).0])
         .filter(|&t| t > 0)
         .collect();
     targets.sort_unstable();
@@ -317,7 +322,8 @@ fn even_cut(
                 return Some(n.max(1));
             }
             let (len, packing) = segment(n.div_ceil(count));
-            (packing == Packing::Free && len <= t && n.div_ceil(len) == count).then_some(len)
+            let fits = len > 0 && len <= t && n.div_ceil(len) == count;
+            (packing == Packing::Free && fits).then_some(len)
         })
         .collect()
 }
@@ -699,6 +705,16 @@ mod tests {
         // Segments that could share a group only with those starting with them: no cut.
         let by_start = |len: u64| (len, Packing::SameStart);
         assert_eq!(cut_to_fill(&windows, s, &by_start), None);
+        // Lengths rounded up to a carrier repeat of 4 blocks: two points of 1000 blocks and
+        // two of 330 (no settling) are weighed with the 1000s in three segments of 336
+        // (rounded from 334): eight lanes within 336 blocks, 8 x 337 lane-samples, against
+        // 8 x 501 for the best cut at a length that needs no rounding (the 1000s in two).
+        let by4 = |len: u64| (len.div_ceil(4) * 4, Packing::Free);
+        let w = [(1_000, 0.0), (1_000, 0.0), (330, 0.0), (330, 0.0)];
+        assert_eq!(cut_to_fill(&w, 0, &by4), Some(vec![336, 336, 330, 330]));
+        // A segment function that gives 0 is never taken.
+        let nothing = |_: u64| (0, Packing::Free);
+        assert_eq!(cut_to_fill(&[(1_000, 0.0); 4], 0, &nothing), None);
     }
 
     #[test]

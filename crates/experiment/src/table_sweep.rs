@@ -82,6 +82,75 @@ pub struct PreparedTables<'c> {
     /// Each group's board (until its run takes it), its points and its settling.
     groups: Vec<(Mutex<Option<GroupBoard>>, Vec<Job>, u64)>,
     outcomes: Vec<Mutex<Option<GroupOutcome>>>,
+    /// The lanes (segments) each point runs as, by (sweep, index).
+    segments: BTreeMap<(usize, usize), usize>,
+}
+
+/// The classes of `cfgs` that can share a lane group (the board but for the table, and the
+/// settling), each with its points, cut into segments with `split` ([`split_jobs`]).
+#[allow(clippy::type_complexity)]
+fn plan_classes(
+    cfgs: &[Config],
+    split: bool,
+) -> Result<Vec<((BoardParams, u64), Vec<Job>)>, SweepError> {
+    let mut classes: Vec<((BoardParams, u64), Vec<Job>)> = Vec::new();
+    for (sweep, cfg) in cfgs.iter().enumerate() {
+        let p = cfg.board_params();
+        let Shape::RateTable { freq_hz } = p.shape else {
+            return Err(SweepError::Param(gyroemu_core::ParamError::new(
+                "experiment",
+                "rate_table",
+                "constant",
+                "a table sweep takes rate-table configs only",
+            )));
+        };
+        let key = board_key(cfg);
+        let jobs = match classes.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, jobs)) => jobs,
+            None => {
+                classes.push((key, Vec::new()));
+                &mut classes.last_mut().expect("just pushed").1
+            }
+        };
+        for (index, &r) in cfg.emulated_rates_dps().iter().enumerate() {
+            jobs.push(Job {
+                sweep,
+                index,
+                point: cfg.plan_point(r),
+                start_block: 0,
+                table_hz: freq_hz,
+                harmonics: p.table_harmonics,
+            });
+        }
+    }
+    if split {
+        for ((_, n_settle), jobs) in &mut classes {
+            *jobs = split_jobs(cfgs, jobs, *n_settle);
+        }
+    }
+    Ok(classes)
+}
+
+/// The work of `cfgs`' table sweeps ([`crate::sweep_work`] of each, the points as each would
+/// run alone: what their results report), with the longest lane (`longest_samples`) their
+/// lane groups run, cut into segments with `split` as [`PreparedTables::new`] cuts them.
+pub fn tables_work(cfgs: &[Config], split: bool) -> Result<crate::Work, SweepError> {
+    let mut work = cfgs
+        .iter()
+        .map(crate::sweep_work)
+        .reduce(|a, b| a.plus(b))
+        .unwrap_or_default();
+    // `longest_s` stays the longest point's signal; its lane may be a segment of it.
+    work.longest_samples = plan_classes(cfgs, split)?
+        .iter()
+        .flat_map(|((_, n_settle), jobs)| {
+            jobs.iter().map(move |j| {
+                (n_settle + j.point.window.samples()) * cfgs[j.sweep].decimation() as u64
+            })
+        })
+        .max()
+        .unwrap_or(0);
+    Ok(work)
 }
 
 impl<'c> PreparedTables<'c> {
@@ -94,41 +163,10 @@ impl<'c> PreparedTables<'c> {
         group_threads: Option<usize>,
         split: bool,
     ) -> Result<Self, SweepError> {
-        // Classes of configs that can share a group, each with its points.
-        let mut classes: Vec<((BoardParams, u64), Vec<Job>)> = Vec::new();
-        for (sweep, cfg) in cfgs.iter().enumerate() {
-            let p = cfg.board_params();
-            let Shape::RateTable { freq_hz } = p.shape else {
-                return Err(SweepError::Param(gyroemu_core::ParamError::new(
-                    "experiment",
-                    "rate_table",
-                    "constant",
-                    "a table sweep takes rate-table configs only",
-                )));
-            };
-            let key = board_key(cfg);
-            let jobs = match classes.iter_mut().find(|(k, _)| *k == key) {
-                Some((_, jobs)) => jobs,
-                None => {
-                    classes.push((key, Vec::new()));
-                    &mut classes.last_mut().expect("just pushed").1
-                }
-            };
-            for (index, &r) in cfg.emulated_rates_dps().iter().enumerate() {
-                jobs.push(Job {
-                    sweep,
-                    index,
-                    point: cfg.plan_point(r),
-                    start_block: 0,
-                    table_hz: freq_hz,
-                    harmonics: p.table_harmonics,
-                });
-            }
-        }
-        if split {
-            for ((_, n_settle), jobs) in &mut classes {
-                *jobs = split_jobs(cfgs, jobs, *n_settle);
-            }
+        let classes = plan_classes(cfgs, split)?;
+        let mut segments: BTreeMap<(usize, usize), usize> = BTreeMap::new();
+        for j in classes.iter().flat_map(|(_, jobs)| jobs) {
+            *segments.entry((j.sweep, j.index)).or_default() += 1;
         }
         let threads = group_threads.unwrap_or_else(rayon::current_num_threads);
         let m_of = |j: &Job| cfgs[j.sweep].decimation() as u64;
@@ -169,6 +207,7 @@ impl<'c> PreparedTables<'c> {
             cfgs,
             outcomes: groups.iter().map(|_| Mutex::new(None)).collect(),
             groups,
+            segments,
         })
     }
 
@@ -237,9 +276,15 @@ impl<'c> PreparedTables<'c> {
         }
         Ok(parts
             .into_iter()
-            .map(|points| {
+            .enumerate()
+            .map(|(sweep, points)| {
                 points
                     .into_iter()
+                    // A point some of whose segments did not run is left out (then missing,
+                    // as a whole point that did not run), never read from part of its window.
+                    .filter(|(index, segs)| {
+                        self.segments.get(&(sweep, *index)) == Some(&segs.len())
+                    })
                     .map(|(index, mut segs)| {
                         segs.sort_by_key(|s| s.0);
                         let segs: Vec<_> = segs.into_iter().map(|(_, w, l)| (w, l)).collect();

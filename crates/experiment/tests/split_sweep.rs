@@ -406,3 +406,36 @@ fn a_rate_tables_long_point_split_reads_the_whole_ones_harmonics() {
     let fold = d / d3 / 3f64.exp();
     assert!((fold - 1.0).abs() < 0.05, "{d:e} then {d3:e}");
 }
+
+#[test]
+fn a_split_table_sweeps_bits_do_not_depend_on_its_threads_and_a_part_run_point_is_missing() {
+    // The long point in eight segments beside a short one of another table frequency (a
+    // 2 Hz table over 2 s, whole), in any grouping.
+    let mut short = long_table(0.0);
+    short.experiment.table_freq_hz = Some(2.0);
+    short.experiment.average_s = 2.0;
+    short.validate().unwrap();
+    let cfgs = [long_table(0.0), short];
+    let run = |threads: Option<usize>| {
+        let t = PreparedTables::new(&cfgs, threads, true).unwrap();
+        for g in 0..t.groups() {
+            t.run_group(g);
+        }
+        t.finish_with_lanes().unwrap().1
+    };
+    let one = run(Some(1));
+    for threads in [Some(2), Some(3), None] {
+        assert_eq!(run(threads), one, "{threads:?}");
+    }
+    // A split point some of whose segments did not run is missing, never read from part of
+    // its window: the long point alone, its eight segments in two groups of four on two
+    // threads, the second not run.
+    let cfgs = [long_table(0.0)];
+    let t = PreparedTables::new(&cfgs, Some(2), true).unwrap();
+    assert_eq!(t.groups(), 2);
+    t.run_group(0);
+    match t.finish() {
+        Err(gyroemu_experiment::SweepError::Missing(points)) => assert_eq!(points, [0]),
+        other => panic!("{other:?}"),
+    }
+}

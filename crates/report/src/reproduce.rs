@@ -17,7 +17,7 @@ use gyroemu_experiment::fit::LineFit;
 use gyroemu_experiment::mutex::lock;
 use gyroemu_experiment::prepared::PreparedSweep;
 use gyroemu_experiment::queue::{run_longest_first, sweep_items, table_items, Item};
-use gyroemu_experiment::table_sweep::PreparedTables;
+use gyroemu_experiment::table_sweep::{tables_work, PreparedTables};
 use gyroemu_experiment::{
     finish_sweep_with, DumpPlan, Reporter, Stage2Leaks, SweepOptions, SweepResult, SweepRun,
     DUMP_STEM,
@@ -112,12 +112,19 @@ pub struct ReproducePlan {
 
 impl ReproducePlan {
     /// The emulation the figures' sweeps and the bandwidth sweep will run (its points as
-    /// each would run alone: the work the results report).
+    /// each would run alone: the work the results report; its longest lane as its long
+    /// points' segments run).
     pub fn work(&self) -> gyroemu_experiment::Work {
+        let bandwidth = tables_work(&self.bandwidth, true).unwrap_or_else(|_| {
+            // Validated rate-table configs plan without error; were one not, its points
+            // would count as they run whole.
+            let each = self.bandwidth.iter().map(gyroemu_experiment::sweep_work);
+            each.reduce(|a, b| a.plus(b)).unwrap_or_default()
+        });
         self.jobs
             .iter()
             .map(|j| job_work(&j.cfg))
-            .chain(self.bandwidth.iter().map(gyroemu_experiment::sweep_work))
+            .chain([bandwidth])
             .reduce(|a, b| a.plus(b))
             .expect("reproduce has jobs")
     }
@@ -645,6 +652,24 @@ mod tests {
             job_work(rot).longest_samples,
             gyroemu_experiment::sweep_work(rot).longest_samples
         );
+        // The bandwidth sweep's longest lane is a 10 s segment of its 0.05 Hz point (12.25 s
+        // of settling), not the point's 52.25 s; its points and point-samples are the same.
+        let lane_s = |samples: u64| samples as f64 / 240_000.0;
+        let split = tables_work(&quick.bandwidth, true).unwrap();
+        let whole = tables_work(&quick.bandwidth, false).unwrap();
+        assert!(
+            (lane_s(split.longest_samples) - 22.25).abs() < 0.01,
+            "{split:?}"
+        );
+        assert!(
+            (lane_s(whole.longest_samples) - 52.25).abs() < 0.01,
+            "{whole:?}"
+        );
+        assert_eq!(
+            (split.points, split.point_samples),
+            (whole.points, whole.point_samples)
+        );
+        assert_eq!(split.longest_s, whole.longest_s);
     }
 
     /// The plan validated in parallel holds what a validation one config after the other
