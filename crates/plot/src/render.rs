@@ -53,26 +53,12 @@ pub fn downsample_rgb(src: &[u8], w: usize, h: usize, k: usize) -> Vec<u8> {
 /// [`downsample_rgb`] into `out` (resized; every byte written).
 fn downsample_into(src: &[u8], w: usize, h: usize, k: usize, out: &mut Vec<u8>) {
     let (ow, oh) = (w / k, h / k);
-    out.clear();
-    out.resize(ow * oh * 3, 0);
+    sized(out, ow * oh * 3);
     if k == 2 {
-        // The PNG path: two rows at a time, two pixels (6 bytes) per output pixel.
         for (oy, o) in out.chunks_exact_mut(ow * 3).enumerate() {
             let r0 = &src[2 * oy * w * 3..][..ow * 6];
             let r1 = &src[(2 * oy + 1) * w * 3..][..ow * 6];
-            for ((a, b), d) in r0
-                .chunks_exact(6)
-                .zip(r1.chunks_exact(6))
-                .zip(o.chunks_exact_mut(3))
-            {
-                for c in 0..3 {
-                    let sum = u16::from(a[c])
-                        + u16::from(a[c + 3])
-                        + u16::from(b[c])
-                        + u16::from(b[c + 3]);
-                    d[c] = ((sum + 2) >> 2) as u8;
-                }
-            }
+            average_rows(r0, r1, o);
         }
         return;
     }
@@ -96,6 +82,55 @@ fn downsample_into(src: &[u8], w: usize, h: usize, k: usize, out: &mut Vec<u8>) 
     }
 }
 
+/// `out` `len` bytes long, whatever they hold (every byte is overwritten next): a kept buffer
+/// that is long enough is cut to length, not cleared.
+fn sized(out: &mut Vec<u8>, len: usize) {
+    if out.len() < len {
+        out.resize(len, 0);
+    }
+    out.truncate(len);
+}
+
+/// One output row of the 2 x 2 average: rows `r0` and `r1` of the canvas, two pixels (6
+/// bytes) per output pixel, rounded to nearest.
+#[inline]
+fn average_rows(r0: &[u8], r1: &[u8], o: &mut [u8]) {
+    for ((a, b), d) in r0
+        .chunks_exact(6)
+        .zip(r1.chunks_exact(6))
+        .zip(o.chunks_exact_mut(3))
+    {
+        for c in 0..3 {
+            let sum = u16::from(a[c]) + u16::from(a[c + 3]) + u16::from(b[c]) + u16::from(b[c + 3]);
+            d[c] = ((sum + 2) >> 2) as u8;
+        }
+    }
+}
+
+/// [`downsample_into`] for `k` = 2 that leaves the canvas white again: each pair of rows is
+/// set to 255 right after it is read, while it is still in cache, so the next figure drawn on
+/// this canvas need not clear it (a separate clear read all of it back from memory first: a
+/// canvas of up to 35 MB, a tenth of a figure's time).
+fn downsample2_whitening(src: &mut [u8], w: usize, h: usize, out: &mut Vec<u8>) {
+    let (ow, oh) = (w / 2, h / 2);
+    sized(out, ow * oh * 3);
+    for (pair, o) in src
+        .chunks_exact_mut(2 * w * 3)
+        .zip(out.chunks_exact_mut(ow * 3))
+    {
+        let (r0, r1) = pair.split_at_mut(w * 3);
+        average_rows(&r0[..ow * 6], &r1[..ow * 6], o);
+        pair.fill(255);
+    }
+}
+
+/// A buffer kept between figures ([`POOL`]), with how many of its leading bytes are known to
+/// be 255 (a canvas left white by [`downsample2_whitening`]).
+struct Kept {
+    buf: Vec<u8>,
+    white: usize,
+}
+
 /// Draws `draw` onto a white `w * k` x `h * k` canvas and leaves it averaged down to `w` x `h`
 /// in `out`.
 fn supersampled<F>(w: u32, h: u32, k: u32, draw: F, out: &mut Vec<u8>) -> Result<(), PlotError>
@@ -105,32 +140,44 @@ where
     let (bw, bh) = (w * k, h * k);
     let len = bw as usize * bh as usize * 3;
     // The canvas is kept between figures ([`take_buffer`]): a fresh one of up to 35 MB per
-    // figure cost a page fault per 4 KiB (about a tenth of a run's figure time).
-    let mut buf = take_buffer(len);
-    buf.clear();
-    buf.resize(len, 255);
+    // figure cost a page fault per 4 KiB (about a tenth of a run's figure time). Only what is
+    // not known to be white is cleared.
+    let Kept { mut buf, white } = take_buffer(len);
+    let dirty = white.min(len)..buf.len().min(len);
+    buf[dirty].fill(255);
+    buf.resize(len.max(buf.len()), 255);
+    let canvas = &mut buf[..len];
     let drawn: DrawResult = (|| {
-        let root = FastLines(BitMapBackend::with_buffer(&mut buf, (bw, bh))).into_drawing_area();
+        let root = FastLines(BitMapBackend::with_buffer(canvas, (bw, bh))).into_drawing_area();
         draw(&root)?;
         root.present()?;
         Ok(())
     })();
-    let res = match drawn {
-        Err(source) => Err(gyroemu_io::IoError::Producer {
-            path: "<memory>".into(),
-            reason: source,
+    // Bytes past the canvas keep what they were; its own are white again only if averaged.
+    let past = if white > len { white } else { len };
+    let (res, white) = match drawn {
+        Err(source) => {
+            let e = gyroemu_io::IoError::Producer {
+                path: "<memory>".into(),
+                reason: source,
+            };
+            (Err(e.into()), 0)
         }
-        .into()),
         Ok(()) if k == 1 => {
+            buf.truncate(len);
             std::mem::swap(&mut buf, out);
-            Ok(())
+            (Ok(()), 0)
+        }
+        Ok(()) if k == 2 => {
+            downsample2_whitening(&mut buf[..len], bw as usize, bh as usize, out);
+            (Ok(()), past)
         }
         Ok(()) => {
-            downsample_into(&buf, bw as usize, bh as usize, k as usize, out);
-            Ok(())
+            downsample_into(&buf[..len], bw as usize, bh as usize, k as usize, out);
+            (Ok(()), 0)
         }
     };
-    give_back(buf);
+    give_back(Kept { buf, white });
     res
 }
 
@@ -149,37 +196,42 @@ fn to_png<F>(path: &Path, w: u32, h: u32, k: u32, draw: F) -> Result<(), PlotErr
 where
     F: FnOnce(&Area) -> DrawResult,
 {
-    let mut rgb = take_buffer(w as usize * h as usize * 3);
+    // An image buffer: every byte is overwritten, so none is white afterwards.
+    let mut rgb = take_buffer(w as usize * h as usize * 3).buf;
     let res = supersampled(w, h, k, draw, &mut rgb).and_then(|()| write_png(path, w, h, &rgb));
-    give_back(rgb);
+    give_back(Kept { buf: rgb, white: 0 });
     res
 }
 
 /// Buffers kept for the next figures (canvases and images): at most [`MAX_POOLED`] of at most
 /// [`MAX_KEPT_BUFFER`] bytes each, whatever the number of threads that draw, so two figures
 /// drawn at once reuse theirs and a process keeps at most 256 MB (88 MB with the presets').
-static POOL: Mutex<Vec<Vec<u8>>> = Mutex::new(Vec::new());
+static POOL: Mutex<Vec<Kept>> = Mutex::new(Vec::new());
 /// Buffers in [`POOL`]: a canvas and an image for each of two figures drawn at once.
 const MAX_POOLED: usize = 4;
 /// Largest buffer kept (bytes): the presets' largest canvas is 35 MB.
 const MAX_KEPT_BUFFER: usize = 64 << 20;
 
 /// A kept buffer for `len` bytes (the smallest that holds them, else the largest, to grow),
-/// or a new one; its contents are for the caller to overwrite.
-fn take_buffer(len: usize) -> Vec<u8> {
+/// or a new one; its contents are for the caller to overwrite (or, up to `white`, 255).
+fn take_buffer(len: usize) -> Kept {
     let mut pool = POOL.lock().unwrap_or_else(|e| e.into_inner());
     let fits = (0..pool.len())
-        .filter(|&i| pool[i].capacity() >= len)
-        .min_by_key(|&i| pool[i].capacity());
-    let pick = fits.or_else(|| (0..pool.len()).max_by_key(|&i| pool[i].capacity()));
-    pick.map(|i| pool.swap_remove(i)).unwrap_or_default()
+        .filter(|&i| pool[i].buf.capacity() >= len)
+        .min_by_key(|&i| pool[i].buf.capacity());
+    let pick = fits.or_else(|| (0..pool.len()).max_by_key(|&i| pool[i].buf.capacity()));
+    pick.map(|i| pool.swap_remove(i)).unwrap_or(Kept {
+        buf: Vec::new(),
+        white: 0,
+    })
 }
 
-/// Keeps `buf` for the next figure, if the pool has room and it is neither empty nor oversized.
-fn give_back(buf: Vec<u8>) {
+/// Keeps `kept` for the next figure, if the pool has room and its buffer is neither empty nor
+/// oversized.
+fn give_back(kept: Kept) {
     let mut pool = POOL.lock().unwrap_or_else(|e| e.into_inner());
-    if pool.len() < MAX_POOLED && (1..=MAX_KEPT_BUFFER).contains(&buf.capacity()) {
-        pool.push(buf);
+    if pool.len() < MAX_POOLED && (1..=MAX_KEPT_BUFFER).contains(&kept.buf.capacity()) {
+        pool.push(kept);
     }
 }
 
@@ -283,16 +335,72 @@ mod tests {
 
     #[test]
     fn the_pool_keeps_at_most_its_bound() {
+        let kept = |buf: Vec<u8>| Kept { buf, white: 0 };
         for n in [0usize, 1, 1000, MAX_KEPT_BUFFER + 1] {
-            give_back(Vec::with_capacity(n));
+            give_back(kept(Vec::with_capacity(n)));
         }
         for _ in 0..10 {
-            give_back(vec![0u8; 100]);
+            give_back(kept(vec![0u8; 100]));
         }
         let pool = POOL.lock().unwrap_or_else(|e| e.into_inner());
         assert!(pool.len() <= MAX_POOLED);
         assert!(pool
             .iter()
-            .all(|b| (1..=MAX_KEPT_BUFFER).contains(&b.capacity())));
+            .all(|b| (1..=MAX_KEPT_BUFFER).contains(&b.buf.capacity())));
+    }
+
+    #[test]
+    fn averaging_that_whitens_gives_the_averages_and_leaves_the_canvas_white() {
+        // A seeded canvas of 10 x 6 pixels: the same output as the plain average, and every
+        // canvas byte 255 after.
+        let (w, h) = (10, 6);
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let src: Vec<u8> = (0..w * h * 3)
+            .map(|_| {
+                s ^= s << 13;
+                s ^= s >> 7;
+                s ^= s << 17;
+                s as u8
+            })
+            .collect();
+        let want = downsample_rgb(&src, w, h, 2);
+        let mut canvas = src.clone();
+        let mut out = vec![9u8; 1000];
+        downsample2_whitening(&mut canvas, w, h, &mut out);
+        assert_eq!(out, want);
+        assert!(canvas.iter().all(|&b| b == 255));
+    }
+
+    #[test]
+    fn figures_drawn_on_kept_canvases_are_those_drawn_on_fresh_ones() {
+        use crate::figure::{Figure, Series, SeriesStyle};
+        // A large figure, a small one and the large one again, in one thread: the kept canvas
+        // (left white by the averaging, or partly by a smaller figure) gives the bytes of a
+        // fresh one, which a render after emptying the pool gets.
+        let fig = |n: usize, w: u32, h: u32| {
+            let xs: Vec<f64> = (0..n).map(|i| i as f64).collect();
+            let ys: Vec<f64> = xs.iter().map(|x| (x * 0.37).sin()).collect();
+            let mut f = Figure::new("kept", "x", "y")
+                .with(Series::new(
+                    "line",
+                    SeriesStyle::Line,
+                    xs.clone(),
+                    ys.clone(),
+                ))
+                .with(Series::new("points", SeriesStyle::Points, xs, ys));
+            f.width_px = w;
+            f.height_px = h;
+            f
+        };
+        let (big, small) = (fig(300, 640, 480), fig(50, 200, 150));
+        let fresh = |f: &Figure| {
+            POOL.lock().unwrap_or_else(|e| e.into_inner()).clear();
+            render_rgb_antialiased(f).unwrap()
+        };
+        let (big0, small0) = (fresh(&big), fresh(&small));
+        for f in [&big, &small, &big, &small, &big] {
+            let want = if f.width_px == 640 { &big0 } else { &small0 };
+            assert_eq!(&render_rgb_antialiased(f).unwrap(), want);
+        }
     }
 }
