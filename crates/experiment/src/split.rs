@@ -60,7 +60,7 @@ pub enum Packing {
 ///   1/[`MIN_IDLE_SAVING`] fewer lane-samples than the whole points do with their groups'
 ///   idle lanes ([`lane_samples_in_fours`]); where those segments leave lanes of groups of
 ///   eight idle, the points with the longest segments then take one segment more each to
-///   fill them, every point cut evenly ([`fill_eights`]): Fig. 5's seven BAW points, 1 s each, run as 32 segments (four points
+///   fill them, every point cut evenly (`fill_eights`): Fig. 5's seven BAW points, 1 s each, run as 32 segments (four points
 ///   in five, three in four) in four full groups of eight, or eight of four.
 ///
 /// A dump that does not fit keeps the sweep whole: its bits are then a continuous run's, not a
