@@ -10,7 +10,7 @@
 //! The cut depends on the config alone (never on the machine), so a split sweep gives the
 //! same bits on every CPU, lane width and thread count.
 
-use gyroemu_board::{starts_share_carrier, LaneResult, Point, MAX_LANES};
+use gyroemu_board::{starts_share_carrier, BoardParams, LaneResult, Point, MAX_LANES};
 use gyroemu_config::Config;
 use gyroemu_core::Complex64;
 use gyroemu_lpf::Window;
@@ -167,8 +167,9 @@ fn fill_eights(cfg: &Config, windows: &[(u64, f64)], lens: &[u64]) -> Option<Vec
         counts[p] += 1;
     }
     let mut even = Vec::with_capacity(windows.len());
+    let p = cfg.board_params();
     for (&(n, _), &c) in windows.iter().zip(&counts) {
-        let (len, packing) = segment_length(cfg, n.div_ceil(c));
+        let (len, packing) = segment_length_on(&p, n.div_ceil(c));
         if packing != Packing::Free || count(n, len) != c {
             return None;
         }
@@ -332,14 +333,19 @@ fn even_cut(
 /// of the carrier's repeat where that repeat is short (then any segments share a lane group),
 /// else `len` (segments share a group only with those starting with them).
 pub fn segment_length(cfg: &Config, len: u64) -> (u64, Packing) {
-    let p = cfg.board_params();
-    let m = cfg.decimation() as u64;
+    segment_length_on(&cfg.board_params(), len)
+}
+
+/// [`segment_length`] on the board `p` (for callers that weigh many lengths: a rate table's
+/// board parameters take steady-state solves to build).
+pub fn segment_length_on(p: &BoardParams, len: u64) -> (u64, Packing) {
+    let m = p.decimation as u64;
     // The carrier's phase word repeats after a power of two of samples: the first power of
     // two of blocks at which it does, if one below 1/16 of the segment.
     (0..=20)
         .map(|e| 1u64 << e)
         .take_while(|&u| 16 * u <= len)
-        .find(|&u| starts_share_carrier(&p, &[0, u * m]))
+        .find(|&u| starts_share_carrier(p, &[0, u * m]))
         .map_or((len, Packing::SameStart), |u| {
             (len.div_ceil(u) * u, Packing::Free)
         })

@@ -7,7 +7,7 @@
 
 use crate::mutex::lock;
 use crate::readout::SweepResult;
-use crate::split::{combine, cut_each, cut_to_fill, segment_length, splittable};
+use crate::split::{combine, cut_each, cut_to_fill, segment_length_on, splittable};
 use crate::sweep::{finish_sweep, group_samples, SweepError};
 use gyroemu_board::{group_sizes, BoardParams, GroupBoard, LaneResult, RunOptions, Shape};
 use gyroemu_config::Config;
@@ -334,9 +334,10 @@ fn split_jobs(cfgs: &[Config], jobs: &[Job], n_settle: u64) -> Vec<Job> {
     let (Some(windows), Some(first)) = (windows, jobs.first()) else {
         return jobs.to_vec();
     };
-    // The carrier, sample rate and decimation are the class's: any of its configs rounds.
-    let cfg = &cfgs[first.sweep];
-    let Some(lens) = cut_to_fill(&windows, n_settle, &|len| segment_length(cfg, len)) else {
+    // The carrier, sample rate and decimation are the class's: any of its configs rounds
+    // (its board parameters built once: a rate table's take steady-state solves).
+    let p = cfgs[first.sweep].board_params();
+    let Some(lens) = cut_to_fill(&windows, n_settle, &|len| segment_length_on(&p, len)) else {
         return jobs.to_vec();
     };
     let todo: Vec<usize> = (0..jobs.len()).collect();
