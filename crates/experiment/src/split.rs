@@ -175,15 +175,24 @@ fn fill_eights(cfg: &Config, windows: &[(u64, f64)], lens: &[u64]) -> Option<Vec
         }
         even.push(len);
     }
+    pays_off(windows, cfg.n_settle_out(), lens, &even).then_some(even)
+}
+
+/// The lane-samples of `windows` cut at `lens` (per point) in groups of `width`.
+fn cut_cost(windows: &[(u64, f64)], n_settle: u64, lens: &[u64], width: usize) -> u64 {
     let todo: Vec<usize> = (0..windows.len()).collect();
-    let n_settle = cfg.n_settle_out();
-    let cost = |lens: &[u64], width: usize| {
-        lane_samples_in(&cut_each(&todo, windows, lens), n_settle, width)
-    };
-    let (eights, fours) = (cost(lens, 8), cost(lens, 4));
-    let gains = cost(&even, 8).saturating_add(eights / MIN_IDLE_SAVING) <= eights;
-    let fair = cost(&even, 4) <= fours.saturating_add(fours / MIN_IDLE_SAVING);
-    (gains && fair).then_some(even)
+    lane_samples_in(&cut_each(&todo, windows, lens), n_settle, width)
+}
+
+/// The cut at `after` (per point) is worth taking over the one at `before`: at least
+/// 1/[`MIN_IDLE_SAVING`] fewer lane-samples in groups of eight and at most 1/`MIN_IDLE_SAVING`
+/// more in groups of four (a gain where eight lanes run, no real loss where four do).
+fn pays_off(windows: &[(u64, f64)], n_settle: u64, before: &[u64], after: &[u64]) -> bool {
+    let cost = |lens: &[u64], width: usize| cut_cost(windows, n_settle, lens, width);
+    let (eights, fours) = (cost(before, 8), cost(before, 4));
+    let gains = cost(after, 8).saturating_add(eights / MIN_IDLE_SAVING) <= eights;
+    let fair = cost(after, 4) <= fours.saturating_add(fours / MIN_IDLE_SAVING);
+    gains && fair
 }
 
 /// A split for idle lanes is taken only if it runs at least 1/this fewer lane-samples (a
@@ -269,11 +278,6 @@ pub fn cut_to_fill(
     segment: &dyn Fn(u64) -> (u64, Packing),
 ) -> Option<Vec<u64>> {
     let whole: Vec<u64> = windows.iter().map(|w| w.0.max(1)).collect();
-    let todo: Vec<usize> = (0..windows.len()).collect();
-    let cost = |lens: &[u64], width: usize| {
-        lane_samples_in(&cut_each(&todo, windows, lens), n_settle, width)
-    };
-    let (whole8, whole4) = (cost(&whole, 8), cost(&whole, 4));
     // Every common length a point's even cut gives, before and after `segment` rounds it.
     let mut targets: Vec<u64> = windows
         .iter()
@@ -293,16 +297,14 @@ pub fn cut_to_fill(
             .zip(&lens)
             .map(|(w, &l)| w.0.div_ceil(l) as usize)
             .sum();
-        let c8 = cost(&lens, 8);
+        let c8 = cut_cost(windows, n_settle, &lens, 8);
         // Of equal costs, the fewer lanes (the less settling).
         if best.as_ref().is_none_or(|(b, n, _)| (c8, lanes) < (*b, *n)) {
             best = Some((c8, lanes, lens));
         }
     }
-    let (c8, _, lens) = best?;
-    let gains = c8.saturating_add(whole8 / MIN_IDLE_SAVING) <= whole8;
-    let fair = cost(&lens, 4) <= whole4.saturating_add(whole4 / MIN_IDLE_SAVING);
-    (gains && fair && lens != whole).then_some(lens)
+    let (_, _, lens) = best?;
+    (lens != whole && pays_off(windows, n_settle, &whole, &lens)).then_some(lens)
 }
 
 /// Per point, the length of its fewest even segments within `t` decimated samples (rounded
