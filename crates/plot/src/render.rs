@@ -114,7 +114,10 @@ fn average_rows(r0: &[u8], r1: &[u8], o: &mut [u8]) {
 /// pixels that is white in both rows gives white and is not written: most of a figure is
 /// background, and a stretch left clean in cache costs memory no write-back.
 fn downsample2_whitening(src: &mut [u8], w: usize, h: usize, out: &mut Vec<u8>) {
-    debug_assert!(w % 2 == 0 && h % 2 == 0, "a canvas twice an image's size");
+    debug_assert!(
+        w.is_multiple_of(2) && h.is_multiple_of(2),
+        "a canvas twice an image's size"
+    );
     let (ow, oh) = (w / 2, h / 2);
     sized(out, ow * oh * 3);
     let (run, used) = (WHITE_RUN * 3, w * 3);
