@@ -1,5 +1,6 @@
 //! The bitmap backend with one faster path: an opaque axis-aligned line wider than one pixel
-//! (the figures' grid lines) is filled as the rectangle it covers. plotters draws every wide
+//! (the figures' grid lines, and the sides of their frames) is filled as the rectangle it
+//! covers. plotters draws every wide
 //! line as a polygon, swept one pixel row at a time with an allocation and a sort per row;
 //! the grid lines of a run's figures took about 40 % of their drawing time that way. The
 //! rectangle is exactly the pixels the polygon path sets (tested pixel for pixel against it),
@@ -101,7 +102,13 @@ impl<'a> DrawingBackend for FastLines<'a> {
         style: &S,
         fill: bool,
     ) -> Result<(), Error<'a>> {
-        self.0.draw_rect(upper_left, bottom_right, style, fill)
+        if fill {
+            return self.0.draw_rect(upper_left, bottom_right, style, fill);
+        }
+        // The bitmap draws an outline as its four sides by plotters' rasterizer on itself, so
+        // a wide one (the figures' frames) took the polygon path; the same rasterizer on this
+        // backend draws the same four sides in the same order through the fast path above.
+        plotters_backend::rasterizer::draw_rect(self, upper_left, bottom_right, style, fill)
     }
 
     fn blit_bitmap(
@@ -173,6 +180,44 @@ mod tests {
         }
         // The walk exercised the fast path, not only the fallback.
         assert!(fast_taken > 2000, "{fast_taken}");
+    }
+
+    #[test]
+    fn rectangle_outlines_set_the_bitmaps_pixels() {
+        // Seeded: outlines of widths 1-8 with corners in any order, inside and across the
+        // canvas edges, opaque and translucent; and filled ones, which stay the bitmap's.
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut next = |n: i32| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x % n as u64) as i32
+        };
+        for case in 0..2000 {
+            let w = 1 + (case % 8) as u32;
+            let a = (next(W as i32 + 20) - 10, next(H as i32 + 20) - 10);
+            let b = (next(W as i32 + 20) - 10, next(H as i32 + 20) - 10);
+            let colour = RGBColor(next(256) as u8, 9, next(256) as u8);
+            let c = if case % 5 == 4 {
+                colour.mix(0.6)
+            } else {
+                colour.to_rgba()
+            };
+            let fill = case % 7 == 6;
+            let mut plain = vec![255u8; (W * H * 3) as usize];
+            let mut fast = plain.clone();
+            {
+                let style = Color::stroke_width(&c, w);
+                let mut p = BitMapBackend::with_buffer(&mut plain, (W, H));
+                let mut f = FastLines(BitMapBackend::with_buffer(&mut fast, (W, H)));
+                p.draw_rect(a, b, &style, fill).unwrap();
+                f.draw_rect(a, b, &style, fill).unwrap();
+            }
+            assert!(
+                plain == fast,
+                "rectangle {a:?} {b:?}, width {w}, colour {c:?}, fill {fill}"
+            );
+        }
     }
 
     #[test]
