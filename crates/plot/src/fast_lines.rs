@@ -9,7 +9,7 @@
 
 use plotters::prelude::BitMapBackend;
 use plotters_backend::{
-    BackendColor, BackendCoord, BackendStyle, DrawingBackend, DrawingErrorKind,
+    BackendColor, BackendCoord, BackendStyle, BackendTextStyle, DrawingBackend, DrawingErrorKind,
 };
 
 /// [`BitMapBackend`] with axis-aligned wide lines filled as rectangles.
@@ -165,6 +165,19 @@ impl<'a> DrawingBackend for FastLines<'a> {
             }
         }
         self.fill_polygon(polygon, &style.color())
+    }
+
+    fn draw_text<TStyle: BackendTextStyle>(
+        &mut self,
+        text: &str,
+        style: &TStyle,
+        pos: BackendCoord,
+    ) -> Result<(), Error<'a>> {
+        if let Some(drawn) = crate::glyphs::draw_text(self, text, style, pos) {
+            return drawn;
+        }
+        // Another family: the trait's own `draw_text`, on the bitmap.
+        self.0.draw_text(text, style, pos)
     }
 
     fn draw_rect<S: BackendStyle>(

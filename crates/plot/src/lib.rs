@@ -10,6 +10,7 @@ mod error;
 mod fast_lines;
 mod figure;
 mod font;
+mod glyphs;
 mod render;
 
 pub use axis::{finite_bounds, AxisScale, MARGIN_FRACTION};
