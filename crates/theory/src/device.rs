@@ -237,10 +237,50 @@ impl DrivenDevice {
     /// periodic steady state (harmonic balance, at any swing), as `(amplitude rad, lag rad)`
     /// per mode, a lag `a sin(w_t t - l)` read as `(a, l)`. NaN when the envelope passes
     /// through 0 (no continuous phase).
+    ///
+    /// Remembered (the last [`MEMO_LEN`] answers, process-wide): a run asks it of the same
+    /// device and table in several rules of its validation and again in its read-out, and each
+    /// answer solves the harmonic balance and reads the phase on grids of up to 2^18 points.
     pub fn rate_table_response(&self, amplitude_rad_s: f64, table_hz: f64) -> ([f64; 2], [f64; 2]) {
+        // Keyed by the device's `Debug` text, which writes every field, each f64 so that it
+        // reads back to the same bits (so -0 and 0 are told apart, as `==` would not).
+        let key = (
+            format!("{self:?}"),
+            amplitude_rad_s.to_bits(),
+            table_hz.to_bits(),
+        );
+        let memo = || RESPONSES.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, found)) = memo().iter().find(|(k, _)| *k == key) {
+            return *found;
+        }
+        let found = self.rate_table_response_solved(amplitude_rad_s, table_hz);
+        let mut kept = memo();
+        if kept.len() >= MEMO_LEN {
+            kept.remove(0);
+        }
+        kept.push((key, found));
+        found
+    }
+
+    /// [`DrivenDevice::rate_table_response`], solved (not remembered).
+    pub fn rate_table_response_solved(
+        &self,
+        amplitude_rad_s: f64,
+        table_hz: f64,
+    ) -> ([f64; 2], [f64; 2]) {
         fundamental_of(|n| self.rate_table_envelopes(amplitude_rad_s, table_hz, n))
     }
 }
+
+/// A rate-table response's key (the device's `Debug` text, the amplitude's and the table
+/// frequency's bits) and its answer.
+type Remembered = ((String, u64, u64), ([f64; 2], [f64; 2]));
+
+/// The answers [`DrivenDevice::rate_table_response`] remembers, oldest first.
+static RESPONSES: std::sync::Mutex<Vec<Remembered>> = std::sync::Mutex::new(Vec::new());
+
+/// How many rate-table responses are remembered (a `reproduce` asks about 20 distinct ones).
+pub const MEMO_LEN: usize = 64;
 
 /// The most envelope harmonics a rate table's theory takes (a swing of 785 degrees needs
 /// about 150); a swing that needs more has no theory here (NaN).

@@ -9,6 +9,6 @@ mod plant_modes;
 pub mod quantiser;
 
 pub use closed_form::*;
-pub use device::{converged_envelopes, DrivenDevice, MAX_THEORY_HARMONICS};
+pub use device::{converged_envelopes, DrivenDevice, MAX_THEORY_HARMONICS, MEMO_LEN};
 pub use plant_modes::{coupled_modes, held_response};
 pub use quantiser::{quantiser_bias_bound, quantiser_phase_bound_rad};

@@ -64,3 +64,35 @@ fn quasi_static_swings_are_atan_of_the_rate() {
         }
     }
 }
+
+#[test]
+fn remembered_responses_are_the_solved_ones() {
+    // The same device and table asked again, after other devices (a mistuned mode, a
+    // coupling of -0 beside +0, other amplitudes) and after more than the memo holds: every
+    // answer has the bits of a fresh solve, and a device one field apart gets its own.
+    let bits = |r: ([f64; 2], [f64; 2])| [r.0[0], r.0[1], r.1[0], r.1[1]].map(f64::to_bits);
+    let base = fork(36_000.0);
+    let mut detuned = base;
+    detuned.plant.mode2.f0_hz += 0.5;
+    let mut minus_zero = base;
+    minus_zero.plant.quadrature_coupling_rad2_s2 = -0.0;
+    let devices = [base, detuned, minus_zero];
+    let asks: Vec<(DrivenDevice, f64)> = (0..gyroemu_theory::MEMO_LEN + 6)
+        .map(|i| (devices[i % 3], 0.01 * (1 + i % 5) as f64))
+        .chain((0..gyroemu_theory::MEMO_LEN + 3).map(|i| (base, 0.2 + 1e-3 * i as f64)))
+        .chain([(base, 0.01), (detuned, 0.01), (minus_zero, 0.02)])
+        .collect();
+    for (dev, amp) in asks {
+        let want = bits(dev.rate_table_response_solved(amp, 2.0));
+        assert_eq!(
+            bits(dev.rate_table_response(amp, 2.0)),
+            want,
+            "{dev:?} {amp}"
+        );
+    }
+    // The detuned device reads otherwise than the matched one (the memo keeps them apart).
+    assert_ne!(
+        bits(detuned.rate_table_response(0.01, 2.0)),
+        bits(base.rate_table_response(0.01, 2.0))
+    );
+}
