@@ -17,7 +17,9 @@ mod recorder;
 mod sigmf;
 mod wav;
 
-pub use atomic::{remove_temporaries, write_atomic, write_atomic_via};
+pub use atomic::{
+    deferred_dir_syncs, remove_temporaries, with_deferred_dir_sync, write_atomic, write_atomic_via,
+};
 pub use bounded_read::{
     read_capped, read_own_text, MAX_LOCK_BYTES, MAX_MANIFEST_BYTES, MAX_RECORD_BYTES,
 };
