@@ -379,6 +379,38 @@ mod tests {
     }
 
     #[test]
+    fn the_two_by_two_average_is_the_rounded_mean_of_each_block() {
+        // Against the mean written out pixel by pixel, on seeded canvases whose widths leave
+        // every remainder after whole blocks of BLOCK_PX (and none, and no whole block).
+        let mut s = 0x9E37_79B9_7F4A_7C15u64;
+        for w in [2, 4, 30, 32, 34, 62, 64, 66, 96, 128, 150] {
+            let h = 4;
+            let src: Vec<u8> = (0..w * h * 3)
+                .map(|_| {
+                    s ^= s << 13;
+                    s ^= s >> 7;
+                    s ^= s << 17;
+                    s as u8
+                })
+                .collect();
+            let px = |x: usize, y: usize, c: usize| u32::from(src[(y * w + x) * 3 + c]);
+            let want: Vec<u8> = (0..h / 2)
+                .flat_map(|oy| (0..w / 2).map(move |ox| (ox, oy)))
+                .flat_map(|(ox, oy)| {
+                    (0..3).map(move |c| {
+                        let sum = px(2 * ox, 2 * oy, c)
+                            + px(2 * ox + 1, 2 * oy, c)
+                            + px(2 * ox, 2 * oy + 1, c)
+                            + px(2 * ox + 1, 2 * oy + 1, c);
+                        ((sum + 2) / 4) as u8
+                    })
+                })
+                .collect();
+            assert_eq!(downsample_rgb(&src, w, h, 2), want, "width {w}");
+        }
+    }
+
+    #[test]
     fn averaging_that_whitens_gives_the_averages_and_leaves_the_canvas_white() {
         // Seeded canvases of 150 x 6 pixels (two whole stretches of 64 and a part of 22 per
         // row): every byte random, and white with a few bytes of ink (one in 97, so some
