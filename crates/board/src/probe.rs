@@ -468,6 +468,12 @@ impl Probe {
     /// Writes `<stem>_fullrate.{csv,wav,sigmf-data,sigmf-meta}` and the same of
     /// `<stem>_decimated` into `dir` (each when it has channels); returns the paths written.
     pub fn write(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, IoError> {
+        // The files synced together (one journal commit, not one each), then renamed.
+        gyroemu_io::with_batched_persist(|| self.write_each(dir, stem))
+    }
+
+    /// [`Probe::write`]'s files, one writer after the other.
+    fn write_each(&self, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, IoError> {
         let mut files = Vec::new();
         if !self.full.names().is_empty() {
             let more = self.event_extra(0);
