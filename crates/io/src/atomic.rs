@@ -151,7 +151,10 @@ thread_local! {
 /// blocked for about 5 ms). If `f` fails, or a sync does, none of its files is put in place
 /// (their temporaries are deleted, the targets untouched); a rename that fails stops the
 /// rest. Until it returns, the files are not at their paths: `f` must not read them back.
-/// Nested calls join the outermost one.
+/// Nested calls join the outermost one. The batch belongs to the thread, so `f` must not wait
+/// on a thread pool that may run other work on this thread meanwhile (rayon's `join` or a
+/// parallel iterator: a job taken up there would write into this batch, and find its files
+/// missing if it read them back); a dump's writers run on their own.
 pub fn with_batched_persist<R>(f: impl FnOnce() -> Result<R, IoError>) -> Result<R, IoError> {
     BATCH.with_borrow_mut(|b| b.get_or_insert_with(|| (0, Vec::new())).0 += 1);
     /// Closes this call's level if `f` panics: the outermost drops its files (their
