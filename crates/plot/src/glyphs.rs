@@ -15,8 +15,8 @@ use std::cell::RefCell;
 use std::collections::HashMap;
 use std::sync::OnceLock;
 
-/// A glyph as plotters draws it at the origin: its coverage `(x, y, c)` in ab_glyph's order,
-/// and its vertical shift.
+/// A glyph as plotters draws it at the origin: its coverage `(x, y, c)` in ab_glyph's order
+/// (the pixels it covers at all), and its vertical shift.
 struct Glyph {
     y_shift: i32,
     coverage: Vec<(u32, u32, f32)>,
@@ -140,8 +140,14 @@ fn rasterise(face: &FontRef<'static>, size: f64, c: char) -> Option<Glyph> {
     let q = font.outline_glyph(font.scaled_glyph(c))?;
     let rect = q.px_bounds();
     let y_shift = ((size as f32) / 2.0 + rect.min.y) as i32;
+    // A pixel of no coverage is left out: drawn, its alpha of 0 leaves the bitmap's pixel as
+    // it was (the bitmap returns before writing it).
     let mut coverage = Vec::new();
-    q.draw(|x, y, c| coverage.push((x, y, c)));
+    q.draw(|x, y, c| {
+        if c > 0.0 {
+            coverage.push((x, y, c))
+        }
+    });
     Some(Glyph { y_shift, coverage })
 }
 
