@@ -258,7 +258,10 @@ fn sync_dir_now_or_later(dir: PathBuf) {
 /// after every rename into it. Every file is still synced before its rename, so a reader
 /// never sees a partial file; only the durability of the names waits, until this returns.
 /// Why: `reproduce` writes 74 files into 6 directories, and a directory sync per file (about
-/// 0.3 ms each) held a worker thread blocked for tens of milliseconds.
+/// 0.3 ms each) held a worker thread blocked for tens of milliseconds. The owed set is the
+/// process's: while calls on several threads overlap, every sync waits for the last of them
+/// to return. An exit that skips destructors (a second Ctrl-C) leaves the syncs unpaid: the
+/// files are whole, their names not yet durable.
 pub fn with_deferred_dir_sync<R>(f: impl FnOnce() -> R) -> R {
     {
         let mut d = deferred();

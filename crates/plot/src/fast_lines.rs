@@ -50,20 +50,23 @@ pub(crate) fn wide_axis_line_rect(
 
 /// The rectangle (upper left, bottom right exclusive) of pixels that `fill_polygon` sets for
 /// the rectangle `[xl, xr] x [yt, yb]` with integer corners (the rule above); `None` where it
-/// is degenerate, or at the end of `i32`'s range.
+/// is degenerate, or at the end of `i32`'s range, or wider or taller than `i32` counts.
 fn filled_rect(xl: i32, xr: i32, yt: i32, yb: i32) -> Option<(BackendCoord, BackendCoord)> {
     if xl == xr || yt == yb {
         // A degenerate polygon: plotters draws a one-pixel line instead.
         return None;
     }
+    // A span past `i32` (a line from -1.5e9 to 1.5e9) would wrap to a negative one and pick
+    // the wrong sweep: such a rectangle keeps plotters' path.
+    let (w, h) = (xr.checked_sub(xl)?, yb.checked_sub(yt)?);
     // The exclusive corner one past the last pixel: a line at the end of `i32`'s range
     // keeps plotters' path rather than wrap.
-    Some(if xr - xl <= yb - yt {
+    Some(if w <= h {
         // Rows yt ..= yb, the last only if the edges are at most one pixel apart.
-        let last = if xr - xl > 1 { yb } else { yb.checked_add(1)? };
+        let last = if w > 1 { yb } else { yb.checked_add(1)? };
         ((xl, yt), (xr.checked_add(1)?, last))
     } else {
-        let last = if yb - yt > 1 { xr } else { xr.checked_add(1)? };
+        let last = if h > 1 { xr } else { xr.checked_add(1)? };
         ((xl, yt), (last, yb.checked_add(1)?))
     })
 }
@@ -363,6 +366,34 @@ mod tests {
         assert!(wide_axis_line_rect((10, i32::MAX - 3), (30, i32::MAX - 3), 4).is_some());
         let (plain, fast) = both(&[((10, i32::MAX - 3), (30, i32::MAX - 3), 4, black)]);
         assert!(plain == fast);
+    }
+
+    #[test]
+    fn spans_wider_than_i32_keep_plotters_path() {
+        // From -1.5e9 to 1.5e9 the span wraps in `i32`: plotters' own pixels, for a line, a
+        // two-point path and a rectangle outline, both ways, widths 2 to 5.
+        let (a, b) = (-1_500_000_000, 1_500_000_000);
+        assert_eq!(filled_rect(a, b, 8, 11), None);
+        assert_eq!(filled_rect(8, 11, a, b), None);
+        let black = RGBColor(0, 0, 0).to_rgba();
+        for w in 2..=5 {
+            let style = Color::stroke_width(&black, w);
+            for (from, to) in [((a, 10), (b, 10)), ((10, a), (10, b))] {
+                let mut plain = vec![255u8; (W * H * 3) as usize];
+                let mut fast = plain.clone();
+                {
+                    let mut p = BitMapBackend::with_buffer(&mut plain, (W, H));
+                    let mut f = FastLines(BitMapBackend::with_buffer(&mut fast, (W, H)));
+                    p.draw_line(from, to, &style).unwrap();
+                    f.draw_line(from, to, &style).unwrap();
+                    p.draw_path([from, to], &style).unwrap();
+                    f.draw_path([from, to], &style).unwrap();
+                    p.draw_rect(from, (to.0, to.1 + 3), &style, false).unwrap();
+                    f.draw_rect(from, (to.0, to.1 + 3), &style, false).unwrap();
+                }
+                assert!(plain == fast, "{from:?} -> {to:?}, width {w}");
+            }
+        }
     }
 
     #[test]

@@ -47,7 +47,11 @@ fn faces() -> Option<&'static (FontRef<'static>, FontRef<'static>)> {
 }
 
 /// Which bundled face plotters draws `style` in (its fallback for a style not registered is
-/// the regular one), or `None` for text in another family.
+/// the regular one), or `None` for text in another family. Read from the style's label:
+/// plotters resolves a `FontDesc`'s face when it is made, and its `FontDesc::style` changes
+/// the label alone, so a style relabelled that way would be drawn here in the other face.
+/// This crate makes its styles only by `font::text` and `font::bold` (which make each face
+/// under its own label) and never relabels one, nor does plotters.
 fn face_of<S: BackendTextStyle>(style: &S) -> Option<(bool, &'static FontRef<'static>)> {
     if style.family().as_str() != FONT_FAMILY {
         return None;
