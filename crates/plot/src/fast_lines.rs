@@ -170,6 +170,15 @@ impl<'a> DrawingBackend for FastLines<'a> {
         self.fill_polygon(polygon, &style.color())
     }
 
+    fn fill_polygon<S: BackendStyle, I: IntoIterator<Item = BackendCoord>>(
+        &mut self,
+        vert: I,
+        style: &S,
+    ) -> Result<(), Error<'a>> {
+        let vertices: Vec<_> = vert.into_iter().collect();
+        crate::polygon::fill_polygon(self, &vertices, style)
+    }
+
     fn draw_text<TStyle: BackendTextStyle>(
         &mut self,
         text: &str,

@@ -11,6 +11,7 @@ mod fast_lines;
 mod figure;
 mod font;
 mod glyphs;
+mod polygon;
 mod render;
 
 pub use axis::{finite_bounds, AxisScale, MARGIN_FRACTION};
