@@ -3,18 +3,9 @@
 //! temporaries deleted, earlier files at those paths untouched), and nested calls join the
 //! outermost.
 
+mod common;
+use common::entries;
 use gyroemu_io::{batched_files, with_batched_persist, write_atomic, IoError};
-use std::path::Path;
-
-/// The names in `dir`, sorted (temporaries included: they start with a dot).
-fn names(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
 
 #[test]
 fn a_batch_puts_its_files_in_place_together() {
@@ -27,9 +18,9 @@ fn a_batch_puts_its_files_in_place_together() {
         // Nothing at the targets yet: six temporaries, held by the batch.
         assert_eq!(batched_files(), 6);
         assert!(
-            names(d).iter().all(|n| n.starts_with('.')),
+            entries(d).iter().all(|n| n.starts_with('.')),
             "{:?}",
-            names(d)
+            entries(d)
         );
         // A nested batch joins this one.
         with_batched_persist(|| write_atomic(&d.join("inner.txt"), b"in"))?;
@@ -42,7 +33,7 @@ fn a_batch_puts_its_files_in_place_together() {
     let mut want: Vec<String> = (0..6).map(|i| format!("f{i}.txt")).collect();
     want.push("inner.txt".into());
     want.sort();
-    assert_eq!(names(d), want);
+    assert_eq!(entries(d), want);
     for i in 0..6 {
         let body = std::fs::read_to_string(d.join(format!("f{i}.txt"))).unwrap();
         assert_eq!(body, format!("body {i}"));
@@ -65,7 +56,7 @@ fn a_failed_or_panicking_batch_puts_nothing_in_place() {
     });
     assert!(failed.is_err());
     // The earlier file keeps its contents, the new one never appears, no temporary is left.
-    assert_eq!(names(d), vec!["kept.txt".to_string()]);
+    assert_eq!(entries(d), vec!["kept.txt".to_string()]);
     assert_eq!(std::fs::read(d.join("kept.txt")).unwrap(), b"old");
     assert_eq!(batched_files(), 0);
     let caught = std::panic::catch_unwind(|| {
@@ -75,7 +66,7 @@ fn a_failed_or_panicking_batch_puts_nothing_in_place() {
         })
     });
     assert!(caught.is_err());
-    assert_eq!(names(d), vec!["kept.txt".to_string()]);
+    assert_eq!(entries(d), vec!["kept.txt".to_string()]);
     // The thread's batch is closed: the next write is in place at once.
     assert_eq!(batched_files(), 0);
     write_atomic(&d.join("after.txt"), b"a").unwrap();

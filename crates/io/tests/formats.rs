@@ -1,8 +1,9 @@
 //! Round trips through independent readers (csv crate, serde_json, hound).
 
+mod common;
+use common::entries;
 use gyroemu_io::{write_csv, write_json, write_wav_f32, CsvCell, CsvTable, IoError};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 /// Deterministic stream of arbitrary finite f64 bit patterns (all exponents, subnormals).
 fn weird_floats(n: usize) -> Vec<f64> {
@@ -28,15 +29,6 @@ fn weird_floats(n: usize) -> Vec<f64> {
         }
     }
     out
-}
-
-fn only_entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 #[test]
@@ -79,7 +71,7 @@ fn csv_rereads_bit_exact_with_header() {
         n += 1;
     }
     assert_eq!(n, xs.len());
-    assert_eq!(only_entries(dir.path()), vec!["t.csv"]);
+    assert_eq!(entries(dir.path()), vec!["t.csv"]);
 }
 
 #[test]
@@ -104,7 +96,7 @@ fn csv_wrong_row_width_is_refused_and_writes_nothing() {
         "{err}"
     );
     assert!(err.to_string().contains("bad.csv"));
-    assert!(only_entries(dir.path()).is_empty());
+    assert!(entries(dir.path()).is_empty());
 }
 
 #[derive(Serialize, Deserialize, Debug, PartialEq)]
@@ -198,7 +190,7 @@ fn wav_refuses_bad_requests_before_writing() {
     assert!(e.to_string().contains("channel 1 has 5"), "{e}");
     assert!(write_wav_f32(&path, 1000, &[]).is_err());
     assert!(write_wav_f32(&path, 0, &[&a]).is_err());
-    assert!(only_entries(dir.path()).is_empty());
+    assert!(entries(dir.path()).is_empty());
 }
 
 #[test]

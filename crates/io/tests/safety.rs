@@ -1,19 +1,12 @@
 //! Size guard, atomicity and the windowed recorder.
 
+mod common;
+use common::entries;
 use gyroemu_io::{
     check_wav_f32_size, write_atomic, write_atomic_via, write_json, IoError, SignalRecorder,
     WAV_F32_MAX_DATA_BYTES,
 };
 use std::path::Path;
-
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
 
 #[test]
 fn wav_guard_at_the_4_gib_boundary() {

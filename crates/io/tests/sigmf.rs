@@ -1,6 +1,8 @@
 //! SigMF recordings checked against independent truths: bytes decoded by hand, JSON parsed by
 //! serde_json, SHA-512 recomputed with sha2 on the file as read back, FIPS known answers.
 
+mod common;
+use common::entries;
 use gyroemu_io::{write_sigmf, IoError, SigmfMeta, SignalRecorder};
 use serde_json::Value;
 use sha2::{Digest, Sha512};
@@ -49,15 +51,6 @@ fn hex(bytes: &[u8]) -> String {
 
 fn read_meta(path: &Path) -> Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
-}
-
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 #[test]

@@ -245,13 +245,7 @@ mod tests {
     fn wide_axis_lines_set_the_polygon_paths_pixels() {
         // Seeded walk: every width 1-8, lengths 0-50 both ways, lines crossing and outside
         // the canvas edges, opaque and translucent colours (those keep the polygon path).
-        let mut x: u64 = 0x2545_F491_4F6C_DD1D;
-        let mut next = |n: i32| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x % n as u64) as i32
-        };
+        let mut next = crate::seeded(0x2545_F491_4F6C_DD1D);
         let mut fast_taken = 0;
         for case in 0..4000 {
             let w = 1 + (case % 8) as u32;
@@ -283,13 +277,7 @@ mod tests {
     fn rectangle_outlines_set_the_bitmaps_pixels() {
         // Seeded: outlines of widths 1-8 with corners in any order, inside and across the
         // canvas edges, opaque and translucent; and filled ones, which stay the bitmap's.
-        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
-        let mut next = |n: i32| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x % n as u64) as i32
-        };
+        let mut next = crate::seeded(0x9E37_79B9_7F4A_7C15);
         for case in 0..2000 {
             let w = 1 + (case % 8) as u32;
             let a = (next(W as i32 + 20) - 10, next(H as i32 + 20) - 10);
@@ -322,13 +310,7 @@ mod tests {
         // Seeded: segments along either axis and of any length (zero too), slanted segments
         // and paths of three to six points, widths 1-8, inside and across the canvas edges,
         // opaque and translucent: the pixels of plotters' own `draw_path` on the bitmap.
-        let mut x: u64 = 0xD1B5_4A32_D192_ED03;
-        let mut next = |n: i32| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x % n as u64) as i32
-        };
+        let mut next = crate::seeded(0xD1B5_4A32_D192_ED03);
         let mut fast_taken = 0;
         for case in 0..6000 {
             let w = 1 + (case % 8) as u32;

@@ -184,13 +184,8 @@ mod tests {
             "",
             " ",
         ];
-        let mut s: u64 = 0x0123_4567_89AB_CDEF;
-        let mut next = |n: u64| {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s % n
-        };
+        let mut walk = crate::seeded(0x0123_4567_89AB_CDEF);
+        let mut next = |n: u64| walk(n as i32) as u64;
         let hs = [HPos::Left, HPos::Center, HPos::Right];
         let vs = [VPos::Top, VPos::Center, VPos::Bottom];
         let turns = [

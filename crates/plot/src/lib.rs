@@ -14,6 +14,17 @@ mod glyphs;
 mod polygon;
 mod render;
 
+/// A seeded xorshift walk for the pixel tests: each call gives a value in `0..n`.
+#[cfg(test)]
+pub(crate) fn seeded(mut x: u64) -> impl FnMut(i32) -> i32 {
+    move |n: i32| {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x % n as u64) as i32
+    }
+}
+
 pub use axis::{finite_bounds, AxisScale, MARGIN_FRACTION};
 pub use error::PlotError;
 pub use figure::{Figure, Marker, Series, SeriesStyle, PALETTE};

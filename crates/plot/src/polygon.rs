@@ -216,13 +216,7 @@ mod tests {
         // self-crossing ones, repeated points), and the polygons plotters makes of wide
         // paths (the figures' data lines), opaque and translucent: the pixels of plotters'
         // own `fill_polygon` on the bitmap, and the same on a canvas drawn over twice.
-        let mut x: u64 = 0xA076_1D64_78BD_642F;
-        let mut next = |n: i32| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x % n as u64) as i32
-        };
+        let mut next = crate::seeded(0xA076_1D64_78BD_642F);
         for case in 0..3000 {
             let mut point = || (next(W as i32 + 30) - 15, next(H as i32 + 30) - 15);
             let polygon: Vec<BackendCoord> = if case % 3 == 0 {
