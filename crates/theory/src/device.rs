@@ -279,7 +279,8 @@ type Remembered = ((String, u64, u64), ([f64; 2], [f64; 2]));
 /// The answers [`DrivenDevice::rate_table_response`] remembers, oldest first.
 static RESPONSES: std::sync::Mutex<Vec<Remembered>> = std::sync::Mutex::new(Vec::new());
 
-/// How many rate-table responses are remembered (a `reproduce` asks about 20 distinct ones).
+/// How many rate-table responses are remembered (a `reproduce` asks those of its 16 rate-table
+/// points: 7 rates and 9 bandwidth frequencies, some for two devices).
 pub const MEMO_LEN: usize = 64;
 
 /// The most envelope harmonics a rate table's theory takes (a swing of 785 degrees needs
