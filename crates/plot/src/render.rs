@@ -382,17 +382,10 @@ mod tests {
     fn the_two_by_two_average_is_the_rounded_mean_of_each_block() {
         // Against the mean written out pixel by pixel, on seeded canvases 2 to 150 pixels
         // wide (shorter than a whitening stretch of 64, a whole number of them, and between).
-        let mut s = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = crate::seeded(0x9E37_79B9_7F4A_7C15);
         for w in [2, 4, 30, 32, 34, 62, 64, 66, 96, 128, 150] {
             let h = 4;
-            let src: Vec<u8> = (0..w * h * 3)
-                .map(|_| {
-                    s ^= s << 13;
-                    s ^= s >> 7;
-                    s ^= s << 17;
-                    s as u8
-                })
-                .collect();
+            let src: Vec<u8> = (0..w * h * 3).map(|_| next(256) as u8).collect();
             let px = |x: usize, y: usize, c: usize| u32::from(src[(y * w + x) * 3 + c]);
             let want: Vec<u8> = (0..h / 2)
                 .flat_map(|oy| (0..w / 2).map(move |ox| (ox, oy)))
@@ -417,17 +410,11 @@ mod tests {
         // stretches are white in both rows, some in one, some in neither). The same output
         // as the plain average, and every canvas byte 255 after.
         let (w, h) = (150, 6);
-        let mut s = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
-        let random: Vec<u8> = (0..w * h * 3).map(|_| next() as u8).collect();
+        let mut next = crate::seeded(0x2545_f491_4f6c_dd1d);
+        let random: Vec<u8> = (0..w * h * 3).map(|_| next(256) as u8).collect();
         let sparse: Vec<u8> = (0..w * h * 3)
-            .map(|_| match next() % 97 {
-                0 => (next() % 255) as u8,
+            .map(|_| match next(97) {
+                0 => next(255) as u8,
                 _ => 255,
             })
             .collect();
