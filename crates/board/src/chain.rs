@@ -86,27 +86,27 @@ impl ChainResponse {
         let top = 2 * harmonics;
         // K(d) for d = 0 ..= 2N; the weights are real, so K(-d) = conj K(d), whose sums are
         // the same sums negated (rounding to nearest is symmetric): half the work.
-        let mut sum: Vec<[KahanSum<f64>; 2]> = vec![[KahanSum::new(), KahanSum::new()]; top + 1];
+        let mut sums = LeakSums::new(top + 1);
         let mut wsum = KahanSum::<f64>::new();
+        // Each term's phasor w e^{j d theta} comes from a chain of products in d, one chain
+        // per window sample: chains of TABLE_BLOCK samples run side by side (a chain alone
+        // waits on each product), then their terms are added in sample order (the same sums
+        // in the same order as one sample at a time, so the same bits).
+        let mut block = LeakBlock::new(top + 1);
         for j in 0..point.window.samples() {
             let w = point.window.weight(j);
             if w == 0.0 {
                 continue;
             }
             let n = (n_settle + j) * m + m - 1;
-            let e = table_reference(n, self.table_hz, self.fs_hz).conj();
-            let mut p = Complex64::new(w, 0.0);
-            for s in sum.iter_mut() {
-                s[0].add(p.re);
-                s[1].add(p.im);
-                p *= e;
-            }
+            block.push(w, table_reference(n, self.table_hz, self.fs_hz).conj());
             wsum.add(w);
+            if block.len == TABLE_BLOCK {
+                block.add_to(&mut sums);
+            }
         }
-        let k = |d: usize| {
-            let [re, im] = &sum[d];
-            Complex64::new(re.value(), im.value()) / wsum.value()
-        };
+        block.add_to(&mut sums);
+        let k = |d: usize| sums.value(d) / wsum.value();
         (0..=2 * top)
             .map(|i| match i.checked_sub(top) {
                 Some(d) => k(d),
@@ -269,6 +269,96 @@ pub(crate) fn stage2_leak_reference(
         wsum.add(w);
     }
     Complex64::new(sum.value(), sum_im.value()) / wsum.value()
+}
+
+/// Window samples whose leak terms [`ChainResponse::table_leak`] forms side by side.
+const TABLE_BLOCK: usize = 8;
+
+/// Compensated sums (as [`KahanSum`] adds them) of the leak's real and imaginary parts, one
+/// per harmonic distance, each array contiguous so an add runs over every distance at once.
+struct LeakSums {
+    re: [Vec<f64>; 2],
+    im: [Vec<f64>; 2],
+}
+
+impl LeakSums {
+    fn new(n: usize) -> Self {
+        Self {
+            re: [vec![0.0; n], vec![0.0; n]],
+            im: [vec![0.0; n], vec![0.0; n]],
+        }
+    }
+
+    /// [`KahanSum::value`] of distance `d`.
+    fn value(&self, d: usize) -> Complex64 {
+        Complex64::new(self.re[0][d] + self.re[1][d], self.im[0][d] + self.im[1][d])
+    }
+}
+
+/// [`KahanSum::add`] of `x[d]` to sum `d` (`[sum, comp]`), for every `d`.
+#[inline(always)]
+fn kahan_add_each(acc: &mut [Vec<f64>; 2], x: &[f64]) {
+    let [sum, comp] = acc;
+    for ((s, c), &x) in sum.iter_mut().zip(comp.iter_mut()).zip(x) {
+        let t = *s + x;
+        let z = t - *s;
+        *c += (*s - (t - z)) + (x - z);
+        *s = t;
+    }
+}
+
+/// Up to [`TABLE_BLOCK`] window samples' weights and conjugate table phasors, then their
+/// terms `w e^{-j d theta}` for `d = 0 .. n`, sample by sample.
+struct LeakBlock {
+    w: [f64; TABLE_BLOCK],
+    e: [Complex64; TABLE_BLOCK],
+    len: usize,
+    terms_re: Vec<f64>,
+    terms_im: Vec<f64>,
+}
+
+impl LeakBlock {
+    fn new(n: usize) -> Self {
+        Self {
+            w: [0.0; TABLE_BLOCK],
+            e: [Complex64::new(0.0, 0.0); TABLE_BLOCK],
+            len: 0,
+            terms_re: vec![0.0; n * TABLE_BLOCK],
+            terms_im: vec![0.0; n * TABLE_BLOCK],
+        }
+    }
+
+    fn push(&mut self, w: f64, e: Complex64) {
+        self.w[self.len] = w;
+        self.e[self.len] = e;
+        self.len += 1;
+    }
+
+    /// Adds the block's terms to `sums` in sample order and empties it.
+    fn add_to(&mut self, sums: &mut LeakSums) {
+        let n = sums.re[0].len();
+        // p = w, then p *= e at each distance: `Complex64`'s `*=` (re e.re - im e.im,
+        // im e.re + re e.im), one chain per sample, all of them at once (the unused ones
+        // run on zeros and are not added).
+        let mut re = self.w;
+        let mut im = [0.0; TABLE_BLOCK];
+        let er: [f64; TABLE_BLOCK] = core::array::from_fn(|k| self.e[k].re);
+        let ei: [f64; TABLE_BLOCK] = core::array::from_fn(|k| self.e[k].im);
+        for d in 0..n {
+            for k in 0..TABLE_BLOCK {
+                self.terms_re[k * n + d] = re[k];
+                self.terms_im[k * n + d] = im[k];
+                let a = re[k];
+                re[k] = re[k] * er[k] - im[k] * ei[k];
+                im[k] = im[k] * er[k] + a * ei[k];
+            }
+        }
+        for k in 0..self.len {
+            kahan_add_each(&mut sums.re, &self.terms_re[k * n..][..n]);
+            kahan_add_each(&mut sums.im, &self.terms_im[k * n..][..n]);
+        }
+        self.len = 0;
+    }
 }
 
 #[cfg(test)]
