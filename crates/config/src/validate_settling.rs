@@ -349,6 +349,11 @@ impl Config {
         let (k0, head) = impulse_head(self.lowpass_design(), fs, self.lpf_cutoff_hz(), n0, ln_a);
         // Every table point has the same window: the plant's Dirichlet-weighted bound once.
         let mut table_fold: Option<Option<Vec<f64>>> = None;
+        // So are the unit phasors of the envelope grid and of the kernel's bins (N is the
+        // config's): formed once, not per point and mode (the same angles, the same bits).
+        let mut grid_memo: Option<Vec<Complex64>> = None;
+        let mut bins_memo: Option<Vec<Complex64>> = None;
+        let mut lp_memo: Option<(Window, Vec<f64>)> = None;
         for rate in self.emulated_rates_dps() {
             let su = StartUp {
                 modes: &modes,
@@ -408,14 +413,25 @@ impl Config {
                         // geometrically; 64 (N+1) points leave their fold-over negligible).
                         let total: f64 = z.iter().map(|v| v.norm()).sum();
                         let steps = 64 * (nu + 1);
+                        // e^{j k theta_t} for k = -(N+1) ..= N+1 (index k + N + 1): z's terms
+                        // take |k| <= N, g's harmonic m takes k = -m.
+                        let row = 2 * nu + 3;
+                        // (Its length is its key: 64 (N + 1) (2N + 3) grows with N.)
+                        let grid = memo(&mut grid_memo, steps * row, || {
+                            (0..steps)
+                                .flat_map(|t| {
+                                    let th = tau * t as f64 / steps as f64;
+                                    (-(n + 1)..=n + 1)
+                                        .map(move |k| Complex64::from_polar(1.0, k as f64 * th))
+                                })
+                                .collect()
+                        });
+                        let at = |t: usize, k: i64| grid[t * row + (k + n + 1) as usize];
                         let zs: Vec<Complex64> = (0..steps)
                             .map(|t| {
-                                let th = tau * t as f64 / steps as f64;
                                 z.iter()
                                     .enumerate()
-                                    .map(|(i, v)| {
-                                        v * Complex64::from_polar(1.0, (i as i64 - n) as f64 * th)
-                                    })
+                                    .map(|(i, v)| v * at(t, i as i64 - n))
                                     .sum::<Complex64>()
                             })
                             .collect();
@@ -427,10 +443,7 @@ impl Config {
                         let g = |m: i64| -> Complex64 {
                             zs.iter()
                                 .enumerate()
-                                .map(|(t, v)| {
-                                    let th = tau * t as f64 / steps as f64;
-                                    Complex64::from_polar(1.0, -(m as f64) * th) / v
-                                })
+                                .map(|(t, v)| at(t, -m) / v)
                                 .sum::<Complex64>()
                                 / steps as f64
                         };
@@ -438,19 +451,32 @@ impl Config {
                         let g_at = |m: i64| gs[(m + n + 1) as usize];
                         // The low-pass's own start-up, exact per tone and per harmonic read:
                         // |d_n| <= left_n / |L_n| in the rebuilt envelope.
+                        // |L's start-up| of harmonic i (and its image) read at harmonic
+                        // `read`: the window's and N's alone, so formed once for every
+                        // point and mode that share the window.
+                        let nz = z.len();
+                        if lp_memo
+                            .as_ref()
+                            .is_none_or(|(w, v)| *w != su.window || v.len() != nz * (2 * nu + 1))
+                        {
+                            let lp = (-n..=n)
+                                .flat_map(|read| {
+                                    let w_read = w_of(read as f64 * freq_hz);
+                                    let su = &su;
+                                    (0..nz).map(move |i| {
+                                        let w = w_of((i as i64 - n) as f64 * freq_hz);
+                                        su.lowpass(w, w_read).norm()
+                                            + su.lowpass(image - w, w_read).norm()
+                                    })
+                                })
+                                .collect();
+                            lp_memo = Some((su.window, lp));
+                        }
+                        let lp = lp_memo.as_ref().map_or(&[][..], |(_, v)| v.as_slice());
                         let d: Vec<f64> = (-n..=n)
                             .map(|read| {
-                                let w_read = w_of(read as f64 * freq_hz);
-                                let left: f64 = z
-                                    .iter()
-                                    .enumerate()
-                                    .map(|(i, v)| {
-                                        let w = w_of((i as i64 - n) as f64 * freq_hz);
-                                        v.norm()
-                                            * (su.lowpass(w, w_read).norm()
-                                                + su.lowpass(image - w, w_read).norm())
-                                    })
-                                    .sum();
+                                let row = &lp[(read + n) as usize * nz..][..nz];
+                                let left: f64 = z.iter().zip(row).map(|(v, l)| v.norm() * l).sum();
                                 left * inv_l[(read + n) as usize].norm()
                             })
                             .collect();
@@ -490,20 +516,37 @@ impl Config {
                                     &uniform
                                 }
                             };
+                            // K_{+-} at each bin: g_{+-1-r} / L_r does not depend on the
+                            // bin, and both share its phasors e^{-j r x} (the same products
+                            // and sums as forming each term whole, so the same bits).
+                            let coef = |s: i64| -> Vec<Complex64> {
+                                (-n..=n)
+                                    .map(|r| g_at(s - r) * inv_l[(r + n) as usize])
+                                    .collect()
+                            };
+                            let (plus, minus) = (coef(1), coef(-1));
+                            let width = plus.len();
+                            let rots = memo(&mut bins_memo, bins * width, || {
+                                (0..bins)
+                                    .flat_map(|b| {
+                                        let x = tau * (b as f64 + 0.5) / bins as f64;
+                                        (-n..=n).map(move |r| {
+                                            Complex64::from_polar(1.0, -(r as f64) * x)
+                                        })
+                                    })
+                                    .collect()
+                            });
                             let kernel = fold.iter().enumerate().filter(|&(_, &f)| f > 0.0).map(
                                 |(b, &f)| {
-                                    let x = tau * (b as f64 + 0.5) / bins as f64;
-                                    let k = |s: i64| {
-                                        (-n..=n)
-                                            .map(|r| {
-                                                g_at(s - r)
-                                                    * inv_l[(r + n) as usize]
-                                                    * Complex64::from_polar(1.0, -(r as f64) * x)
-                                            })
+                                    let rot = &rots[b * width..][..width];
+                                    let k = |c: &[Complex64]| {
+                                        c.iter()
+                                            .zip(rot)
+                                            .map(|(a, p)| a * p)
                                             .sum::<Complex64>()
                                             .norm()
                                     };
-                                    f * (k(1) + k(-1) + slope * half_bin)
+                                    f * (k(&plus) + k(&minus) + slope * half_bin)
                                 },
                             );
                             let plant_part: f64 = if folded {
@@ -614,11 +657,29 @@ impl Config {
     }
 }
 
+/// The vector kept in `slot` if it has `len` entries, else `make()`'s, kept there.
+fn memo<T>(slot: &mut Option<Vec<T>>, len: usize, make: impl FnOnce() -> Vec<T>) -> &[T] {
+    if slot.as_ref().is_none_or(|v| v.len() != len) {
+        *slot = Some(make());
+    }
+    slot.as_deref().unwrap_or_default()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use gyroemu_core::Stage;
     use gyroemu_lpf::{LowPass, LowPassDesign};
+
+    /// A kept vector is reused at its length (its key) and replaced at another.
+    #[test]
+    fn memo_keeps_a_vector_of_its_length_only() {
+        let mut slot = None;
+        assert_eq!(memo(&mut slot, 2, || vec![1, 2]), &[1, 2]);
+        assert_eq!(memo(&mut slot, 2, || vec![7, 7]), &[1, 2]);
+        assert_eq!(memo(&mut slot, 3, || vec![3, 4, 5]), &[3, 4, 5]);
+        assert_eq!(slot, Some(vec![3, 4, 5]));
+    }
 
     /// The modal impulse response is the built filter's (run on an impulse), every order, a
     /// narrow and a wide cutoff: the bound rests on the real filter, not an analog model.
