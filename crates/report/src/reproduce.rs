@@ -27,7 +27,7 @@ use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
 use gyroemu_theory::rate_table_gain;
 use serde_json::json;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, OnceLock};
 
 /// Averaging of Fig. 9 with `--quick`, s (the paper: 500 s).
@@ -251,9 +251,11 @@ pub fn reproduce(
     let progress: Vec<_> = (0..jobs.len())
         .map(|i| move |d: u64, t: u64| report(i, d, t))
         .collect();
-    // Every board of every experiment built before the first sample.
-    let mut sweeps = Vec::with_capacity(jobs.len());
-    for (i, job) in jobs.iter().enumerate() {
+    // Every board of every experiment built before the first sample, the experiments on every
+    // thread at once (built one after another they kept the other thread waiting); the first
+    // error in the experiments' order.
+    let prepare = |i: usize| {
+        let job = &jobs[i];
         // The dump only records: the results are those of a run without it. Groups sized
         // for one thread and long points split into segments (Fig. 9's 500 s): every group
         // is as wide as the CPU runs and none is long enough to run alone at the end (bits
@@ -265,14 +267,23 @@ pub fn reproduce(
             split: true,
             ..Default::default()
         };
-        sweeps.push(PreparedSweep::new(
-            &job.cfg,
-            &progress[i],
-            Some(&dirs[i]),
-            opts,
-        )?);
+        PreparedSweep::new(&job.cfg, &progress[i], Some(&dirs[i]), opts)
+    };
+    let (prepared, tables) = rayon::join(
+        || {
+            use rayon::prelude::*;
+            (0..jobs.len())
+                .into_par_iter()
+                .map(prepare)
+                .collect::<Vec<_>>()
+        },
+        || PreparedTables::new(&plan.bandwidth, Some(1), true),
+    );
+    let mut sweeps = Vec::with_capacity(jobs.len());
+    for sweep in prepared {
+        sweeps.push(sweep?);
     }
-    let tables = PreparedTables::new(&plan.bandwidth, Some(1), true)?;
+    let tables = tables?;
     // Every lane group of every experiment and of the bandwidth sweep runs from one queue,
     // the costliest first. The stage-2 leaks depend on the configs alone: items beside the
     // groups compute them, or the read-out that needs them first (an error resurfaces in the
@@ -284,17 +295,51 @@ pub fn reproduce(
     // while the other experiments' groups go on; the bandwidth sweep's likewise.
     let outputs: Vec<Mutex<Option<Result<JobOutput, ReportError>>>> =
         jobs.iter().map(|_| Mutex::new(None)).collect();
+    // Fig. 6 as soon as both BAW experiments are read out, beside the second one's files (a
+    // thread with nothing left to run takes either), while other items still run: drawn at
+    // the end it kept one thread alone while the other waited.
+    let (baw_c, baw_r) = (
+        job_index(jobs, "baw-coriolis"),
+        job_index(jobs, "baw-rotating"),
+    );
+    let fig6_left = AtomicUsize::new(2);
+    let fig6_in: [Mutex<Option<SweepResult>>; 2] = Default::default();
+    let fig6_out: Mutex<Option<Result<PathBuf, ReportError>>> = Mutex::new(None);
+    let fig6_path = out.join("fig6.png");
+    let fig6_hand_in = |i: usize, r: &SweepResult| {
+        let k = match i {
+            _ if i == baw_c => 0,
+            _ if i == baw_r => 1,
+            _ => return,
+        };
+        // Only from clean read-outs: otherwise the run stops at their problems first.
+        if r.problems.is_empty() {
+            *lock(&fig6_in[k]) = Some(r.clone());
+        }
+        if fig6_left.fetch_sub(1, Ordering::AcqRel) == 1 {
+            let (c, rot) = (lock(&fig6_in[0]), lock(&fig6_in[1]));
+            if let (Some(c), Some(rot)) = (&*c, &*rot) {
+                let res = render_png(&fig6(&jobs[baw_c].cfg, c, rot), &fig6_path)
+                    .map(|()| fig6_path.clone())
+                    .map_err(ReportError::from);
+                *lock(&fig6_out) = Some(res);
+            }
+        }
+    };
     let finishers: Vec<_> = (0..jobs.len())
         .map(|i| {
-            let (sweeps, outputs) = (&sweeps, &outputs);
+            let (sweeps, outputs, fig6_hand_in) = (&sweeps, &outputs, &fig6_hand_in);
             move || {
                 let job = &jobs[i];
                 let res = (|| -> Result<JobOutput, ReportError> {
                     let run = sweeps[i].finish()?;
                     let r = finish_sweep_with(&job.cfg, &run.lanes, leaks_of(i))?;
                     let written = if r.problems.is_empty() {
-                        Some(write_job(out, job, &run, &r))
+                        let (w, ()) =
+                            rayon::join(|| write_job(out, job, &run, &r), || fig6_hand_in(i, &r));
+                        Some(w)
                     } else {
+                        fig6_hand_in(i, &r);
                         None
                     };
                     Ok((run, r, written))
@@ -388,12 +433,17 @@ pub fn reproduce(
             files.push(p.clone());
         }
     }
-    let (cc, cr, _) = get("baw-coriolis");
-    let (_, rr, _) = get("baw-rotating");
     files.extend(bandwidth_files);
-    let path = out.join("fig6.png");
-    render_png(&fig6(cc, cr, rr), &path)?;
-    files.push(path);
+    // Rendered in the queue; both read-outs passed their checks above, so it was drawn.
+    let fig6_file = match lock(&fig6_out).take() {
+        Some(res) => res?,
+        None => {
+            let ((cc, cr, _), (_, rr, _)) = (get("baw-coriolis"), get("baw-rotating"));
+            render_png(&fig6(cc, cr, rr), &fig6_path)?;
+            fig6_path.clone()
+        }
+    };
+    files.push(fig6_file);
     let pair = |c: &str, rname: &str| {
         let (cfg, rc, _) = get(c);
         let (_, rrot, _) = get(rname);
