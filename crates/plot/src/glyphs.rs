@@ -220,7 +220,7 @@ mod tests {
             let mut kept = plain.clone();
             {
                 let mut p = BitMapBackend::with_buffer(&mut plain, (w, h));
-                let mut k = FastLines(BitMapBackend::with_buffer(&mut kept, (w, h)));
+                let mut k = FastLines(BitMapBackend::with_buffer(&mut kept, (w, h)), None);
                 for _ in 0..2 {
                     p.draw_text(word, &style, at).unwrap();
                     k.draw_text(word, &style, at).unwrap();
@@ -242,8 +242,11 @@ mod tests {
         let mut plain = vec![255u8; (w * h * 3) as usize];
         let mut kept = plain.clone();
         let a = BitMapBackend::with_buffer(&mut plain, (w, h)).draw_text("x", &style, (5, 5));
-        let b =
-            FastLines(BitMapBackend::with_buffer(&mut kept, (w, h))).draw_text("x", &style, (5, 5));
+        let b = FastLines(BitMapBackend::with_buffer(&mut kept, (w, h)), None).draw_text(
+            "x",
+            &style,
+            (5, 5),
+        );
         assert_eq!(a.is_err(), b.is_err());
         assert!(plain == kept);
     }

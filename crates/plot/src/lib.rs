@@ -5,6 +5,7 @@
 //! Files are written atomically through `gyroemu-io`.
 
 mod axis;
+mod dirty;
 mod draw;
 mod error;
 mod fast_lines;

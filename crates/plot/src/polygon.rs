@@ -235,7 +235,7 @@ mod tests {
             let mut fast = plain.clone();
             {
                 let mut p = BitMapBackend::with_buffer(&mut plain, (W, H));
-                let mut f = FastLines(BitMapBackend::with_buffer(&mut fast, (W, H)));
+                let mut f = FastLines(BitMapBackend::with_buffer(&mut fast, (W, H)), None);
                 for _ in 0..2 {
                     plotters_backend::rasterizer::fill_polygon(&mut p, &polygon, &c).unwrap();
                     f.fill_polygon(polygon.iter().copied(), &c).unwrap();

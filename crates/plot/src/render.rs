@@ -2,6 +2,7 @@
 //! down 2 x 2 (supersampling): plotters' bitmap backend draws lines and markers without
 //! anti-aliasing, which looks stepped on slanted lines.
 
+use crate::dirty::Dirty;
 use crate::draw::{draw_figure, text_scale, Area};
 use crate::fast_lines::FastLines;
 use crate::figure::Figure;
@@ -113,7 +114,15 @@ fn average_rows(r0: &[u8], r1: &[u8], o: &mut [u8]) {
 /// canvas of up to 35 MB, a tenth of a figure's time). A stretch of [`WHITE_RUN`] canvas
 /// pixels that is white in both rows gives white and is not written: most of a figure is
 /// background, and a stretch left clean in cache costs memory no write-back.
-fn downsample2_whitening(src: &mut [u8], w: usize, h: usize, out: &mut Vec<u8>) {
+///
+/// With `dirty`, the stretches no drawing touched are not even read: they are white.
+fn downsample2_whitening(
+    src: &mut [u8],
+    w: usize,
+    h: usize,
+    out: &mut Vec<u8>,
+    dirty: Option<&Dirty>,
+) {
     debug_assert!(
         w.is_multiple_of(2) && h.is_multiple_of(2),
         "a canvas twice an image's size"
@@ -121,16 +130,22 @@ fn downsample2_whitening(src: &mut [u8], w: usize, h: usize, out: &mut Vec<u8>) 
     let (ow, oh) = (w / 2, h / 2);
     sized(out, ow * oh * 3);
     let (run, used) = (WHITE_RUN * 3, w * 3);
-    for (pair, o) in src
+    for (p, (pair, o)) in src
         .chunks_exact_mut(2 * w * 3)
         .zip(out.chunks_exact_mut(ow * 3))
+        .enumerate()
     {
         let (r0, r1) = pair.split_at_mut(used);
         let mut start = 0;
         while start < used {
             let end = (start + run).min(used);
-            let (a, b) = (&mut r0[start..end], &mut r1[start..end]);
             let d = &mut o[start / 2..end / 2];
+            if dirty.is_some_and(|t| !t.touched(p, start / run)) {
+                d.fill(255);
+                start = end;
+                continue;
+            }
+            let (a, b) = (&mut r0[start..end], &mut r1[start..end]);
             if all_white(a) & all_white(b) {
                 d.fill(255);
             } else {
@@ -145,7 +160,7 @@ fn downsample2_whitening(src: &mut [u8], w: usize, h: usize, out: &mut Vec<u8>) 
 
 /// Canvas pixels per stretch that [`downsample2_whitening`] skips when white: 64 (192 bytes,
 /// three cache lines, a whole number of output pixels).
-const WHITE_RUN: usize = 64;
+const WHITE_RUN: usize = crate::dirty::STRETCH;
 
 /// Whether every byte is 255 (a fold without early exit, which vectorises).
 #[inline]
@@ -176,8 +191,12 @@ where
     buf[dirty].fill(255);
     buf.resize(len.max(buf.len()), 255);
     let canvas = &mut buf[..len];
+    // What the drawing touches, for the 2 x 2 average to read only that.
+    let mut dirty = Dirty::new(bw, bh);
     let drawn: DrawResult = (|| {
-        let root = FastLines(BitMapBackend::with_buffer(canvas, (bw, bh))).into_drawing_area();
+        let tracked = (k == 2).then_some(&mut dirty);
+        let root =
+            FastLines(BitMapBackend::with_buffer(canvas, (bw, bh)), tracked).into_drawing_area();
         draw(&root)?;
         root.present()?;
         Ok(())
@@ -198,7 +217,7 @@ where
             (Ok(()), 0)
         }
         Ok(()) if k == 2 => {
-            downsample2_whitening(&mut buf[..len], bw as usize, bh as usize, out);
+            downsample2_whitening(&mut buf[..len], bw as usize, bh as usize, out, Some(&dirty));
             (Ok(()), past)
         }
         Ok(()) => {
@@ -439,7 +458,7 @@ mod tests {
             let want = downsample_rgb(&src, w, h, 2);
             let mut canvas = src.clone();
             let mut out = vec![9u8; 1000];
-            downsample2_whitening(&mut canvas, w, h, &mut out);
+            downsample2_whitening(&mut canvas, w, h, &mut out, None);
             assert_eq!(out, want);
             assert!(canvas.iter().all(|&b| b == 255));
         }
