@@ -26,8 +26,11 @@ pub fn reproduce_command(out: &Path, quick: bool) -> Result<()> {
     let _preset_locks = lock_subfolders(out, &plan.preset_folders(), &command_line(), &Terminal)?;
     let rate = gyroemu_experiment::work::measured_throughput(plan.heaviest_config());
     note!("{}", plan.work().describe(Some(rate)));
-    // Each output folder synced once at the end, not after every file renamed into it.
-    let files = gyroemu_io::with_deferred_dir_sync(|| reproduce(&plan, out, &Terminal))?;
+    // Each output folder synced once at the end, not after every file renamed into it, and
+    // each file synced and renamed by a thread of its own, not by the worker that wrote it.
+    let files = gyroemu_io::with_deferred_dir_sync(|| {
+        gyroemu_io::with_background_persist(|| reproduce(&plan, out, &Terminal))
+    })?;
     list_written(out, &files);
     Ok(())
 }
