@@ -155,18 +155,8 @@ pub fn with_background_persist<R, E: From<IoError>>(
             }
         }
     }
-    /// Waits for the files if `f` panics.
-    struct OnUnwind;
-    impl Drop for OnUnwind {
-        fn drop(&mut self) {
-            drop(leave_background());
-        }
-    }
-    let guard = OnUnwind;
-    let result = f();
-    std::mem::forget(guard);
-    let value = (result, leave_background());
-    match value {
+    // The files are waited for if `f` panics too.
+    match then_leave(f, leave_background) {
         (Err(e), _) => Err(e),
         (Ok(_), Some(e)) => Err(e.into()),
         (Ok(v), None) => Ok(v),
@@ -258,18 +248,9 @@ thread_local! {
 /// missing if it read them back); a dump's writers run on their own.
 pub fn with_batched_persist<R>(f: impl FnOnce() -> Result<R, IoError>) -> Result<R, IoError> {
     BATCH.with_borrow_mut(|b| b.get_or_insert_with(|| (0, Vec::new())).0 += 1);
-    /// Closes this call's level if `f` panics: the outermost drops its files (their
-    /// temporaries deleted, nothing put in place).
-    struct OnUnwind;
-    impl Drop for OnUnwind {
-        fn drop(&mut self) {
-            drop(close_batch());
-        }
-    }
-    let guard = OnUnwind;
-    let result = f();
-    std::mem::forget(guard);
-    let files = close_batch();
+    // If `f` panics, the outermost level drops its files (their temporaries deleted,
+    // nothing put in place).
+    let (result, files) = then_leave(f, close_batch);
     let value = result?;
     // An inner call's files wait for the outermost.
     let Some(files) = files else {
@@ -304,6 +285,21 @@ pub fn with_batched_persist<R>(f: impl FnOnce() -> Result<R, IoError>) -> Result
         rename_into_place(p)?;
     }
     Ok(value)
+}
+
+/// Runs `f`, then `leave`, which also runs (its value dropped) if `f` panics: a scope's level
+/// is left on every way out.
+fn then_leave<R, L>(f: impl FnOnce() -> R, leave: fn() -> L) -> (R, L) {
+    struct OnUnwind<L>(fn() -> L);
+    impl<L> Drop for OnUnwind<L> {
+        fn drop(&mut self) {
+            drop((self.0)());
+        }
+    }
+    let guard = OnUnwind(leave);
+    let result = f();
+    std::mem::forget(guard);
+    (result, leave())
 }
 
 /// Leaves one level of [`with_batched_persist`] on this thread: the batch's files when it was
