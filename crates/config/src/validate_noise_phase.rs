@@ -307,7 +307,7 @@ impl Config {
     /// Brownian part is the resonance's, correlated over a mode's Q / (pi f0): an average
     /// shorter than a few of those sees less of it than stated (the warning errs towards
     /// warning). Of flicker, the TIA's voltage flicker near the carrier is counted, and the
-    /// drive and carrier phase flicker ([`Config::slow_flicker_variance`]) on a Coriolis or
+    /// drive and carrier phase flicker (`Config::slow_flicker_variance`) on a Coriolis or
     /// rate-table reading; a rotating psi keeps neither to first order.
     pub fn noise_phase(&self) -> Option<Vec<NoisePhase>> {
         // With a [pll], the reading's noise and phase at the carrier the lock holds.
