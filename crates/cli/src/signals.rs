@@ -28,6 +28,8 @@ pub fn install(graceful: bool) -> Arc<AtomicBool> {
                     return;
                 }
                 let marked = gyroemu_runs::abort_now();
+                // Finished files still waiting for their sync and rename go in place first.
+                gyroemu_io::flush_background_persist();
                 let removed = gyroemu_io::remove_temporaries();
                 for m in &marked {
                     note!("\ninterrupted: `{}` marked interrupted", m.display());

@@ -89,7 +89,7 @@ fn persist(tmp: NamedTempFile, path: &Path, live: Registered) -> Result<(), IoEr
     }) else {
         return Ok(());
     };
-    let Some(pending) = to_background(pending) else {
+    let Some(pending) = to_background(pending)? else {
         return Ok(());
     };
     sync_file(&pending)?;
@@ -109,11 +109,44 @@ fn background() -> std::sync::MutexGuard<'static, Background> {
     BACKGROUND.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Hands `p` to the background thread, if one runs (`None`), else gives it back.
-fn to_background(p: Pending) -> Option<Pending> {
-    match background().1.as_ref() {
-        Some(queue) => queue.send(p).err().map(|e| e.0),
-        None => Some(p),
+/// The first failure of the background thread, as text, while [`with_background_persist`]
+/// runs: the writes after it fail at once, naming it, so a run stops as it did when the
+/// writer itself met the failure.
+static BACKGROUND_FAILED: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+fn background_failed() -> std::sync::MutexGuard<'static, Option<String>> {
+    BACKGROUND_FAILED.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Hands `p` to the background thread, if one runs (`None`), else gives it back; refuses it
+/// (its temporary deleted) once a file before it could not be put in place.
+fn to_background(p: Pending) -> Result<Option<Pending>, IoError> {
+    let b = background();
+    let Some(queue) = b.1.as_ref() else {
+        return Ok(Some(p));
+    };
+    if let Some(earlier) = background_failed().as_ref() {
+        return Err(IoError::Write {
+            path: p.path.clone(),
+            reason: std::io::Error::other(format!(
+                "not put in place, since an earlier file could not be: {earlier}"
+            )),
+        });
+    }
+    Ok(queue.send(p).err().map(|e| e.0))
+}
+
+/// Puts in place, now, every file [`with_background_persist`] is holding, and leaves the
+/// files written from here on to their writers: for an exit that skips its end (Ctrl-C),
+/// which would otherwise delete finished files still waiting as temporaries.
+pub fn flush_background_persist() {
+    let worker = {
+        let mut b = background();
+        b.1 = None;
+        b.2.take()
+    };
+    if let Some(w) = worker {
+        let _ = w.join();
     }
 }
 
@@ -129,14 +162,19 @@ fn to_background(p: Pending) -> Option<Pending> {
 /// The mode is the process's: while it runs, a file written atomically on any thread is not
 /// at its path when its writer returns, only when this returns, so nothing may read back what
 /// it wrote meanwhile (a dump, which its figures read, is written in a batch, which puts its
-/// files in place before returning). For a command's whole run, not inside other work.
+/// files in place before returning). For a command's whole run, not inside other work. Once
+/// a file could not be put in place, later writes fail at once, naming it; if `f` fails, its
+/// own error is returned (the first such write's names the file). A path written here and
+/// then again in a batch may end with the first contents (the batch's rename is immediate,
+/// the queued one later): write each path once, as `reproduce` does.
 pub fn with_background_persist<R, E: From<IoError>>(
     f: impl FnOnce() -> Result<R, E>,
 ) -> Result<R, E> {
     {
         let mut b = background();
         b.0 += 1;
-        if b.1.is_none() {
+        if b.1.is_none() && b.0 == 1 {
+            *background_failed() = None;
             let (tx, rx) = std::sync::mpsc::channel::<Pending>();
             let worker = std::thread::Builder::new()
                 .name("persist".into())
@@ -144,6 +182,7 @@ pub fn with_background_persist<R, E: From<IoError>>(
                     let mut first = None;
                     for p in rx {
                         if let Err(e) = sync_file(&p).and_then(|()| rename_into_place(p)) {
+                            background_failed().get_or_insert_with(|| e.to_string());
                             first.get_or_insert(e);
                         }
                     }

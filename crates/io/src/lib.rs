@@ -18,8 +18,9 @@ mod sigmf;
 mod wav;
 
 pub use atomic::{
-    batched_files, deferred_dir_syncs, remove_temporaries, with_background_persist,
-    with_batched_persist, with_deferred_dir_sync, write_atomic, write_atomic_via,
+    batched_files, deferred_dir_syncs, flush_background_persist, remove_temporaries,
+    with_background_persist, with_batched_persist, with_deferred_dir_sync, write_atomic,
+    write_atomic_via,
 };
 pub use bounded_read::{
     read_capped, read_own_text, MAX_LOCK_BYTES, MAX_MANIFEST_BYTES, MAX_RECORD_BYTES,

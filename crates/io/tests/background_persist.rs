@@ -78,21 +78,67 @@ fn a_file_that_cannot_be_put_in_place_is_reported_at_the_end() {
     let got: Result<(), IoError> = with_background_persist(|| {
         write_atomic(&d.join("before.txt"), b"a")?;
         // Outside the mode this write fails at once; here its writer goes on.
-        write_atomic(&target, b"cannot replace a directory")?;
-        write_atomic(&d.join("after.txt"), b"b")?;
-        Ok(())
+        write_atomic(&target, b"cannot replace a directory")
     });
     match got {
         Err(IoError::Persist { path, .. }) => assert_eq!(path, target),
         other => panic!("expected the blocked target's error, got {other:?}"),
     }
-    // The others are in place, the directory untouched, no temporary left.
-    assert_eq!(entries(d), vec!["after.txt", "before.txt", "blocked"]);
+    // The other file is in place, the directory untouched, no temporary left.
+    assert_eq!(entries(d), vec!["before.txt", "blocked"]);
     assert_eq!(entries(&target), vec!["inside"]);
     assert!(
         write_atomic(&target, b"x").is_err(),
         "outside the mode it fails at once"
     );
+}
+
+#[test]
+fn writes_after_a_failure_fail_at_once_naming_it() {
+    let _s = serial();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let target = blocked(d);
+    let mut written = 0;
+    let got: Result<(), IoError> = with_background_persist(|| {
+        write_atomic(&target, b"x")?;
+        // Until the thread has met the failure, writes go on; then the next one is refused.
+        for i in 0..20_000 {
+            write_atomic(&d.join(format!("n{i:05}.txt")), b"n")?;
+            written += 1;
+            std::thread::sleep(std::time::Duration::from_micros(200));
+        }
+        Ok(())
+    });
+    let e = got.expect_err("a write after the failure is refused");
+    assert!(matches!(e, IoError::Write { .. }), "{e:?}");
+    assert!(e.to_string().contains("blocked"), "{e}");
+    // The writes before it are in place, the refused one is not, no temporary is left.
+    let names = entries(d);
+    assert_eq!(names.len(), written + 1, "{names:?}");
+    assert!(names.iter().all(|n| !n.starts_with('.')));
+}
+
+#[test]
+fn a_flush_puts_the_files_in_place_and_leaves_the_rest_to_their_writers() {
+    let _s = serial();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let got: Result<(), IoError> = with_background_persist(|| {
+        for i in 0..5 {
+            write_atomic(&d.join(format!("q{i}.txt")), b"q")?;
+        }
+        gyroemu_io::flush_background_persist();
+        assert_eq!(
+            entries(d),
+            vec!["q0.txt", "q1.txt", "q2.txt", "q3.txt", "q4.txt"]
+        );
+        // After the flush a write is in place when it returns.
+        write_atomic(&d.join("later.txt"), b"l")?;
+        assert!(d.join("later.txt").exists());
+        Ok(())
+    });
+    got.unwrap();
 }
 
 #[test]
@@ -111,9 +157,10 @@ fn the_callers_error_wins_and_a_panic_still_waits_for_the_files() {
             Failure::Io(e)
         }
     }
+    // The failing file last: no write after it can meet its failure and be refused.
     let got: Result<(), Failure> = with_background_persist(|| {
-        write_atomic(&target, b"x")?;
         write_atomic(&d.join("written.txt"), b"w")?;
+        write_atomic(&target, b"x")?;
         Err(Failure::Own)
     });
     assert!(matches!(got, Err(Failure::Own)), "{got:?}");

@@ -21,10 +21,18 @@ use plotters_backend::{
 pub(crate) struct FastLines<'a>(pub BitMapBackend<'a>, pub Option<&'a mut Dirty>);
 
 impl FastLines<'_> {
-    /// Marks the box of corners `a` and `b` widened by `margin` pixels.
-    fn touch(&mut self, a: BackendCoord, b: BackendCoord, margin: i32) {
+    /// Marks the box of corners `a` and `b` widened by `margin` pixels, or the whole canvas
+    /// when a corner is so far out (or the margin so wide) that plotters' own arithmetic on it
+    /// may wrap (`to + 1` at `i32::MAX`) and set pixels elsewhere.
+    fn touch(&mut self, a: BackendCoord, b: BackendCoord, margin: u32) {
+        const FAR: u32 = 1 << 30;
+        let far = |p: BackendCoord| p.0.unsigned_abs() >= FAR || p.1.unsigned_abs() >= FAR;
         if let Some(d) = self.1.as_deref_mut() {
-            d.rect(a, b, margin);
+            if far(a) || far(b) || margin >= FAR {
+                d.all();
+            } else {
+                d.rect(a, b, margin as i32);
+            }
         }
     }
 }
@@ -155,7 +163,7 @@ impl<'a> DrawingBackend for FastLines<'a> {
             }
         }
         // Within the segment's box widened by its half width (and a pixel of rounding).
-        self.touch(from, to, style.stroke_width().min(1 << 20) as i32 + 1);
+        self.touch(from, to, style.stroke_width().saturating_add(1));
         self.0.draw_line(from, to, style)
     }
 
@@ -239,8 +247,8 @@ impl<'a> DrawingBackend for FastLines<'a> {
         size: (u32, u32),
         src: &[u8],
     ) -> Result<(), Error<'a>> {
-        let far = |p: i32, n: u32| p.saturating_add(n.min(i32::MAX as u32) as i32);
-        self.touch(pos, (far(pos.0, size.0), far(pos.1, size.1)), 0);
+        let end = |p: i32, n: u32| p.saturating_add(n.min(i32::MAX as u32) as i32);
+        self.touch(pos, (end(pos.0, size.0), end(pos.1, size.1)), 0);
         self.0.blit_bitmap(pos, size, src)
     }
 }
@@ -535,5 +543,44 @@ mod tests {
             left_unmarked > 300,
             "{left_unmarked} of 600 drawings left cells unmarked"
         );
+    }
+    #[test]
+    fn draws_far_off_the_canvas_are_marked_too() {
+        // Calls that reach the backend with coordinates near the ends of i32 or widths in the
+        // millions (plotters' elements clip before this, the backend does not): plotters'
+        // `to + 1` wraps there, and a line's box widened by a capped margin missed pixels.
+        // Every pixel drawn still lies in a marked cell.
+        use crate::dirty::{Dirty, STRETCH};
+        use plotters::style::{Color, RGBColor};
+        let (w, h) = (300u32, 100u32);
+        let red = RGBColor(200, 0, 0);
+        let lines: [(BackendCoord, BackendCoord, u32, f64); 5] = [
+            ((200, 10), (i32::MAX, 10), 1, 1.0),
+            ((0, i32::MAX), (100, i32::MAX), 1, 1.0),
+            ((0, i32::MAX), (100, i32::MAX), 1, 0.5),
+            ((-2_000_000, -50), (-2_000_000, 500), 5_000_000, 0.5),
+            ((i32::MIN, 40), (i32::MAX, 60), 3, 1.0),
+        ];
+        for (k, &(a, b, width, alpha)) in lines.iter().enumerate() {
+            let mut canvas = vec![255u8; (w * h * 3) as usize];
+            let mut dirty = Dirty::new(w, h);
+            {
+                let mut f = FastLines(
+                    BitMapBackend::with_buffer(&mut canvas, (w, h)),
+                    Some(&mut dirty),
+                );
+                let style = plotters::style::ShapeStyle::from(&red.mix(alpha)).stroke_width(width);
+                f.draw_line(a, b, &style).unwrap();
+            }
+            for y in 0..h as usize {
+                for x in 0..w as usize {
+                    let px = &canvas[(y * w as usize + x) * 3..][..3];
+                    assert!(
+                        dirty.touched(y / 2, x / STRETCH) || px == [255; 3],
+                        "line {k}: pixel ({x}, {y}) drawn, not marked"
+                    );
+                }
+            }
+        }
     }
 }

@@ -326,6 +326,30 @@ pub fn render_rgb_antialiased(fig: &Figure) -> Result<Vec<u8>, PlotError> {
     })
 }
 
+/// Encodes an RGB image (`width_px * height_px * 3` bytes, as [`render_rgb_antialiased`]
+/// gives) as a PNG at `path`, atomically: the bytes [`render_png`] writes for the same pixels.
+pub fn write_rgb_png(
+    path: &Path,
+    width_px: u32,
+    height_px: u32,
+    rgb: &[u8],
+) -> Result<(), PlotError> {
+    check_target(path, width_px, height_px)?;
+    if rgb.len() != width_px as usize * height_px as usize * 3 {
+        return Err(gyroemu_io::IoError::Producer {
+            path: path.to_path_buf(),
+            reason: format!(
+                "{} bytes for a {width_px} x {height_px} RGB image (it takes {})",
+                rgb.len(),
+                width_px as usize * height_px as usize * 3
+            )
+            .into(),
+        }
+        .into());
+    }
+    write_png(path, width_px, height_px, rgb)
+}
+
 /// Renders `panels` in a grid of `cols` columns (rows as needed, filled row by row) under an
 /// overall `title`, into one `width_px` x `height_px` PNG at `path`, atomically and
 /// anti-aliased. Each panel's own `width_px`/`height_px` are ignored; its text scales with
@@ -462,6 +486,26 @@ mod tests {
             assert_eq!(out, want);
             assert!(canvas.iter().all(|&b| b == 255));
         }
+    }
+
+    #[test]
+    fn an_image_drawn_in_memory_writes_the_bytes_of_render_png() {
+        use crate::figure::{Figure, Series, SeriesStyle};
+        let xs: Vec<f64> = (0..40).map(f64::from).collect();
+        let ys: Vec<f64> = xs.iter().map(|x| (x * 0.3).cos()).collect();
+        let mut fig =
+            Figure::new("in memory", "x", "y").with(Series::new("line", SeriesStyle::Line, xs, ys));
+        (fig.width_px, fig.height_px) = (300, 200);
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+        render_png(&fig, &a).unwrap();
+        let rgb = render_rgb_antialiased(&fig).unwrap();
+        write_rgb_png(&b, 300, 200, &rgb).unwrap();
+        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+        // An image of the wrong size is refused, nothing written.
+        let c = dir.path().join("c.png");
+        assert!(write_rgb_png(&c, 300, 201, &rgb).is_err());
+        assert!(!c.exists());
     }
 
     #[test]

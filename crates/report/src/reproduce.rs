@@ -23,7 +23,9 @@ use gyroemu_experiment::{
     DUMP_STEM,
 };
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
-use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
+use gyroemu_plot::{
+    render_png, render_rgb_antialiased, write_rgb_png, Figure, Series, SeriesStyle,
+};
 use gyroemu_theory::rate_table_gain;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -67,6 +69,9 @@ type JobOutput = (
     SweepResult,
     Option<Result<(Vec<PathBuf>, Option<PathBuf>), ReportError>>,
 );
+
+/// A figure drawn in memory: its description (for its size) and its RGB pixels.
+type DrawnFigure = (Figure, Vec<u8>);
 
 /// What the bandwidth sweep's read-out gives: its point-samples, its table and its figure.
 type BandwidthOutput = (u64, [PathBuf; 2]);
@@ -295,17 +300,17 @@ pub fn reproduce(
     // while the other experiments' groups go on; the bandwidth sweep's likewise.
     let outputs: Vec<Mutex<Option<Result<JobOutput, ReportError>>>> =
         jobs.iter().map(|_| Mutex::new(None)).collect();
-    // Fig. 6 as soon as both BAW experiments are read out, beside the second one's files (a
-    // thread with nothing left to run takes either), while other items still run: drawn at
-    // the end it kept one thread alone while the other waited.
+    // Fig. 6 drawn (in memory) as soon as both BAW experiments are read out, beside the
+    // second one's files (a thread with nothing left to run takes either), while other items
+    // still run: drawn at the end it kept one thread alone while the other waited. It is
+    // written at the end, once every experiment has passed its checks, as before.
     let (baw_c, baw_r) = (
         job_index(jobs, "baw-coriolis"),
         job_index(jobs, "baw-rotating"),
     );
     let fig6_left = AtomicUsize::new(2);
     let fig6_in: [Mutex<Option<SweepResult>>; 2] = Default::default();
-    let fig6_out: Mutex<Option<Result<PathBuf, ReportError>>> = Mutex::new(None);
-    let fig6_path = out.join("fig6.png");
+    let fig6_drawn: Mutex<Option<Result<DrawnFigure, ReportError>>> = Mutex::new(None);
     let fig6_hand_in = |i: usize, r: &SweepResult| {
         let k = match i {
             _ if i == baw_c => 0,
@@ -319,10 +324,11 @@ pub fn reproduce(
         if fig6_left.fetch_sub(1, Ordering::AcqRel) == 1 {
             let (c, rot) = (lock(&fig6_in[0]), lock(&fig6_in[1]));
             if let (Some(c), Some(rot)) = (&*c, &*rot) {
-                let res = render_png(&fig6(&jobs[baw_c].cfg, c, rot), &fig6_path)
-                    .map(|()| fig6_path.clone())
+                let fig = fig6(&jobs[baw_c].cfg, c, rot);
+                let drawn = render_rgb_antialiased(&fig)
+                    .map(|rgb| (fig, rgb))
                     .map_err(ReportError::from);
-                *lock(&fig6_out) = Some(res);
+                *lock(&fig6_drawn) = Some(drawn);
             }
         }
     };
@@ -434,16 +440,19 @@ pub fn reproduce(
         }
     }
     files.extend(bandwidth_files);
-    // Rendered in the queue; both read-outs passed their checks above, so it was drawn.
-    let fig6_file = match lock(&fig6_out).take() {
-        Some(res) => res?,
+    // Drawn in the queue (both read-outs passed their checks above, so it was), written now.
+    let path = out.join("fig6.png");
+    match lock(&fig6_drawn).take() {
+        Some(drawn) => {
+            let (fig, rgb) = drawn?;
+            write_rgb_png(&path, fig.width_px, fig.height_px, &rgb)?;
+        }
         None => {
             let ((cc, cr, _), (_, rr, _)) = (get("baw-coriolis"), get("baw-rotating"));
-            render_png(&fig6(cc, cr, rr), &fig6_path)?;
-            fig6_path.clone()
+            render_png(&fig6(cc, cr, rr), &path)?;
         }
-    };
-    files.push(fig6_file);
+    }
+    files.push(path);
     let pair = |c: &str, rname: &str| {
         let (cfg, rc, _) = get(c);
         let (_, rrot, _) = get(rname);
