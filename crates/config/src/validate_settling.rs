@@ -351,9 +351,9 @@ impl Config {
         let mut table_fold: Option<Option<Vec<f64>>> = None;
         // So are the unit phasors of the envelope grid and of the kernel's bins (N is the
         // config's): formed once, not per point and mode (the same angles, the same bits).
-        let mut grid_memo: Option<Vec<Complex64>> = None;
-        let mut bins_memo: Option<Vec<Complex64>> = None;
-        let mut lp_memo: Option<(Window, Vec<f64>)> = None;
+        let mut grid_memo: Option<(usize, Vec<Complex64>)> = None;
+        let mut bins_memo: Option<(usize, Vec<Complex64>)> = None;
+        let mut lp_memo: Option<((Window, usize), Vec<f64>)> = None;
         for rate in self.emulated_rates_dps() {
             let su = StartUp {
                 modes: &modes,
@@ -455,11 +455,8 @@ impl Config {
                         // `read`: the window's and N's alone, so formed once for every
                         // point and mode that share the window.
                         let nz = z.len();
-                        if lp_memo
-                            .as_ref()
-                            .is_none_or(|(w, v)| *w != su.window || v.len() != nz * (2 * nu + 1))
-                        {
-                            let lp = (-n..=n)
+                        let lp = memo(&mut lp_memo, (su.window, nz * (2 * nu + 1)), || {
+                            (-n..=n)
                                 .flat_map(|read| {
                                     let w_read = w_of(read as f64 * freq_hz);
                                     let su = &su;
@@ -469,10 +466,8 @@ impl Config {
                                             + su.lowpass(image - w, w_read).norm()
                                     })
                                 })
-                                .collect();
-                            lp_memo = Some((su.window, lp));
-                        }
-                        let lp = lp_memo.as_ref().map_or(&[][..], |(_, v)| v.as_slice());
+                                .collect()
+                        });
                         let d: Vec<f64> = (-n..=n)
                             .map(|read| {
                                 let row = &lp[(read + n) as usize * nz..][..nz];
@@ -657,12 +652,16 @@ impl Config {
     }
 }
 
-/// The vector kept in `slot` if it has `len` entries, else `make()`'s, kept there.
-fn memo<T>(slot: &mut Option<Vec<T>>, len: usize, make: impl FnOnce() -> Vec<T>) -> &[T] {
-    if slot.as_ref().is_none_or(|v| v.len() != len) {
-        *slot = Some(make());
+/// The vector kept in `slot` if it was made for `key`, else `make()`'s, kept there for `key`.
+fn memo<K: PartialEq, T>(
+    slot: &mut Option<(K, Vec<T>)>,
+    key: K,
+    make: impl FnOnce() -> Vec<T>,
+) -> &[T] {
+    if slot.as_ref().is_none_or(|(k, _)| *k != key) {
+        *slot = Some((key, make()));
     }
-    slot.as_deref().unwrap_or_default()
+    slot.as_ref().map_or(&[], |(_, v)| v.as_slice())
 }
 
 #[cfg(test)]
@@ -671,14 +670,14 @@ mod tests {
     use gyroemu_core::Stage;
     use gyroemu_lpf::{LowPass, LowPassDesign};
 
-    /// A kept vector is reused at its length (its key) and replaced at another.
+    /// A kept vector is reused for its key and replaced for another.
     #[test]
-    fn memo_keeps_a_vector_of_its_length_only() {
+    fn memo_keeps_a_vector_for_its_key_only() {
         let mut slot = None;
         assert_eq!(memo(&mut slot, 2, || vec![1, 2]), &[1, 2]);
         assert_eq!(memo(&mut slot, 2, || vec![7, 7]), &[1, 2]);
         assert_eq!(memo(&mut slot, 3, || vec![3, 4, 5]), &[3, 4, 5]);
-        assert_eq!(slot, Some(vec![3, 4, 5]));
+        assert_eq!(slot, Some((3, vec![3, 4, 5])));
     }
 
     /// The modal impulse response is the built filter's (run on an impulse), every order, a
