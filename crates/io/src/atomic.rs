@@ -140,14 +140,27 @@ fn to_background(p: Pending) -> Result<Option<Pending>, IoError> {
 /// files written from here on to their writers: for an exit that skips its end (Ctrl-C),
 /// which would otherwise delete finished files still waiting as temporaries.
 pub fn flush_background_persist() {
-    let worker = {
-        let mut b = background();
-        b.1 = None;
-        b.2.take()
-    };
+    let worker = close_queue(&mut background());
     if let Some(w) = worker {
-        let _ = w.join();
+        drop(join_worker(w));
     }
+}
+
+/// Closes the background queue (the thread ends after the last file in it) and gives the
+/// thread to wait for; later files are synced and renamed by their writers.
+fn close_queue(b: &mut Background) -> Option<std::thread::JoinHandle<Option<IoError>>> {
+    b.1 = None;
+    b.2.take()
+}
+
+/// Waits for the background thread: its first failure, if any.
+fn join_worker(w: std::thread::JoinHandle<Option<IoError>>) -> Option<IoError> {
+    w.join().unwrap_or_else(|_| {
+        Some(IoError::Write {
+            path: PathBuf::from("<background persist>"),
+            reason: std::io::Error::other("the thread putting files in place panicked"),
+        })
+    })
 }
 
 /// Runs `f` with the sync and rename of every file written atomically (outside
@@ -211,16 +224,9 @@ fn leave_background() -> Option<IoError> {
         if b.0 > 0 {
             return None;
         }
-        // The queue closes: the thread ends after the last file.
-        b.1 = None;
-        b.2.take()
+        close_queue(&mut b)
     }?;
-    worker.join().unwrap_or_else(|_| {
-        Some(IoError::Write {
-            path: PathBuf::from("<background persist>"),
-            reason: std::io::Error::other("the thread putting files in place panicked"),
-        })
-    })
+    join_worker(worker)
 }
 
 /// A temporary file written whole, waiting for its sync and rename onto `path`.
