@@ -140,13 +140,9 @@ fn downsample2_whitening(
         while start < used {
             let end = (start + run).min(used);
             let d = &mut o[start / 2..end / 2];
-            if dirty.is_some_and(|t| !t.touched(p, start / run)) {
-                d.fill(255);
-                start = end;
-                continue;
-            }
             let (a, b) = (&mut r0[start..end], &mut r1[start..end]);
-            if all_white(a) & all_white(b) {
+            // Untouched (not read), or white in both rows: white, nothing written back.
+            if dirty.is_some_and(|t| !t.touched(p, start / run)) || all_white(a) & all_white(b) {
                 d.fill(255);
             } else {
                 average_rows(a, b, d);
@@ -192,11 +188,10 @@ where
     buf.resize(len.max(buf.len()), 255);
     let canvas = &mut buf[..len];
     // What the drawing touches, for the 2 x 2 average to read only that.
-    let mut dirty = Dirty::new(bw, bh);
+    let mut dirty = (k == 2).then(|| Dirty::new(bw, bh));
     let drawn: DrawResult = (|| {
-        let tracked = (k == 2).then_some(&mut dirty);
-        let root =
-            FastLines(BitMapBackend::with_buffer(canvas, (bw, bh)), tracked).into_drawing_area();
+        let root = FastLines(BitMapBackend::with_buffer(canvas, (bw, bh)), dirty.as_mut())
+            .into_drawing_area();
         draw(&root)?;
         root.present()?;
         Ok(())
@@ -217,7 +212,13 @@ where
             (Ok(()), 0)
         }
         Ok(()) if k == 2 => {
-            downsample2_whitening(&mut buf[..len], bw as usize, bh as usize, out, Some(&dirty));
+            downsample2_whitening(
+                &mut buf[..len],
+                bw as usize,
+                bh as usize,
+                out,
+                dirty.as_ref(),
+            );
             (Ok(()), past)
         }
         Ok(()) => {
@@ -483,6 +484,17 @@ mod tests {
             let mut canvas = src.clone();
             let mut out = vec![9u8; 1000];
             downsample2_whitening(&mut canvas, w, h, &mut out, None);
+            assert_eq!(out, want);
+            assert!(canvas.iter().all(|&b| b == 255));
+            // With the cells of the inked pixels marked (the rest left unread): the same.
+            let mut dirty = Dirty::new(w as u32, h as u32);
+            for (i, px) in src.chunks_exact(3).enumerate() {
+                if px != [255; 3] {
+                    dirty.pixel(((i % w) as i32, (i / w) as i32));
+                }
+            }
+            let mut canvas = src.clone();
+            downsample2_whitening(&mut canvas, w, h, &mut out, Some(&dirty));
             assert_eq!(out, want);
             assert!(canvas.iter().all(|&b| b == 255));
         }
