@@ -96,14 +96,20 @@ fn persist(tmp: NamedTempFile, path: &Path, live: Registered) -> Result<(), IoEr
     rename_into_place(pending)
 }
 
-/// The thread that syncs and renames files while [`with_background_persist`] runs (how many
-/// run at once, the queue, the thread, which returns the first error).
-type Background = (
-    usize,
-    Option<std::sync::mpsc::Sender<Pending>>,
-    Option<std::thread::JoinHandle<Option<IoError>>>,
-);
-static BACKGROUND: std::sync::Mutex<Background> = std::sync::Mutex::new((0, None, None));
+/// The thread that syncs and renames files while [`with_background_persist`] runs.
+struct Background {
+    /// Calls of [`with_background_persist`] running (nested or on several threads).
+    depth: usize,
+    /// Where writers hand their files; `None` when no thread takes them.
+    queue: Option<std::sync::mpsc::Sender<Pending>>,
+    /// The thread, which returns its first failure.
+    worker: Option<std::thread::JoinHandle<Option<IoError>>>,
+}
+static BACKGROUND: std::sync::Mutex<Background> = std::sync::Mutex::new(Background {
+    depth: 0,
+    queue: None,
+    worker: None,
+});
 
 fn background() -> std::sync::MutexGuard<'static, Background> {
     BACKGROUND.lock().unwrap_or_else(|e| e.into_inner())
@@ -122,7 +128,7 @@ fn background_failed() -> std::sync::MutexGuard<'static, Option<String>> {
 /// (its temporary deleted) once a file before it could not be put in place.
 fn to_background(p: Pending) -> Result<Option<Pending>, IoError> {
     let b = background();
-    let Some(queue) = b.1.as_ref() else {
+    let Some(queue) = b.queue.as_ref() else {
         return Ok(Some(p));
     };
     if let Some(earlier) = background_failed().as_ref() {
@@ -149,8 +155,8 @@ pub fn flush_background_persist() {
 /// Closes the background queue (the thread ends after the last file in it) and gives the
 /// thread to wait for; later files are synced and renamed by their writers.
 fn close_queue(b: &mut Background) -> Option<std::thread::JoinHandle<Option<IoError>>> {
-    b.1 = None;
-    b.2.take()
+    b.queue = None;
+    b.worker.take()
 }
 
 /// Waits for the background thread: its first failure, if any.
@@ -185,8 +191,8 @@ pub fn with_background_persist<R, E: From<IoError>>(
 ) -> Result<R, E> {
     {
         let mut b = background();
-        b.0 += 1;
-        if b.1.is_none() && b.0 == 1 {
+        b.depth += 1;
+        if b.queue.is_none() && b.depth == 1 {
             *background_failed() = None;
             let (tx, rx) = std::sync::mpsc::channel::<Pending>();
             let worker = std::thread::Builder::new()
@@ -203,7 +209,7 @@ pub fn with_background_persist<R, E: From<IoError>>(
                 });
             // No thread: each writer syncs and renames its own files, as outside this.
             if let Ok(worker) = worker {
-                (b.1, b.2) = (Some(tx), Some(worker));
+                (b.queue, b.worker) = (Some(tx), Some(worker));
             }
         }
     }
@@ -220,8 +226,8 @@ pub fn with_background_persist<R, E: From<IoError>>(
 fn leave_background() -> Option<IoError> {
     let worker = {
         let mut b = background();
-        b.0 -= 1;
-        if b.0 > 0 {
+        b.depth -= 1;
+        if b.depth > 0 {
             return None;
         }
         close_queue(&mut b)
