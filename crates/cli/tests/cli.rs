@@ -219,6 +219,18 @@ fn reproduce_quick_writes_every_figure_and_the_slope_ratio() {
     ] {
         assert!(out.join(f).metadata().unwrap().len() > 1000, "{f}");
     }
+    // A figure that is its experiment's own plot has its bytes (drawn once, written twice);
+    // the rotating figures add the paper-style estimate, so they differ from theirs.
+    let bytes = |p: &str| std::fs::read(out.join(p)).unwrap();
+    for (fig, plot, same) in [
+        ("fig8.png", "m2tfg-coriolis/plot.png", true),
+        ("fig4.png", "baw-coriolis/plot.png", true),
+        ("fig_ratetable.png", "m2tfg-ratetable/plot.png", true),
+        ("fig9.png", "m2tfg-rotating/plot.png", false),
+        ("fig5.png", "baw-rotating/plot.png", false),
+    ] {
+        assert_eq!(bytes(fig) == bytes(plot), same, "{fig} against {plot}");
+    }
     // Every file on disk is in the closing list, and each experiment has its small dump of
     // every node and the two figures drawn from it.
     let listed: std::collections::BTreeSet<String> = stderr(&o)

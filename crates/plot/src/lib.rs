@@ -31,6 +31,6 @@ pub use error::PlotError;
 pub use figure::{Figure, Marker, Series, SeriesStyle, PALETTE};
 pub use font::{ensure_font, FONT_FAMILY};
 pub use render::{
-    downsample_rgb, render_panels_png, render_png, render_rgb, render_rgb_antialiased,
-    write_rgb_png, MAX_SIDE_PX, MIN_SIDE_PX, SUPERSAMPLE,
+    downsample_rgb, render_panels_png, render_png, render_png_copies, render_rgb,
+    render_rgb_antialiased, write_rgb_png, MAX_SIDE_PX, MIN_SIDE_PX, SUPERSAMPLE,
 };

@@ -8,6 +8,7 @@ use crate::fast_lines::FastLines;
 use crate::figure::Figure;
 use crate::font::{bold, ensure_font};
 use crate::PlotError;
+use image::ImageEncoder;
 use plotters::prelude::*;
 use std::path::Path;
 use std::sync::Mutex;
@@ -37,7 +38,7 @@ fn check_target(path: &Path, w: u32, h: u32) -> Result<(), PlotError> {
     if !png {
         return Err(PlotError::InvalidLayout {
             path: path.to_path_buf(),
-            reason: "the file name must end in .png (the encoder picks the format from it)".into(),
+            reason: "the file name must end in .png (figures are written as PNG)".into(),
         });
     }
     Ok(())
@@ -240,14 +241,15 @@ where
     Ok(out)
 }
 
-/// [`supersampled`] into a kept image buffer, encoded as a PNG at `path` (atomically).
-fn to_png<F>(path: &Path, w: u32, h: u32, k: u32, draw: F) -> Result<(), PlotError>
+/// [`supersampled`] into a kept image buffer, encoded once as a PNG and written at each of
+/// `paths` (atomically).
+fn to_png<F>(paths: &[&Path], w: u32, h: u32, k: u32, draw: F) -> Result<(), PlotError>
 where
     F: FnOnce(&Area) -> DrawResult,
 {
     // An image buffer: every byte is overwritten, so none is white afterwards.
     let mut rgb = take_buffer(w as usize * h as usize * 3).buf;
-    let res = supersampled(w, h, k, draw, &mut rgb).and_then(|()| write_png(path, w, h, &rgb));
+    let res = supersampled(w, h, k, draw, &mut rgb).and_then(|()| write_png(paths, w, h, &rgb));
     give_back(Kept { buf: rgb, white: 0 });
     res
 }
@@ -284,13 +286,23 @@ fn give_back(kept: Kept) {
     }
 }
 
-/// Encodes an RGB image as PNG at `path`, atomically: `image`'s encoder, as plotters' bitmap
-/// backend calls it (the same bytes), without copying the image into a backend first.
-fn write_png(path: &Path, w: u32, h: u32, rgb: &[u8]) -> Result<(), PlotError> {
-    gyroemu_io::write_atomic_via(path, |tmp| {
-        image::save_buffer(tmp, rgb, w, h, image::ColorType::Rgb8)?;
-        Ok(())
-    })?;
+/// Encodes an RGB image as PNG once and writes it at each of `paths`, atomically: `image`'s
+/// encoder, as plotters' bitmap backend calls it (the same bytes), without copying the image
+/// into a backend first.
+fn write_png(paths: &[&Path], w: u32, h: u32, rgb: &[u8]) -> Result<(), PlotError> {
+    let Some(first) = paths.first() else {
+        return Ok(());
+    };
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(rgb, w, h, image::ColorType::Rgb8)
+        .map_err(|e| gyroemu_io::IoError::Producer {
+            path: first.to_path_buf(),
+            reason: e.into(),
+        })?;
+    for path in paths {
+        gyroemu_io::write_atomic(path, &bytes)?;
+    }
     Ok(())
 }
 
@@ -299,10 +311,21 @@ fn write_png(path: &Path, w: u32, h: u32, rgb: &[u8]) -> Result<(), PlotError> {
 /// span the finite data with a 5 % margin (whole decades on a log axis); non-finite points are
 /// skipped; empty or constant data get a sensible span.
 pub fn render_png(fig: &Figure, path: &Path) -> Result<(), PlotError> {
-    check_target(path, fig.width_px, fig.height_px)?;
+    render_png_copies(fig, &[path])
+}
+
+/// [`render_png`] at each of `paths`: drawn and encoded once, the same bytes in every file
+/// (every target checked before drawing).
+pub fn render_png_copies(fig: &Figure, paths: &[&Path]) -> Result<(), PlotError> {
+    if paths.is_empty() {
+        return Ok(());
+    }
+    for path in paths {
+        check_target(path, fig.width_px, fig.height_px)?;
+    }
     ensure_font()?;
     let k = SUPERSAMPLE;
-    to_png(path, fig.width_px, fig.height_px, k, |a| {
+    to_png(paths, fig.width_px, fig.height_px, k, |a| {
         draw_figure(a, fig, f64::from(k))
     })
 }
@@ -348,7 +371,7 @@ pub fn write_rgb_png(
         }
         .into());
     }
-    write_png(path, width_px, height_px, rgb)
+    write_png(&[path], width_px, height_px, rgb)
 }
 
 /// Renders `panels` in a grid of `cols` columns (rows as needed, filled row by row) under an
@@ -384,7 +407,7 @@ pub fn render_panels_png(
     ensure_font()?;
     let k = SUPERSAMPLE;
     let ss = f64::from(k);
-    to_png(path, width_px, height_px, k, |root| {
+    to_png(&[path], width_px, height_px, k, |root| {
         let body = if title.is_empty() {
             root.clone()
         } else {

@@ -1,7 +1,8 @@
 //! PNG output, text presence, geometry, degenerate inputs and atomicity.
 
 use gyroemu_plot::{
-    render_panels_png, render_png, render_rgb, Figure, PlotError, Series, SeriesStyle, PALETTE,
+    render_panels_png, render_png, render_png_copies, render_rgb, Figure, PlotError, Series,
+    SeriesStyle, PALETTE,
 };
 use std::path::Path;
 
@@ -308,6 +309,32 @@ fn failed_renders_leave_nothing_under_the_final_name() {
     assert!(blocker.is_dir());
     assert_eq!(std::fs::read(&keep).unwrap(), b"old");
     assert_eq!(entries(dir.path()), vec!["blocked.png", "keep.png"]);
+}
+
+/// One figure under several names: each file has the bytes `render_png` writes alone, and a
+/// refused name among them leaves every one untouched.
+#[test]
+fn copies_have_the_bytes_of_a_render_and_fail_together() {
+    let dir = tempfile::tempdir().unwrap();
+    let [alone, a, b] = ["alone.png", "a.png", "b.png"].map(|f| dir.path().join(f));
+    render_png(&demo("Copies"), &alone).unwrap();
+    render_png_copies(&demo("Copies"), &[&a, &b]).unwrap();
+    let want = std::fs::read(&alone).unwrap();
+    assert_eq!(std::fs::read(&a).unwrap(), want);
+    assert_eq!(std::fs::read(&b).unwrap(), want);
+    // A different figure gives different bytes (the comparison above can fail).
+    render_png(&demo("Other"), &alone).unwrap();
+    assert_ne!(std::fs::read(&alone).unwrap(), want);
+
+    let (c, jpeg) = (dir.path().join("c.png"), dir.path().join("d.jpeg"));
+    assert!(matches!(
+        render_png_copies(&demo("x"), &[&c, &jpeg]),
+        Err(PlotError::InvalidLayout { .. })
+    ));
+    assert!(!c.exists() && !jpeg.exists());
+    // No names: nothing drawn, nothing written.
+    render_png_copies(&demo("x"), &[]).unwrap();
+    assert_eq!(entries(dir.path()), vec!["a.png", "alone.png", "b.png"]);
 }
 
 /// Figures drawn into buffers kept from earlier figures (larger, smaller, drawn at once on

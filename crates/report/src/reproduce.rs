@@ -593,22 +593,23 @@ fn write_job(
     // One figure for both files (its theory overlay is a harmonic balance per abscissa on a
     // rate table), and the plan's validation for the summary's warnings.
     let plot = sweep_figure(&job.cfg, r, job.title);
-    // In parallel: the last experiment to finish has the pool to itself.
-    let (run, figure) = rayon::join(
-        || write_run_with(&dir, &job.cfg, Ok(job.warnings.clone()), r, &plot),
-        || -> Result<_, ReportError> {
-            let Some(name) = figure_name(job.preset) else {
-                return Ok(None);
-            };
-            let mut f = plot.clone();
-            if let Some(paper) = paper_i_series(r) {
-                f = f.with(paper);
-            }
-            let path = out.join(format!("{name}.png"));
-            render_png(&f, &path)?;
-            Ok(Some(path))
-        },
-    );
+    let figure_path = figure_name(job.preset).map(|name| out.join(format!("{name}.png")));
+    let write_run = |copies: &[&Path]| {
+        write_run_with(&dir, &job.cfg, Ok(job.warnings.clone()), r, &plot, copies)
+    };
+    let (run, figure) = match (&figure_path, paper_i_series(r)) {
+        // The figure is the run's own plot: drawn and encoded once, written under both names.
+        (Some(path), None) => (write_run(&[path]), Ok(figure_path.clone())),
+        // In parallel: the last experiment to finish has the pool to itself.
+        (Some(path), Some(paper)) => rayon::join(
+            || write_run(&[]),
+            || -> Result<_, ReportError> {
+                render_png(&plot.clone().with(paper), path)?;
+                Ok(figure_path.clone())
+            },
+        ),
+        (None, _) => (write_run(&[]), Ok(None)),
+    };
     let mut files = run?;
     files.extend(swept.dump_files.iter().cloned());
     files.extend(swept.dump_made.iter().cloned());

@@ -7,7 +7,7 @@ use gyroemu_config::Config;
 use gyroemu_experiment::fit::LineFit;
 use gyroemu_experiment::{fit_readings, reading_period_deg, theory_deg, SweepResult};
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
-use gyroemu_plot::{render_png, Figure, Series, SeriesStyle};
+use gyroemu_plot::{render_png_copies, Figure, Series, SeriesStyle};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -381,23 +381,34 @@ pub fn write_run(
     r: &SweepResult,
     title: &str,
 ) -> Result<Vec<PathBuf>, ReportError> {
-    write_run_with(dir, cfg, judged.validate(), r, &sweep_figure(cfg, r, title))
+    write_run_with(
+        dir,
+        cfg,
+        judged.validate(),
+        r,
+        &sweep_figure(cfg, r, title),
+        &[],
+    )
 }
 
 /// [`write_run`] with the judged config's validation already done (`validated`, as
-/// [`summary_with`] takes it) and the run's figure drawn (`figure`, [`sweep_figure`]'s).
+/// [`summary_with`] takes it) and the run's figure drawn (`figure`, [`sweep_figure`]'s);
+/// `plot.png`'s bytes are also written at each of `copies` (drawn and encoded once).
 pub fn write_run_with(
     dir: &Path,
     cfg: &Config,
     validated: Result<Vec<String>, gyroemu_config::ConfigError>,
     r: &SweepResult,
     figure: &Figure,
+    copies: &[&Path],
 ) -> Result<Vec<PathBuf>, ReportError> {
     create_dir(dir)?;
     let [csv, json, png] = RUN_FILES.map(|f| dir.join(f));
     write_csv(&csv, &results_table(r))?;
     write_json(&json, &summary_with(cfg, validated, r))?;
-    render_png(figure, &png)?;
+    let mut targets = vec![png.as_path()];
+    targets.extend_from_slice(copies);
+    render_png_copies(figure, &targets)?;
     Ok(vec![csv, json, png])
 }
 
