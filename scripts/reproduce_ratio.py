@@ -28,14 +28,17 @@ from pathlib import Path
 PRESETS = ["m2tfg-rotating", "baw-rotating", "m2tfg-ratetable", "m2tfg-coriolis", "baw-coriolis"]
 
 
-def bench(binary: str, repeats: int) -> dict:
-    """The best `whole chain` rate on all threads of each preset, point-samples/s."""
-    rates = {}
+def bench(binary: str, repeats: int) -> tuple:
+    """The best `whole chain` rate on all threads of each preset, point-samples/s, and the
+    bench's line naming the CPU."""
+    rates, cpu = {}, "cpu: not named by this binary"
     for preset in PRESETS:
-        out = subprocess.run(
+        done = subprocess.run(
             [binary, "bench", "--preset", preset, "--repeats", str(repeats)],
             check=True, capture_output=True, text=True,
-        ).stdout
+        )
+        out = done.stdout
+        cpu = next((l for l in done.stderr.splitlines() if l.startswith("cpu: ")), cpu)
         # The row without a lane type is the chain in the lanes a run of it uses on this CPU
         # (eight, or four where they run faster: `gyroemu_board::max_lanes_for`).
         rows = [line.split() for line in out.splitlines()
@@ -43,7 +46,7 @@ def bench(binary: str, repeats: int) -> dict:
         # On the most threads.
         best = max(rows, key=lambda r: int(r[-3]))
         rates[preset] = float(best[-2]) * 1e6
-    return rates
+    return rates, cpu
 
 
 def run_reproduce(binary: str, out: Path) -> tuple:
@@ -81,15 +84,16 @@ def main() -> None:
     tmp = Path(tempfile.mkdtemp(prefix="reproduce_ratio_"))
     _, total = run_reproduce(a.binaries[0], tmp / "first")
     samples = point_samples(tmp / "first", total)
-    before = bench(a.binaries[0], a.repeats)
+    before, cpu = bench(a.binaries[0], a.repeats)
     walls = {b: [] for b in a.binaries}
     for _ in range(a.runs):
         for b in a.binaries:
             walls[b].append(run_reproduce(b, tmp / "run")[0])
-    after = bench(a.binaries[0], a.repeats)
+    after, _ = bench(a.binaries[0], a.repeats)
     shutil.rmtree(tmp, ignore_errors=True)
     p = [predict(samples, r) for r in (before, after)]
     pred = statistics.mean(p)
+    print(cpu)
     print("point-samples:", {k: f"{v:.4g}" for k, v in samples.items()})
     for name, r in (("before", before), ("after", after)):
         print(f"bench {name} (M point-samples/s):",

@@ -110,41 +110,12 @@ impl LaneCpu {
 /// and Intel's cores run them whole; Zen 5 mobile parts are said to split them too, but are
 /// not told apart here (unmeasured: they run eight lanes on every chain).
 pub fn halves_512() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        static HALVES: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-        *HALVES.get_or_init(|| {
-            // Leaves 0 and 1 exist on every x86-64 CPU.
-            use core::arch::x86_64::__cpuid;
-            let (v, f) = (__cpuid(0), __cpuid(1).eax);
-            let vendor = [v.ebx, v.edx, v.ecx];
-            eight_lanes_available() && is_amd(vendor) && family(f) == 0x19
-        })
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
-/// CPUID leaf 0's vendor words (EBX, EDX, ECX) spell "AuthenticAMD".
-fn is_amd(words: [u32; 3]) -> bool {
-    let mut name = [0u8; 12];
-    for (k, w) in words.iter().enumerate() {
-        name[4 * k..4 * k + 4].copy_from_slice(&w.to_le_bytes());
-    }
-    &name == b"AuthenticAMD"
-}
-
-/// The CPU family of CPUID leaf 1's EAX: the base family, plus the extended family when the
-/// base is 0Fh (the rule of both vendors' manuals).
-fn family(eax: u32) -> u32 {
-    let base = (eax >> 8) & 0xF;
-    if base == 0xF {
-        base + ((eax >> 20) & 0xFF)
-    } else {
-        base
-    }
+    static HALVES: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *HALVES.get_or_init(|| {
+        let zen4 = crate::CpuId::this_cpu()
+            .is_some_and(|c| c.vendor == "AuthenticAMD" && c.family == 0x19);
+        eight_lanes_available() && zen4
+    })
 }
 
 /// The sizes of the lane groups for `n` points on `threads` threads, in order (points taken
@@ -227,21 +198,6 @@ pub fn group_sizes(p: &BoardParams, samples: &[u64], threads: usize) -> Vec<usiz
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn cpuid_words_decode_to_vendor_and_family() {
-        // Leaf 0's EBX, EDX, ECX of each vendor.
-        assert!(is_amd([0x6874_7541, 0x6974_6e65, 0x444d_4163]));
-        assert!(!is_amd([0x756e_6547, 0x4965_6e69, 0x6c65_746e]));
-        // Leaf 1's EAX: Zen 4 EPYC 9004 (family 19h model 11h), Zen 5 (1Ah model 02h),
-        // Zen 3 (19h model 01h), an Intel Sapphire Rapids (6, model 8Fh) and a 486-era base
-        // family 4 whose extended bits must be ignored.
-        assert_eq!(family(0x00A1_0F11), 0x19);
-        assert_eq!(family(0x00B0_0F20), 0x1A);
-        assert_eq!(family(0x00A0_0F11), 0x19);
-        assert_eq!(family(0x0008_06F8), 6);
-        assert_eq!(family(0x0FF0_0400), 4);
-    }
 
     #[test]
     fn groups_cover_the_points_fill_the_threads_and_fit_their_width() {

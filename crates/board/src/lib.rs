@@ -10,6 +10,7 @@
 
 mod board;
 mod chain;
+mod cpu;
 #[cfg(target_arch = "x86_64")]
 mod f64x8;
 mod fault;
@@ -27,6 +28,7 @@ mod seeding;
 
 pub use board::{drive_shifter, starts_share_carrier, Board, MAX_START};
 pub use chain::{unleak_sidebands, unleak_table_harmonics, ChainResponse, RotatingTerms};
+pub use cpu::{vector_paths, CpuId};
 pub use fault::NonFinite;
 pub use group::GroupBoard;
 pub use health::Health;

@@ -213,3 +213,38 @@ fn split_512_bit_units_are_what_proc_cpuinfo_says() {
         "{vendor} family {family}"
     );
 }
+
+/// CPUID's vendor, family, model and brand agree with the kernel's `/proc/cpuinfo` (what
+/// `gyroemu bench` prints about the CPU its figures come from).
+#[test]
+fn the_cpu_id_is_what_proc_cpuinfo_says() {
+    let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") else {
+        return;
+    };
+    let field = |key: &str| {
+        info.lines()
+            .find(|l| l.split(':').next().map(str::trim) == Some(key))
+            .and_then(|l| l.split_once(':'))
+            .map(|(_, v)| v.trim().to_string())
+    };
+    let (Some(vendor), Some(family), Some(model)) =
+        (field("vendor_id"), field("cpu family"), field("model"))
+    else {
+        return;
+    };
+    let cpu = gyroemu_board::CpuId::this_cpu().expect("/proc/cpuinfo names an x86 CPU");
+    assert_eq!(
+        (
+            cpu.vendor.as_str(),
+            cpu.family.to_string(),
+            cpu.model.to_string()
+        ),
+        (vendor.as_str(), family, model)
+    );
+    // The kernel prints the brand string with its padding trimmed; runs of spaces inside it
+    // are kept there and folded here.
+    if let Some(name) = field("model name") {
+        let folded = name.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert_eq!(cpu.brand, folded);
+    }
+}

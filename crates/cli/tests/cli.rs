@@ -404,6 +404,20 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8_lossy(&o.stdout);
+    // The figures' CPU first: its CPUID names and the threads, then what its vector units run.
+    let first = stderr(&o).lines().next().unwrap_or_default().to_string();
+    if let Some(cpu) = gyroemu_board::CpuId::this_cpu() {
+        assert!(
+            first.starts_with(&format!("cpu: {}; 2 threads; ", cpu.describe())),
+            "{first}"
+        );
+    }
+    let avx512 = if gyroemu_board::eight_lanes_available() {
+        "; AVX-512"
+    } else {
+        "; no AVX-512"
+    };
+    assert!(first.contains(avx512), "{first}");
     // Groups of eight exist on a CPU with AVX-512 only; the rows without a lane type are the
     // figures of the type a run of that chain uses, which the header names per chain: the
     // widest, except four for the noiseless rotating chain (the default preset's) where the

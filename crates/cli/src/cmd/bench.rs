@@ -40,6 +40,15 @@ pub fn bench_command(preset_name: &str, samples: u64, repeats: usize) -> Result<
             format!("{lanes} points in {}", lane_type(lanes))
         })
         .collect();
+    // The figures below belong to this CPU: they mean little without it.
+    let cpu = gyroemu_board::CpuId::this_cpu()
+        .map_or_else(|| "not an x86-64 CPU".to_string(), |c| c.describe());
+    let threads = rayon::current_num_threads();
+    let s = if threads == 1 { "" } else { "s" };
+    note!(
+        "cpu: {cpu}; {threads} thread{s}; {}",
+        gyroemu_board::vector_paths()
+    );
     note!(
         "bench: preset {preset_name}, fs = {} Hz, {samples} input samples per lane group, best and median of {repeats} runs; \
          whole chain (the preset's / with noise / with noise and flicker): {} per group (what a run uses on this CPU), {typed}; stages: 4 lanes",
