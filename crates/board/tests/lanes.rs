@@ -190,20 +190,25 @@ fn the_lane_width_is_four_only_for_the_ideal_rotating_loop_on_split_512_bit_unit
     }
 }
 
+/// The first CPU's `keys` in `/proc/cpuinfo` (trimmed values; a brand string keeps its
+/// colons), or `None` where the file or a key is missing.
+fn cpuinfo<const K: usize>(keys: [&str; K]) -> Option<[String; K]> {
+    let info = std::fs::read_to_string("/proc/cpuinfo").ok()?;
+    let field = |key: &str| {
+        info.lines()
+            .find(|l| l.split(':').next().map(str::trim) == Some(key))
+            .and_then(|l| l.split_once(':'))
+            .map(|(_, v)| v.trim().to_string())
+    };
+    let values: Vec<String> = keys.iter().map(|k| field(k)).collect::<Option<_>>()?;
+    values.try_into().ok()
+}
+
 /// CPUID's answer agrees with the kernel's: a CPU splits 512-bit operations when it runs
 /// eight lanes and `/proc/cpuinfo` names an AMD of family 25 (19h, Zen 4).
 #[test]
 fn split_512_bit_units_are_what_proc_cpuinfo_says() {
-    let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") else {
-        return;
-    };
-    let field = |key: &str| {
-        info.lines()
-            .find(|l| l.split(':').next().map(str::trim) == Some(key))
-            .and_then(|l| l.split(':').nth(1))
-            .map(|v| v.trim().to_string())
-    };
-    let (Some(vendor), Some(family)) = (field("vendor_id"), field("cpu family")) else {
+    let Some([vendor, family]) = cpuinfo(["vendor_id", "cpu family"]) else {
         return;
     };
     let zen4 = vendor == "AuthenticAMD" && family == "25";
@@ -218,18 +223,7 @@ fn split_512_bit_units_are_what_proc_cpuinfo_says() {
 /// `gyroemu bench` prints about the CPU its figures come from).
 #[test]
 fn the_cpu_id_is_what_proc_cpuinfo_says() {
-    let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") else {
-        return;
-    };
-    let field = |key: &str| {
-        info.lines()
-            .find(|l| l.split(':').next().map(str::trim) == Some(key))
-            .and_then(|l| l.split_once(':'))
-            .map(|(_, v)| v.trim().to_string())
-    };
-    let (Some(vendor), Some(family), Some(model)) =
-        (field("vendor_id"), field("cpu family"), field("model"))
-    else {
+    let Some([vendor, family, model]) = cpuinfo(["vendor_id", "cpu family", "model"]) else {
         return;
     };
     let cpu = gyroemu_board::CpuId::this_cpu().expect("/proc/cpuinfo names an x86 CPU");
@@ -243,7 +237,7 @@ fn the_cpu_id_is_what_proc_cpuinfo_says() {
     );
     // The kernel prints the brand string with its padding trimmed; runs of spaces inside it
     // are kept there and folded here.
-    if let Some(name) = field("model name") {
+    if let Some([name]) = cpuinfo(["model name"]) {
         let folded = name.split_whitespace().collect::<Vec<_>>().join(" ");
         assert_eq!(cpu.brand, folded);
     }
