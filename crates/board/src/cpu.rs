@@ -5,7 +5,7 @@
 /// A CPU as CPUID names it.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct CpuId {
-    /// Leaf 0's twelve bytes: "GenuineIntel", "AuthenticAMD", ...
+    /// Leaf 0's twelve bytes, trimmed: "GenuineIntel", "AuthenticAMD", ...
     pub vendor: String,
     /// The display family (leaf 1: base family, plus the extended family when the base is 0Fh).
     pub family: u32,
@@ -64,33 +64,33 @@ impl CpuId {
     }
 }
 
-/// What this CPU offers the sample loops, as chosen at run time: AVX-512 (F, VL, DQ and BW,
-/// which eight lanes need) or not, whether it runs 512-bit operations whole or in halves
-/// ([`crate::halves_512`]), and how the normal generator's fast path fetches its table
-/// entries ([`gyroemu_core::gauss::Lookup::this_cpu`]).
+/// The vector paths this process chose on this CPU, for a benchmark's header: the widest
+/// lane group (eight needs AVX-512 F, VL, DQ and BW), whether 512-bit operations are taken to
+/// run in halves ([`crate::halves_512`]: AMD family 19h only, so a chain may run four lanes),
+/// and the normal generator's fast path ([`gyroemu_core::gauss::fast_path`], its own check).
+/// The choices, not a survey of the hardware.
 pub fn vector_paths() -> String {
-    use gyroemu_core::gauss::Lookup;
-    if !crate::eight_lanes_available() {
-        return "no AVX-512 (F, VL, DQ, BW): four lanes only".into();
-    }
-    let whole = if crate::halves_512() {
-        "512-bit operations in two halves"
+    let lanes = if !crate::eight_lanes_available() {
+        "groups of up to four lanes (no AVX-512 F, VL, DQ and BW)"
+    } else if crate::halves_512() {
+        "groups of up to eight lanes (AVX-512 F, VL, DQ, BW; 512-bit operations taken to run in halves, AMD family 19h)"
     } else {
-        "512-bit operations whole"
+        "groups of up to eight lanes (AVX-512 F, VL, DQ, BW)"
     };
-    let lookup = match Lookup::this_cpu() {
-        Lookup::Gather => "two 512-bit gathers",
-        Lookup::Loads => "128-bit loads",
-    };
-    format!("AVX-512 (F, VL, DQ, BW), {whole}; the generator's table look-up by {lookup}")
+    format!(
+        "{lanes}; the normal generator: {}",
+        gyroemu_core::gauss::fast_path()
+    )
 }
 
-/// CPUID's registers as the ASCII text they hold (little-endian bytes in register order),
-/// without the NULs and the spaces that pad it.
+/// CPUID's registers as the ASCII text they hold (little-endian bytes in register order), up
+/// to the first NUL (where the kernel stops too), without the spaces that pad it; a byte that
+/// is not printable ASCII reads as a space.
 fn text_of(words: &[u32]) -> String {
     let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
     let text: String = bytes
         .iter()
+        .take_while(|&&b| b != 0)
         .map(|&b| {
             if b.is_ascii_graphic() || b == b' ' {
                 b as char
@@ -114,7 +114,8 @@ fn family(eax: u32) -> u32 {
 }
 
 /// The display model of CPUID leaf 1's EAX: the base model, plus the extended model times 16
-/// when the base family is 6 or 0Fh (both vendors' manuals).
+/// when the base family is 6 or 0Fh (Intel's rule; AMD's adds it for 0Fh, the base family of
+/// every AMD x86-64 part, so the two agree on every x86-64 CPU).
 fn model(eax: u32) -> u32 {
     let base = (eax >> 4) & 0xF;
     match (eax >> 8) & 0xF {
@@ -187,8 +188,18 @@ mod tests {
     #[test]
     #[cfg(target_arch = "x86_64")]
     fn this_cpu_has_a_vendor() {
+        // Not always twelve letters once trimmed ("  Shanghai  ", "VIA VIA VIA "); the
+        // integration test compares every field with /proc/cpuinfo.
         let cpu = CpuId::this_cpu().expect("x86-64");
-        assert_eq!(cpu.vendor.len(), 12, "{cpu:?}");
+        assert!(!cpu.vendor.is_empty() && cpu.vendor.is_ascii(), "{cpu:?}");
         assert!(cpu.family >= 6, "{cpu:?}");
+    }
+
+    #[test]
+    fn text_ends_at_the_first_nul() {
+        let mut w = words("Brand");
+        w.extend(words("\0\0\0\0after"));
+        assert_eq!(text_of(&w), "Brand");
+        assert_eq!(text_of(&[0; 4]), "");
     }
 }

@@ -404,20 +404,40 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8_lossy(&o.stdout);
-    // The figures' CPU first: its CPUID names and the threads, then what its vector units run.
+    // The figures' CPU first, as the kernel names it (vendor, family and model; the
+    // threads), and eight lanes exactly where its flags list AVX-512 F, VL, DQ and BW.
     let first = stderr(&o).lines().next().unwrap_or_default().to_string();
-    if let Some(cpu) = gyroemu_board::CpuId::this_cpu() {
-        assert!(
-            first.starts_with(&format!("cpu: {}; 2 threads; ", cpu.describe())),
+    assert!(
+        first.starts_with("cpu: ") && first.contains("; 2 threads; "),
+        "{first}"
+    );
+    if let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") {
+        let field = |key: &str| {
+            info.lines()
+                .find(|l| l.split(':').next().map(str::trim) == Some(key))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+                .unwrap_or_else(|| panic!("no `{key}` in /proc/cpuinfo"))
+        };
+        let id = format!(
+            "{} family {} model {}",
+            field("vendor_id"),
+            field("cpu family"),
+            field("model")
+        );
+        assert!(first.contains(&id), "{first} against {id}");
+        let flags = field("flags");
+        let has = |f: &str| flags.split_whitespace().any(|x| x == f);
+        let eight = ["avx512f", "avx512vl", "avx512dq", "avx512bw"]
+            .iter()
+            .all(|f| has(f));
+        assert_eq!(first.contains("up to eight lanes"), eight, "{first}");
+        assert_eq!(
+            first.contains("generator: AVX-512F"),
+            has("avx512f"),
             "{first}"
         );
     }
-    let avx512 = if gyroemu_board::eight_lanes_available() {
-        "; AVX-512"
-    } else {
-        "; no AVX-512"
-    };
-    assert!(first.contains(avx512), "{first}");
     // Groups of eight exist on a CPU with AVX-512 only; the rows without a lane type are the
     // figures of the type a run of that chain uses, which the header names per chain: the
     // widest, except four for the noiseless rotating chain (the default preset's) where the

@@ -103,6 +103,19 @@ impl Lookup {
     }
 }
 
+/// The generator's fast path on this CPU, as [`fill_one`] and [`fill_two`] choose it, for a
+/// benchmark's header: AVX-512F with its table look-up ([`Lookup::this_cpu`]), or without.
+pub fn fast_path() -> &'static str {
+    #[cfg(target_arch = "x86_64")]
+    if crate::gauss_avx512::available() {
+        return match Lookup::this_cpu() {
+            Lookup::Gather => "AVX-512F, its table look-up by two 512-bit gathers",
+            Lookup::Loads => "AVX-512F, its table look-up by 128-bit loads",
+        };
+    }
+    "no AVX-512F, four lanes at a time"
+}
+
 /// Fills `out` (of even length) with the next normals of stream a and stream b of four
 /// lanes in turn, with AVX-512F when the CPU has it (the same bits).
 #[inline]

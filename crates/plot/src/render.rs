@@ -306,16 +306,17 @@ fn write_png(paths: &[&Path], w: u32, h: u32, rgb: &[u8]) -> Result<(), PlotErro
     Ok(())
 }
 
-/// Renders `fig` alone into a `width_px` x `height_px` PNG at `path`, atomically (temporary
-/// `.png` in the same directory, renamed when complete), anti-aliased by supersampling. Axes
+/// Renders `fig` alone into a `width_px` x `height_px` PNG at `path`, atomically (a temporary
+/// file in the same directory, renamed when complete), anti-aliased by supersampling. Axes
 /// span the finite data with a 5 % margin (whole decades on a log axis); non-finite points are
 /// skipped; empty or constant data get a sensible span.
 pub fn render_png(fig: &Figure, path: &Path) -> Result<(), PlotError> {
     render_png_copies(fig, &[path])
 }
 
-/// [`render_png`] at each of `paths`: drawn and encoded once, the same bytes in every file
-/// (every target checked before drawing).
+/// [`render_png`] at each of `paths`: drawn and encoded once, the same bytes in every file.
+/// Every name is checked before drawing, so a refused one writes none; the files are then
+/// written one after another, so a write that fails leaves the ones before it in place.
 pub fn render_png_copies(fig: &Figure, paths: &[&Path]) -> Result<(), PlotError> {
     if paths.is_empty() {
         return Ok(());

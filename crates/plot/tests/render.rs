@@ -312,9 +312,9 @@ fn failed_renders_leave_nothing_under_the_final_name() {
 }
 
 /// One figure under several names: each file has the bytes `render_png` writes alone, and a
-/// refused name among them leaves every one untouched.
+/// name refused before drawing writes none of them.
 #[test]
-fn copies_have_the_bytes_of_a_render_and_fail_together() {
+fn copies_have_the_bytes_of_a_render_and_a_refused_name_writes_none() {
     let dir = tempfile::tempdir().unwrap();
     let [alone, a, b] = ["alone.png", "a.png", "b.png"].map(|f| dir.path().join(f));
     render_png(&demo("Copies"), &alone).unwrap();
@@ -335,6 +335,26 @@ fn copies_have_the_bytes_of_a_render_and_fail_together() {
     // No names: nothing drawn, nothing written.
     render_png_copies(&demo("x"), &[]).unwrap();
     assert_eq!(entries(dir.path()), vec!["a.png", "alone.png", "b.png"]);
+}
+
+/// A figure's file has the bytes `image`'s PNG encoder (what plotters' bitmap backend saves
+/// with) gives for the figure's pixels: the encoding is `image`'s, whatever path writes it.
+#[test]
+fn files_have_the_bytes_of_image_for_their_pixels() {
+    use image::ImageEncoder;
+    let dir = tempfile::tempdir().unwrap();
+    let mut small = demo("Small");
+    (small.width_px, small.height_px) = (300, 200);
+    for fig in [demo("Bytes"), small] {
+        let path = dir.path().join("f.png");
+        render_png(&fig, &path).unwrap();
+        let rgb = gyroemu_plot::render_rgb_antialiased(&fig).unwrap();
+        let mut want = Vec::new();
+        image::codecs::png::PngEncoder::new(&mut want)
+            .write_image(&rgb, fig.width_px, fig.height_px, image::ColorType::Rgb8)
+            .unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), want, "{}", fig.title);
+    }
 }
 
 /// Figures drawn into buffers kept from earlier figures (larger, smaller, drawn at once on

@@ -567,7 +567,6 @@ fn bandwidth_outputs(
     Ok((figure, csv))
 }
 
-/// The paper-style real-I-channel estimate of mode 1, for the rotating figures.
 /// The figure `reproduce` draws of an experiment alone.
 fn figure_name(preset: &str) -> Option<&'static str> {
     Some(match preset {
@@ -616,6 +615,7 @@ fn write_job(
     Ok((files, figure?))
 }
 
+/// The paper-style real-I-channel estimate of mode 1, for the rotating figures.
 fn paper_i_series(r: &SweepResult) -> Option<Series> {
     let ys: Option<Vec<f64>> = r
         .points
