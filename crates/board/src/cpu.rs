@@ -1,6 +1,7 @@
 //! Which CPU this is, from CPUID: its vendor, family, model and brand string. The lane width
 //! and the generator's look-up are chosen from them at run time, and a benchmark's figures mean
-//! little without them (machines differ from run to run), so `gyroemu bench` prints them.
+//! little without them (machines differ from run to run), so `gyroemu bench` prints them
+//! (beside the choices, `lanes::vector_paths`).
 
 /// A CPU as CPUID names it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -62,25 +63,6 @@ impl CpuId {
             format!("{} ({id})", self.brand)
         }
     }
-}
-
-/// The vector paths this process chose on this CPU, for a benchmark's header: the widest
-/// lane group (eight needs AVX-512 F, VL, DQ and BW), whether 512-bit operations are taken to
-/// run in halves ([`crate::halves_512`]: AMD family 19h only, so a chain may run four lanes),
-/// and the normal generator's fast path ([`gyroemu_core::gauss::fast_path`], its own check).
-/// The choices, not a survey of the hardware.
-pub fn vector_paths() -> String {
-    let lanes = if !crate::eight_lanes_available() {
-        "groups of up to four lanes (no AVX-512 F, VL, DQ and BW)"
-    } else if crate::halves_512() {
-        "groups of up to eight lanes (AVX-512 F, VL, DQ, BW; 512-bit operations taken to run in halves, AMD family 19h)"
-    } else {
-        "groups of up to eight lanes (AVX-512 F, VL, DQ, BW)"
-    };
-    format!(
-        "{lanes}; the normal generator: {}",
-        gyroemu_core::gauss::fast_path()
-    )
 }
 
 /// CPUID's registers as the ASCII text they hold (little-endian bytes in register order), up

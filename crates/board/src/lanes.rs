@@ -118,6 +118,25 @@ pub fn halves_512() -> bool {
     })
 }
 
+/// The vector paths this process chose on this CPU, for a benchmark's header: the widest
+/// lane group (eight needs AVX-512 F, VL, DQ and BW), whether 512-bit operations are taken to
+/// run in halves ([`halves_512`]: AMD family 19h only, so a chain may run four lanes),
+/// and the normal generator's fast path ([`gyroemu_core::gauss::fast_path`], its own check).
+/// The choices, not a survey of the hardware.
+pub fn vector_paths() -> String {
+    let lanes = if !eight_lanes_available() {
+        "groups of up to four lanes (no AVX-512 F, VL, DQ and BW)"
+    } else if halves_512() {
+        "groups of up to eight lanes (AVX-512 F, VL, DQ, BW; 512-bit operations taken to run in halves, AMD family 19h)"
+    } else {
+        "groups of up to eight lanes (AVX-512 F, VL, DQ, BW)"
+    };
+    format!(
+        "{lanes}; the normal generator: {}",
+        gyroemu_core::gauss::fast_path()
+    )
+}
+
 /// The sizes of the lane groups for `n` points on `threads` threads, in order (points taken
 /// in the caller's order), each at most `width` (4 or 8) points. Groups of eight are used only
 /// where they do not leave a thread idle that groups of four would keep busy: with at most

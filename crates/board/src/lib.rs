@@ -28,13 +28,14 @@ mod seeding;
 
 pub use board::{drive_shifter, starts_share_carrier, Board, MAX_START};
 pub use chain::{unleak_sidebands, unleak_table_harmonics, ChainResponse, RotatingTerms};
-pub use cpu::{vector_paths, CpuId};
+pub use cpu::CpuId;
 pub use fault::NonFinite;
 pub use group::GroupBoard;
 pub use health::Health;
 pub use lanes::{
     eight_lanes_available, group_sizes, groups_by_length, halves_512, lane_groups, max_lanes,
-    max_lanes_for, set_max_lanes, LaneCpu, CANONICAL_LANES, FOUR_LANE_COST, MAX_LANES,
+    max_lanes_for, set_max_lanes, vector_paths, LaneCpu, CANONICAL_LANES, FOUR_LANE_COST,
+    MAX_LANES,
 };
 pub use lock::{lock_carrier, LockRun};
 pub use params::{BoardParams, Converter, NoiseParams, Shape};
