@@ -126,6 +126,8 @@ pub fn halves_512() -> bool {
 pub fn vector_paths() -> String {
     let lanes = if !eight_lanes_available() {
         "groups of up to four lanes (no AVX-512 F, VL, DQ and BW)"
+    } else if max_lanes() == 4 {
+        "groups of up to four lanes (limited to four in this process; the CPU has AVX-512 F, VL, DQ and BW)"
     } else if halves_512() {
         "groups of up to eight lanes (AVX-512 F, VL, DQ, BW; 512-bit operations taken to run in halves, AMD family 19h)"
     } else {

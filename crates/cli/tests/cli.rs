@@ -473,6 +473,17 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
         let forced = gyroemu(&[&["--threads", "1", "--lanes", lanes][..], &short[..]].concat());
         assert!(forced.status.success(), "{}", stderr(&forced));
         assert_eq!(natives(&stderr(&forced)), [*t; 3], "{}", stderr(&forced));
+        // The CPU line states the process's widest group, not only the CPU's.
+        let widest = if *lanes == "4" { "four" } else { "eight" };
+        let first = stderr(&forced)
+            .lines()
+            .next()
+            .unwrap_or_default()
+            .to_string();
+        assert!(
+            first.contains(&format!("groups of up to {widest} lanes")),
+            "{first}"
+        );
     }
     let mut names = vec![
         "whole chain".to_string(),
