@@ -1,5 +1,6 @@
 //! Progress on long runs: a bar on a terminal, a periodic log line otherwise (CI, pipes).
 
+use gyroemu_core::sig3;
 use gyroemu_experiment::{Reporter, Task, Written};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -86,16 +87,18 @@ impl Progress {
 /// CSV can take longer to write than the emulation that produced it.
 pub fn counted_line(label: &str, point_samples: u64, emulation_s: f64, written: Written) -> String {
     let mut line = format!(
-        "{label}: {point_samples} point-samples in {emulation_s:.1} s ({:.0} M point-samples/s)",
-        point_samples as f64 / emulation_s.max(1e-9) / 1e6
+        "{label}: {point_samples} point-samples in {} s ({} M point-samples/s)",
+        sig3(emulation_s),
+        sig3(point_samples as f64 / emulation_s.max(1e-9) / 1e6)
     );
     if written.files > 0 {
         let mb = written.bytes as f64 / 1e6;
         line.push_str(&format!(
-            "; writing dumps: {mb:.1} MB in {} files in {:.2} s ({:.0} MB/s)",
+            "; writing dumps: {} MB in {} files in {} s ({} MB/s)",
+            sig3(mb),
             written.files,
-            written.seconds,
-            mb / written.seconds.max(1e-9)
+            sig3(written.seconds),
+            sig3(mb / written.seconds.max(1e-9))
         ));
     }
     line
@@ -128,5 +131,38 @@ impl Reporter for Terminal {
     }
     fn warn(&self, text: &str) {
         note!("warning: {text}");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::counted_line;
+    use gyroemu_experiment::Written;
+
+    /// Every figure of the line to three significant figures whatever its size (an emulated
+    /// CPU's 0.14 M point-samples/s once read as `0 M`, a slow disk's 0.4 MB/s as `0 MB/s`).
+    #[test]
+    fn the_counted_line_gives_slow_and_fast_rates_their_figures() {
+        let none = Written::default();
+        let slow = counted_line("run", 548_400, 3.91, none);
+        assert_eq!(
+            slow,
+            "run: 548400 point-samples in 3.91 s (0.140 M point-samples/s)"
+        );
+        let fast = counted_line("reproduce", 1_297_000_000, 1.3, none);
+        assert!(
+            fast.ends_with("in 1.30 s (998 M point-samples/s)"),
+            "{fast}"
+        );
+        let dumps = Written {
+            files: 3,
+            bytes: 2_500_000,
+            seconds: 0.5,
+        };
+        let with = counted_line("run", 1000, 0.0104, dumps);
+        assert!(
+            with.ends_with("in 0.0104 s (0.0962 M point-samples/s); writing dumps: 2.50 MB in 3 files in 0.500 s (5.00 MB/s)"),
+            "{with}"
+        );
     }
 }

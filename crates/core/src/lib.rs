@@ -14,10 +14,12 @@ mod gauss_scalar;
 mod gauss_tables;
 pub mod noise;
 pub mod sample;
+mod significant;
 pub mod stage;
 
 pub use error::{ParamError, ParamResult};
 pub use num_complex::Complex64;
 pub use sample::Sample;
+pub use significant::sig3;
 pub use stage::{Response, Stage};
 pub use wide::f64x4;

@@ -8,6 +8,7 @@ use crate::split::lanes_of;
 use crate::sweep::canonical_work;
 use gyroemu_board::Point;
 use gyroemu_config::Config;
+use gyroemu_core::sig3;
 
 /// Runs above this many operating-point samples are refused unless forced: minutes of a
 /// 2-core machine at the chain's rate (docs/performance.md), and far more than any figure of
@@ -101,9 +102,9 @@ impl Work {
                 String::new()
             };
             format!(
-                ", about {:.3} s at the {:.0} M point-samples/s measured here (lane groups of up to {lanes}{bound}{lock_note})",
+                ", about {:.3} s at the {} M point-samples/s measured here (lane groups of up to {lanes}{bound}{lock_note})",
                 lock + even.max(longest),
-                r / 1e6,
+                sig3(r / 1e6),
             )
         });
         let lock = if self.lock_samples > 0 {
@@ -293,6 +294,12 @@ mod tests {
         let s = w(4).summary(Some(4.0 * t));
         assert!(s.contains("lane groups of up to 4"), "{s}");
         assert!(s.contains("about 20.000 s"), "{s}");
+        // The measured rate keeps three figures however slow the CPU (an emulated one's
+        // 0.345 M point-samples/s once read as `0 M`).
+        let slow = w(4).summary(Some(345_000.0));
+        assert!(slow.contains("at the 0.345 M point-samples/s"), "{slow}");
+        let fast = w(8).summary(Some(1_173.3e6));
+        assert!(fast.contains("at the 1173 M point-samples/s"), "{fast}");
     }
 
     #[test]

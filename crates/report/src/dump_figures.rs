@@ -6,6 +6,7 @@
 
 use crate::dump_set::{groups, DumpSet, Group};
 use crate::error::ReportError;
+use gyroemu_core::sig3;
 use gyroemu_io::Dump;
 use gyroemu_plot::{render_panels_png, Figure, Series, SeriesStyle};
 use gyroemu_spectrum::{tone_near, unresolved, welch, Psd, SpectrumError};
@@ -21,12 +22,6 @@ pub const SPECTRUM_RANGE_DB: f64 = 200.0;
 /// Width of the figures, px; each row of panels is this high.
 const WIDTH_PX: u32 = 1600;
 const ROW_PX: u32 = 430;
-
-/// `x` with three significant digits, plainly written.
-fn sig3(x: f64) -> String {
-    let d = (2 - x.abs().log10().floor() as i32).max(0) as usize;
-    format!("{x:.d$}")
-}
 
 /// `"dBV"` for volts, else `"dB re 1 <unit>"` (or `"dB"` when dimensionless).
 pub fn db_unit(unit: &str) -> String {

@@ -3,12 +3,13 @@
 
 use crate::error::ReportError;
 use crate::sweep_report::{health_json, with_config_warnings};
-use gyroemu_analysis::allan::fit::{sig3, NoiseModelFit};
+use gyroemu_analysis::allan::fit::NoiseModelFit;
 use gyroemu_analysis::allan::AllanPoint;
 use gyroemu_analysis::selfcal::SelfcalCore;
 use gyroemu_analysis::selfcal_analyses::{AllanResult, DriftCase, DriftPoint, TauPoint};
 use gyroemu_analysis::SelfcalReport;
 use gyroemu_config::Config;
+use gyroemu_core::sig3;
 use gyroemu_io::{write_csv, write_json, CsvCell, CsvTable};
 use gyroemu_plot::{render_panels_png, render_png, Figure, Series, SeriesStyle};
 use serde_json::json;

@@ -5,6 +5,7 @@
 //! along -1/2 (a flicker floor under the white region), which the slope reading cannot.
 
 use super::{AllanPoint, ARW_UNIT, B_UNIT};
+use gyroemu_core::sig3;
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
@@ -159,19 +160,6 @@ impl NoiseModelFit {
             sig3(self.tau_max_s),
             self.points
         ))
-    }
-}
-
-/// Three significant figures, plain for moderate magnitudes.
-pub fn sig3(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let e = v.abs().log10().floor() as i32;
-    if (-3..5).contains(&e) {
-        format!("{:.*}", (2 - e).max(0) as usize, v)
-    } else {
-        format!("{v:.2e}")
     }
 }
 
@@ -633,14 +621,5 @@ mod tests {
         let three = fit_noise_model(&pts, 0.01, false);
         assert!(three.arw_deg_per_rt_h < 0.99 * n, "{three:?}");
         assert!(three.tau_minus2_coefficient_dps2_s2.is_nan());
-    }
-
-    #[test]
-    fn sig3_rounds_to_three_figures() {
-        assert_eq!(sig3(2.1234), "2.12");
-        assert_eq!(sig3(95.76), "95.8");
-        assert_eq!(sig3(0.0123456), "0.0123");
-        assert_eq!(sig3(1234.5), "1234");
-        assert_eq!(sig3(1.5e-6), "1.50e-6");
     }
 }
