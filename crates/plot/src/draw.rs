@@ -169,7 +169,11 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
         .x_label_area_size(x_area)
         .y_label_area_size(y_area);
     if !fig.title.is_empty() {
-        cb.caption(&fig.title, bold(20.0 * s));
+        // A long title (a spectrum panel's notes) shrinks to fit its panel, down to half its
+        // size, as the overall title of a set of panels does; plotters would cut it off.
+        let (tw, _) = area.estimate_text_size(&fig.title, &bold(20.0 * s))?;
+        let fit = (0.96 * f64::from(w) / tw.max(1) as f64).clamp(0.5, 1.0);
+        cb.caption(&fig.title, bold(20.0 * s * fit));
     }
     let mut chart = cb.build_cartesian_2d(
         Ticked {

@@ -216,3 +216,46 @@ fn markers_draw_a_dashed_line_at_their_abscissa() {
         "marker at column {col}"
     );
 }
+
+/// The columns holding ink (any non-white pixel) in rows `rows` of an RGB image `w` wide.
+fn ink_columns(img: &[u8], w: usize, rows: std::ops::Range<usize>) -> Option<(usize, usize)> {
+    let cols: Vec<usize> = rows
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| img[3 * (y * w + x)..3 * (y * w + x) + 3] != [255, 255, 255])
+        .map(|(x, _)| x)
+        .collect();
+    Some((*cols.iter().min()?, *cols.iter().max()?))
+}
+
+#[test]
+fn a_long_title_shrinks_to_fit_its_figure() {
+    let xs: Vec<f64> = (0..12).map(f64::from).collect();
+    let line = |title: &str| {
+        Figure::new(title, "x", "y").with(Series::new(
+            "a",
+            SeriesStyle::Line,
+            xs.clone(),
+            xs.clone(),
+        ))
+    };
+    // About 1.4 times the width at the title's full size: plotters centres it and cuts both
+    // ends at the figure's edges.
+    let long = "Low-pass output (decimated): Ω (3.50 Hz) unresolved in 93.8 Hz bins; the 2 fc residual aliases onto DC, twice over";
+    // The rows above the frame (the title's, at this size rows 36 to 49; the frame from 56).
+    let (w, band) = (900usize, 0..52);
+    let img = render_rgb(&line(long)).unwrap();
+    let (lo, hi) = ink_columns(&img, w, band.clone()).expect("the title is drawn");
+    assert!(
+        lo >= 8 && hi <= w - 8,
+        "title ink in columns {lo} to {hi} of {w}"
+    );
+    // Spread over most of the width: shrunk to fit, not to nothing.
+    assert!(
+        hi - lo > w * 8 / 10,
+        "title ink in columns {lo} to {hi} of {w}"
+    );
+    // A title that fits keeps its size: the same ink as a figure drawn with it alone.
+    let short = render_rgb(&line("Fits")).unwrap();
+    let (slo, shi) = ink_columns(&short, w, band).expect("the title is drawn");
+    assert!(shi - slo < w / 10, "{slo} to {shi}");
+}
