@@ -302,10 +302,16 @@ fn spectrum_panel(
                 Some(t) => format!("{:.1}", t.level_db()),
             })
             .collect();
-        f = f.with_marker(
-            m.freq_hz,
-            format!("{}: {} {}", m.what, levels.join(" / "), db_unit(unit)),
-        );
+        // The unit only beside a level; one word for all channels once (the m2tfg presets'
+        // 2 fc residual, unresolved on fs/2 in every channel, ran into its own mark).
+        let label = if levels.iter().any(|l| l.parse::<f64>().is_ok()) {
+            format!("{}: {} {}", m.what, levels.join(" / "), db_unit(unit))
+        } else if levels.len() > 1 && levels.iter().all(|l| *l == levels[0]) {
+            format!("{}: {} (every channel)", m.what, levels[0])
+        } else {
+            format!("{}: {}", m.what, levels.join(" / "))
+        };
+        f = f.with_marker(m.freq_hz, label);
     }
     Some(f)
 }

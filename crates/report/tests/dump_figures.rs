@@ -220,14 +220,26 @@ fn the_marks_sit_at_the_carrier_not_at_the_resonance() {
 /// The low-pass panel of a decimated dump of `lp_i1` = `x(k)`, `n` samples at 2400 Hz from a
 /// board of carrier 15 kHz decimating by 100.
 fn low_pass_panel(n: u64, x: impl Fn(u64) -> f64) -> gyroemu_plot::Figure {
+    low_pass_panel_of(&["lp_i1"], n, |k, _| x(k))
+}
+
+/// [`low_pass_panel`] of the channels `names`, channel `c` = `x(k, c)`.
+fn low_pass_panel_of(
+    names: &[&str],
+    n: u64,
+    x: impl Fn(u64, usize) -> f64,
+) -> gyroemu_plot::Figure {
     let dir = tempfile::tempdir().unwrap();
     let extra = BTreeMap::from([
         ("carrier_hz".to_string(), 15_000.0),
         ("decimation".into(), 100.0),
     ]);
-    let mut dec = SignalRecorder::new(vec!["lp_i1".into()], 2400.0, 0, n).with_extra(extra);
+    let channels = names.len();
+    let names = names.iter().map(|s| s.to_string()).collect();
+    let mut dec = SignalRecorder::new(names, 2400.0, 0, n).with_extra(extra);
     for k in 0..n {
-        dec.record(k, &[x(k)]);
+        let row: Vec<f64> = (0..channels).map(|c| x(k, c)).collect();
+        dec.record(k, &row);
     }
     dec.write(dir.path(), "dump_decimated").unwrap();
     let set = read_dump_set(&dir.path().join("dump_decimated.sigmf-meta")).unwrap();
@@ -265,6 +277,37 @@ fn a_mark_at_fs_over_2_reads_unresolved() {
         dc.label.contains(&format!("{:.1}", 20.0 * 1e-3f64.log10())),
         "{}",
         dc.label
+    );
+}
+
+/// A mark no channel reads a level at says so once and without a dB unit: the m2tfg presets'
+/// 2 fc residual, unresolved on fs/2 in all four low-pass channels, once ran
+/// `unresolved / unresolved / unresolved / unresolved dBV` into its own mark.
+#[test]
+fn a_mark_no_channel_reads_says_so_once_without_a_unit() {
+    let alternating = |k: u64, c: usize| {
+        let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+        (1.0 + c as f64) * 1e-3 + 1e-9 * sign
+    };
+    let four = low_pass_panel_of(&["lp_i1", "lp_q1", "lp_i2", "lp_q2"], 1024, alternating);
+    let label = |fig: &gyroemu_plot::Figure, start: &str| {
+        let m = fig.markers.iter().find(|m| m.label.starts_with(start));
+        m.unwrap().label.clone()
+    };
+    let residual = label(&four, "2 fc residual");
+    assert_eq!(
+        residual,
+        "2 fc residual (aliased): unresolved (every channel)"
+    );
+    // Levels that are read keep their unit, one per channel.
+    let dc = label(&four, "DC");
+    assert_eq!(dc.matches(" / ").count(), 3, "{dc}");
+    assert!(dc.ends_with(" dBV"), "{dc}");
+    // One channel: the word alone.
+    let one = low_pass_panel(1024, |k| alternating(k, 0));
+    assert_eq!(
+        label(&one, "2 fc residual"),
+        "2 fc residual (aliased): unresolved"
     );
 }
 
