@@ -286,7 +286,7 @@ fn a_mark_at_fs_over_2_reads_unresolved() {
 #[test]
 fn a_mark_no_channel_reads_says_so_once_without_a_unit() {
     let alternating = |k: u64, c: usize| {
-        let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+        let sign = if k.is_multiple_of(2) { 1.0 } else { -1.0 };
         (1.0 + c as f64) * 1e-3 + 1e-9 * sign
     };
     let four = low_pass_panel_of(&["lp_i1", "lp_q1", "lp_i2", "lp_q2"], 1024, alternating);
