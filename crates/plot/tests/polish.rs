@@ -254,7 +254,7 @@ fn a_long_title_shrinks_to_fit_its_figure() {
         hi - lo > w * 8 / 10,
         "title ink in columns {lo} to {hi} of {w}"
     );
-    // A title that fits keeps its size: the same ink as a figure drawn with it alone.
+    // A title that fits is not stretched to the width: `Fits` stays a word wide.
     let short = render_rgb(&line("Fits")).unwrap();
     let (slo, shi) = ink_columns(&short, w, band).expect("the title is drawn");
     assert!(shi - slo < w / 10, "{slo} to {shi}");
