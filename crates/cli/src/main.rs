@@ -22,6 +22,7 @@ macro_rules! say {
 }
 
 mod cmd;
+mod cpu_check;
 mod input;
 mod lot_text;
 mod progress;
@@ -175,32 +176,9 @@ fn exit_code(e: &anyhow::Error) -> u8 {
     }
 }
 
-/// The build targets x86-64-v3 (`.cargo/config.toml`); on an older CPU say so instead of
-/// dying on an illegal instruction. `is_x86_feature_detected!` cannot tell: it folds to `true`
-/// when the build enables the feature, so this asks `cpuid` directly (AVX2: leaf 7 EBX bit 5;
-/// FMA: leaf 1 ECX bit 12; BMI2: leaf 7 EBX bit 8), before any other code runs.
-#[inline(never)]
-fn cpu_supports_build() -> Result<(), &'static str> {
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
-    {
-        let (l1, l7) = (
-            core::arch::x86_64::__cpuid(1),
-            core::arch::x86_64::__cpuid_count(7, 0),
-        );
-        let fma = l1.ecx & (1 << 12) != 0;
-        let avx2 = l7.ebx & (1 << 5) != 0;
-        let bmi2 = l7.ebx & (1 << 8) != 0;
-        if !(fma && avx2 && bmi2) {
-            return Err("this gyroemu was built for x86-64-v3 (AVX2, FMA, BMI2), which this CPU lacks; rebuild with \
-                 RUSTFLAGS=\"-C target-cpu=x86-64\" cargo build --release (see docs/performance.md)\n");
-        }
-    }
-    Ok(())
-}
-
 fn main() -> ExitCode {
     // Nothing but the CPU check may run before it: the rest is out of line.
-    if let Err(e) = cpu_supports_build() {
+    if let Err(e) = cpu_check::cpu_supports_build() {
         // Static bytes only: formatting could already use AVX to copy them.
         let mut err = std::io::stderr();
         std::io::Write::write_all(&mut err, b"error: ").ok();
