@@ -1,6 +1,7 @@
-//! Numbers written for people: three significant figures, the one rule every printed summary,
-//! label and note uses, so a small value never reads as `0` (a rate of 0.13 M point-samples/s
-//! under an emulated CPU was once printed as `0 M`).
+//! Numbers written for people: three significant figures, for the printed rates and times of
+//! the plan and the closing lines, the spectrum figures' notes and the noise fits, so a small
+//! value never reads as `0` (a rate of 0.13 M point-samples/s under an emulated CPU was once
+//! printed as `0 M`).
 
 /// `v` with three significant figures: plainly written from 1e-3 to below 1e5 (`2.12`,
 /// `0.0123`, `1234`: whole numbers keep their digits), else as `1.50e-6`; zero and non-finite

@@ -110,6 +110,13 @@ fn marker_polygon(k: usize, r: i32) -> Vec<(i32, i32)> {
     }
 }
 
+/// The height plotters' `DrawingArea::titled` takes for a caption `text_h` high: the text and a
+/// padding of min(text_h / 2, 5) above and below it.
+fn caption_height(text_h: u32) -> i32 {
+    let pad = (text_h / 2).min(5) as i32;
+    text_h as i32 + 2 * pad
+}
+
 /// Draws one figure filling `area`: title, framed axes with grid, tick labels, axis labels with
 /// the scale exponent (if any) at the axis end, series (lines first, then filled markers, then
 /// hollow ones, so no marker hides under a line), markers, legend. `ss` is the supersampling
@@ -161,19 +168,34 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
     let y_exp = ya.exponent_text();
     let x_exp = xa.exponent_text();
 
+    let (left, right) = (px(18.0), px(28.0));
+    // A long title (a spectrum panel's notes) shrinks to fit between the margins, where
+    // plotters centres it, down to half its size, as a set's overall title does; plotters
+    // would cut it off at the figure's edges. The height plotters gives a caption follows its
+    // font, so the top margin takes up what the smaller font leaves: the frame stays where a
+    // full-size title puts it, in line with its neighbours' in a set of panels.
+    let mut title_room = 0;
+    let title = if fig.title.is_empty() {
+        None
+    } else {
+        let full = bold(20.0 * s);
+        let (tw, th_full) = area.estimate_text_size(&fig.title, &full)?;
+        let room = (w as i32 - left - right).max(1);
+        let fit = (0.98 * f64::from(room) / tw.max(1) as f64).clamp(0.5, 1.0);
+        let style = bold(20.0 * s * fit);
+        let (_, th) = area.estimate_text_size(&fig.title, &style)?;
+        title_room = caption_height(th_full) - caption_height(th);
+        Some(style)
+    };
     let mut cb = ChartBuilder::on(area);
-    cb.margin(px(18.0))
-        .margin_right(px(28.0))
+    cb.margin(left)
+        .margin_right(right)
         // Room for a "×10ⁿ" above the y axis is always kept so frames of panels line up.
-        .margin_top(px(34.0))
+        .margin_top(px(34.0) + title_room)
         .x_label_area_size(x_area)
         .y_label_area_size(y_area);
-    if !fig.title.is_empty() {
-        // A long title (a spectrum panel's notes) shrinks to fit its panel, down to half its
-        // size, as the overall title of a set of panels does; plotters would cut it off.
-        let (tw, _) = area.estimate_text_size(&fig.title, &bold(20.0 * s))?;
-        let fit = (0.96 * f64::from(w) / tw.max(1) as f64).clamp(0.5, 1.0);
-        cb.caption(&fig.title, bold(20.0 * s * fit));
+    if let Some(style) = title {
+        cb.caption(&fig.title, style);
     }
     let mut chart = cb.build_cartesian_2d(
         Ticked {

@@ -256,6 +256,37 @@ fn a_long_title_shrinks_to_fit_its_figure() {
     );
     // A title that fits is not stretched to the width: `Fits` stays a word wide.
     let short = render_rgb(&line("Fits")).unwrap();
-    let (slo, shi) = ink_columns(&short, w, band).expect("the title is drawn");
+    let (slo, shi) = ink_columns(&short, w, band.clone()).expect("the title is drawn");
     assert!(shi - slo < w / 10, "{slo} to {shi}");
+    // The frame stays where a full-size title puts it, so panels side by side line up.
+    let (top, top_short) = (frame_top(&img, w), frame_top(&short, w));
+    assert!(top.is_some() && top == top_short, "{top:?} {top_short:?}");
+    // In the supersampled render too (the PNGs'), where every length is doubled.
+    let (big, big_short) = (
+        render_rgb_antialiased(&line(long)).unwrap(),
+        render_rgb_antialiased(&line("Fits")).unwrap(),
+    );
+    let (lo, hi) = ink_columns(&big, w, band).expect("the title is drawn");
+    assert!(
+        lo >= 8 && hi <= w - 8,
+        "title ink in columns {lo} to {hi} of {w}"
+    );
+    assert_eq!(frame_top(&big, w), frame_top(&big_short, w));
+}
+
+/// The first row holding a dark run of at least a third of the width: the frame's top edge
+/// (text has no such run).
+fn frame_top(img: &[u8], w: usize) -> Option<usize> {
+    (0..img.len() / (3 * w)).find(|&y| {
+        let row = &img[3 * y * w..3 * (y + 1) * w];
+        let mut run = 0;
+        row.chunks(3).any(|p| {
+            run = if p.iter().all(|&c| c < 100) {
+                run + 1
+            } else {
+                0
+            };
+            run >= w / 3
+        })
+    })
 }

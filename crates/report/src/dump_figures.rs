@@ -306,8 +306,8 @@ fn spectrum_panel(
         // 2 fc residual, unresolved on fs/2 in every channel, ran into its own mark).
         let label = if levels.iter().any(|l| l.parse::<f64>().is_ok()) {
             format!("{}: {} {}", m.what, levels.join(" / "), db_unit(unit))
-        } else if levels.len() > 1 && levels.iter().all(|l| *l == levels[0]) {
-            format!("{}: {} (every channel)", m.what, levels[0])
+        } else if levels.len() > 1 && levels.iter().all(|l| l == "unresolved") {
+            format!("{}: unresolved (every channel)", m.what)
         } else {
             format!("{}: {}", m.what, levels.join(" / "))
         };
