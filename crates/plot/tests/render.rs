@@ -1,8 +1,8 @@
 //! PNG output, text presence, geometry, degenerate inputs and atomicity.
 
 use gyroemu_plot::{
-    render_panels_png, render_png, render_png_copies, render_rgb, Figure, PlotError, Series,
-    SeriesStyle, PALETTE,
+    render_panels_png, render_png, render_png_copies, render_rgb, render_rgb_antialiased, Figure,
+    PlotError, Series, SeriesStyle, PALETTE,
 };
 use std::path::Path;
 
@@ -71,17 +71,35 @@ impl Img {
     fn at(&self, x: usize, y: usize) -> &[u8] {
         &self.px[(y * self.w + x) * 3..(y * self.w + x) * 3 + 3]
     }
-    /// Frame of the plot: first/last rows and columns with a dark run over 40 % of the image.
+    /// Frame of the plot: first/last rows and columns with a dark run over 40 % of the image
+    /// (unbroken: a long bold title darkens that many pixels of a row, in pieces).
     fn frame(&self) -> (usize, usize, usize, usize) {
+        let longest_run = |dark_at: &mut dyn Iterator<Item = bool>| {
+            dark_at
+                .scan(0, |run, d| {
+                    *run = if d { *run + 1 } else { 0 };
+                    Some(*run)
+                })
+                .max()
+                .unwrap_or(0)
+        };
         let row_dark =
-            |y: usize| (0..self.w).filter(|&x| dark(self.at(x, y))).count() > self.w * 2 / 5;
+            |y: usize| longest_run(&mut (0..self.w).map(|x| dark(self.at(x, y)))) > self.w * 2 / 5;
         let col_dark =
-            |x: usize| (0..self.h).filter(|&y| dark(self.at(x, y))).count() > self.h * 2 / 5;
+            |x: usize| longest_run(&mut (0..self.h).map(|y| dark(self.at(x, y)))) > self.h * 2 / 5;
         let top = (0..self.h).find(|&y| row_dark(y)).unwrap();
         let bottom = (0..self.h).rev().find(|&y| row_dark(y)).unwrap();
         let left = (0..self.w).find(|&x| col_dark(x)).unwrap();
         let right = (0..self.w).rev().find(|&x| col_dark(x)).unwrap();
         (left, right, top, bottom)
+    }
+    /// The first and last columns holding ink (any non-white pixel) in rows `ys`.
+    fn ink_columns(&self, ys: std::ops::Range<usize>) -> Option<(usize, usize)> {
+        let inked = |x: usize| ys.clone().any(|y| self.at(x, y) != [255; 3]);
+        Some((
+            (0..self.w).find(|&x| inked(x))?,
+            (0..self.w).rfind(|&x| inked(x))?,
+        ))
     }
     fn dark_in(&self, xs: std::ops::Range<usize>, ys: std::ops::Range<usize>) -> usize {
         ys.flat_map(|y| xs.clone().map(move |x| (x, y)))
@@ -142,6 +160,60 @@ fn title_and_labels_are_drawn_with_the_bundled_font() {
         "y label added only {} dark pixels",
         ylab_ink - ticks_only_ink
     );
+}
+
+/// A title too long for its figure shrinks to fit inside it, and the frame stays where a
+/// full-size title puts it (so panels side by side line up); a short one keeps its size.
+#[test]
+fn a_long_title_shrinks_to_fit_its_figure() {
+    let xs: Vec<f64> = (0..12).map(f64::from).collect();
+    let line = |title: &str| {
+        Figure::new(title, "x", "y").with(Series::new(
+            "a",
+            SeriesStyle::Line,
+            xs.clone(),
+            xs.clone(),
+        ))
+    };
+    // About 1.4 times the width at the title's full size: plotters centres it and cuts both
+    // ends at the figure's edges.
+    let long = "Low-pass output (decimated): Ω (3.50 Hz) unresolved in 93.8 Hz bins; the 2 fc residual aliases onto DC, twice over";
+    // Plain, then supersampled (the PNGs'), where every length is doubled.
+    for antialiased in [false, true] {
+        let img = |title: &str| {
+            let fig = line(title);
+            let px = if antialiased {
+                render_rgb_antialiased(&fig)
+            } else {
+                render_rgb(&fig)
+            };
+            Img {
+                w: fig.width_px as usize,
+                h: fig.height_px as usize,
+                px: px.unwrap(),
+            }
+        };
+        let (shrunk, short) = (img(long), img("Fits"));
+        let (_, _, top, _) = shrunk.frame();
+        let w = shrunk.w;
+        let (lo, hi) = shrunk.ink_columns(0..top - 2).expect("the title is drawn");
+        assert!(
+            lo >= 8 && hi <= w - 8,
+            "title ink in columns {lo} to {hi} of {w}"
+        );
+        // Spread over most of the width: shrunk to fit, not to nothing.
+        assert!(
+            hi - lo > w * 8 / 10,
+            "title ink in columns {lo} to {hi} of {w}"
+        );
+        // A title that fits is not stretched to the width: `Fits` stays a word wide.
+        let (_, _, top_short, _) = short.frame();
+        let (slo, shi) = short
+            .ink_columns(0..top_short - 2)
+            .expect("the title is drawn");
+        assert!(shi - slo < w / 10, "{slo} to {shi}");
+        assert_eq!(top, top_short, "the frame moved under the shrunk title");
+    }
 }
 
 /// Two markers at the data extremes land 0.5/11 and 10.5/11 of the way across the frame
