@@ -110,6 +110,13 @@ fn marker_polygon(k: usize, r: i32) -> Vec<(i32, i32)> {
     }
 }
 
+/// The scale that fits a title `text_w` pixels wide at full size into `room` pixels: never
+/// above full size, never below half (a longer title is cut rather than made unreadable). The
+/// rule of every title, a figure's, a panel's or a set's.
+pub(crate) fn title_scale(room: f64, text_w: u32) -> f64 {
+    (room / f64::from(text_w.max(1))).clamp(0.5, 1.0)
+}
+
 /// The height plotters' `DrawingArea::titled` takes for a caption `text_h` high: the text and a
 /// padding of min(text_h / 2, 5) above and below it.
 fn caption_height(text_h: u32) -> i32 {
@@ -181,7 +188,7 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
         let full = bold(20.0 * s);
         let (tw, th_full) = area.estimate_text_size(&fig.title, &full)?;
         let room = (w as i32 - left - right).max(1);
-        let fit = (0.98 * f64::from(room) / tw.max(1) as f64).clamp(0.5, 1.0);
+        let fit = title_scale(0.98 * f64::from(room), tw);
         let style = bold(20.0 * s * fit);
         let (_, th) = area.estimate_text_size(&fig.title, &style)?;
         title_room = caption_height(th_full) - caption_height(th);

@@ -3,7 +3,7 @@
 //! anti-aliasing, which looks stepped on slanted lines.
 
 use crate::dirty::Dirty;
-use crate::draw::{draw_figure, text_scale, Area};
+use crate::draw::{draw_figure, text_scale, title_scale, Area};
 use crate::fast_lines::FastLines;
 use crate::figure::Figure;
 use crate::font::{bold, ensure_font};
@@ -415,7 +415,7 @@ pub fn render_panels_png(
             let s = text_scale(width_px, height_px) * ss;
             // A long title shrinks to fit the width (down to half its size).
             let (tw, _) = root.estimate_text_size(title, &bold(24.0 * s))?;
-            let fit = (0.96 * f64::from(width_px) * ss / tw.max(1) as f64).clamp(0.5, 1.0);
+            let fit = title_scale(0.96 * f64::from(width_px) * ss, tw);
             root.margin((10.0 * s).round() as i32, 0, 0, 0)
                 .titled(title, bold(24.0 * s * fit))?
         };
