@@ -70,16 +70,15 @@ impl AxisScale {
                 (lo - pad, hi + pad, e)
             }
         };
-        let ticks = RangedCoordf64::from(lo..hi).key_points(n_ticks.max(2));
-        let decimals = common_decimals(&ticks, hi - lo);
         AxisScale {
             lo,
             hi,
             exp10,
-            decimals,
+            decimals: 0,
             log: false,
             factor: 10f64.powi(exp10),
         }
+        .with_range(lo, hi, n_ticks)
     }
 
     /// Logarithmic axis over the positive finite values of `vals`: their span in decades with
@@ -112,6 +111,23 @@ impl AxisScale {
             decimals: 0,
             log: true,
             factor: 1.0,
+        }
+    }
+
+    /// The same axis (scale, log or linear) over the plotted range `lo..hi` instead, with its
+    /// tick labels' decimals for about `n_ticks` ticks there.
+    pub fn with_range(&self, lo: f64, hi: f64, n_ticks: usize) -> Self {
+        let decimals = if self.log {
+            0
+        } else {
+            let ticks = RangedCoordf64::from(lo..hi).key_points(n_ticks.max(2));
+            common_decimals(&ticks, hi - lo)
+        };
+        AxisScale {
+            lo,
+            hi,
+            decimals,
+            ..self.clone()
         }
     }
 

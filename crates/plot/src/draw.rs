@@ -3,13 +3,15 @@
 use crate::axis::AxisScale;
 use crate::figure::{Figure, Series, SeriesStyle, PALETTE};
 use crate::font::{bold, text};
+use crate::legend::{headroom, legend_corner};
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 pub(crate) type Area<'a> = DrawingArea<crate::fast_lines::FastLines<'a>, Shift>;
-type DrawResult = Result<(), Box<dyn std::error::Error + Send + Sync>>;
+type DrawError = Box<dyn std::error::Error + Send + Sync>;
+type DrawResult = Result<(), DrawError>;
 
 /// A linear coordinate over `lo..hi` whose ticks are given (plotters' own choice of round
 /// steps cannot be told to keep to whole decades on a log axis).
@@ -45,41 +47,29 @@ pub(crate) fn text_scale(w: u32, h: u32) -> f64 {
         .clamp(0.85, 2.0)
 }
 
-/// The corner whose legend box (`box_frac`: its width and height as fractions of the plot)
-/// covers the fewest data points, so the legend hides as little as possible: upper left,
-/// upper right, lower left, lower right, the first on a tie.
-fn legend_corner(
-    points: &[(f64, f64)],
-    xa: &AxisScale,
-    ya: &AxisScale,
-    (bw, bh): (f64, f64),
-) -> SeriesLabelPosition {
-    let frac = |v: f64, a: &AxisScale| (a.map(v) - a.lo) / (a.hi - a.lo);
-    let corners = [
-        (SeriesLabelPosition::UpperLeft, false, true),
-        (SeriesLabelPosition::UpperRight, true, true),
-        (SeriesLabelPosition::LowerLeft, false, false),
-        (SeriesLabelPosition::LowerRight, true, false),
-    ];
-    let covered = |right: bool, upper: bool| {
-        points
-            .iter()
-            .filter(|&&(x, y)| {
-                let (fx, fy) = (frac(x, xa), frac(y, ya));
-                let in_x = if right { fx >= 1.0 - bw } else { fx <= bw };
-                let in_y = if upper { fy >= 1.0 - bh } else { fy <= bh };
-                in_x && in_y
-            })
-            .count()
-    };
-    let mut best = (usize::MAX, SeriesLabelPosition::UpperLeft);
-    for (pos, right, upper) in corners {
-        let n = covered(right, upper);
-        if n < best.0 {
-            best = (n, pos);
-        }
+/// The legend box as fractions of a frame `frame` pixels wide and high: its widest label plus
+/// the marker and margins, one row per named series; `None` when no series is named.
+fn legend_box(
+    area: &Area,
+    fig: &Figure,
+    font: &TextStyle,
+    s: f64,
+    frame: (i32, i32),
+) -> Result<Option<(f64, f64)>, DrawError> {
+    let rows = fig.series.iter().filter(|s| !s.name.is_empty()).count();
+    if rows == 0 {
+        return Ok(None);
     }
-    best.1
+    let (mut label_w, mut label_h) = (0u32, 0u32);
+    for se in &fig.series {
+        let (w, h) = area.estimate_text_size(&se.name, font)?;
+        label_w = label_w.max(w);
+        label_h = label_h.max(h);
+    }
+    Ok(Some((
+        ((label_w as f64 + 60.0 * s) / frame.0.max(1) as f64).min(1.0),
+        ((rows as f64 * (label_h as f64 + 8.0 * s) + 20.0 * s) / frame.1.max(1) as f64).min(1.0),
+    )))
 }
 
 /// The axis of one coordinate of the figure's plottable points.
@@ -146,42 +136,13 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
             .collect::<Vec<_>>()
     };
     let all: Vec<(f64, f64)> = fig.series.iter().flat_map(finite).collect();
-    let xa = axis(all.iter().map(|p| p.0), fig.x_log, nx);
-    let ya = axis(all.iter().map(|p| p.1), fig.y_log, ny);
-    let (x_ticks, y_ticks) = (xa.ticks(nx), ya.ticks(ny));
-    let (nx, ny) = (x_ticks.len(), y_ticks.len());
-
-    // Size the label areas from the actual tick labels so nothing overlaps.
-    let mut y_tick_w = 0;
-    for t in &y_ticks {
-        y_tick_w = y_tick_w.max(area.estimate_text_size(&ya.label(*t), &tick_font)?.0);
-    }
-    let (_, tick_h) = area.estimate_text_size("0", &tick_font)?;
-    let (_, desc_h) = area.estimate_text_size("Hg", &desc_font)?;
-    let y_area = y_tick_w as i32
-        + px(12.0)
-        + if fig.y_label.is_empty() {
-            0
-        } else {
-            desc_h as i32 + px(14.0)
-        };
-    let x_area = tick_h as i32
-        + px(14.0)
-        + if fig.x_label.is_empty() {
-            0
-        } else {
-            desc_h as i32 + px(14.0)
-        };
-    let y_exp = ya.exponent_text();
-    let x_exp = xa.exponent_text();
-
     let (left, right) = (px(18.0), px(28.0));
     // A long title (a spectrum panel's notes) shrinks to fit between the margins, where
     // plotters centres it, down to half its size, as a set's overall title does; plotters
     // would cut it off at the figure's edges. The height plotters gives a caption follows its
     // font, so the top margin takes up what the smaller font leaves: the frame stays where a
     // full-size title puts it, in line with its neighbours' in a set of panels.
-    let mut title_room = 0;
+    let (mut title_room, mut caption_h) = (0, 0);
     let title = if fig.title.is_empty() {
         None
     } else {
@@ -192,13 +153,72 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
         let style = bold(20.0 * s * fit);
         let (_, th) = area.estimate_text_size(&fig.title, &style)?;
         title_room = caption_height(th_full) - caption_height(th);
+        caption_h = caption_height(th);
         Some(style)
     };
+    // Room for a "×10ⁿ" above the y axis is always kept so frames of panels line up.
+    let top = px(34.0) + title_room;
+
+    let xa = axis(all.iter().map(|p| p.0), fig.x_log, nx);
+    let mut ya = axis(all.iter().map(|p| p.1), fig.y_log, ny);
+    let x_ticks = xa.ticks(nx);
+    let nx = x_ticks.len();
+
+    // Size the label areas from the actual tick labels so nothing overlaps.
+    let (_, tick_h) = area.estimate_text_size("0", &tick_font)?;
+    let (_, desc_h) = area.estimate_text_size("Hg", &desc_font)?;
+    let y_area_of = |ticks: &[f64], ya: &AxisScale| -> Result<i32, DrawError> {
+        let mut y_tick_w = 0;
+        for t in ticks {
+            y_tick_w = y_tick_w.max(area.estimate_text_size(&ya.label(*t), &tick_font)?.0);
+        }
+        Ok(y_tick_w as i32
+            + px(12.0)
+            + if fig.y_label.is_empty() {
+                0
+            } else {
+                desc_h as i32 + px(14.0)
+            })
+    };
+    let mut y_ticks = ya.ticks(ny);
+    let mut y_area = y_area_of(&y_ticks, &ya)?;
+    let x_area = tick_h as i32
+        + px(14.0)
+        + if fig.x_label.is_empty() {
+            0
+        } else {
+            desc_h as i32 + px(14.0)
+        };
+    // When the legend would hide data in every corner, the y axis grows at one end to make
+    // room for it. The frame's size here is plotters' layout: the margins (the bottom one is
+    // `left`), the caption and the label areas.
+    let frame = (
+        w as i32 - left - right - y_area - 1,
+        h as i32 - top - left - caption_h - x_area - 1,
+    );
+    let mut grew = false;
+    if let Some(bx) = legend_box(area, fig, &legend_font, s, frame)? {
+        // The legend's 5 px from the frame (plotters' layout) and a hollow marker's radius.
+        let clear = f64::from(px(5.0) + 2 * px(3.5) + 2);
+        let clear = (
+            clear / f64::from(frame.0.max(1)),
+            clear / f64::from(frame.1.max(1)),
+        );
+        if let Some(grown) = headroom(&all, &xa, &ya, bx, clear, ny) {
+            grew = true;
+            ya = grown;
+            y_ticks = ya.ticks(ny);
+            y_area = y_area_of(&y_ticks, &ya)?;
+        }
+    }
+    let ny = y_ticks.len();
+    let y_exp = ya.exponent_text();
+    let x_exp = xa.exponent_text();
+
     let mut cb = ChartBuilder::on(area);
     cb.margin(left)
         .margin_right(right)
-        // Room for a "×10ⁿ" above the y axis is always kept so frames of panels line up.
-        .margin_top(px(34.0) + title_room)
+        .margin_top(top)
         .x_label_area_size(x_area)
         .y_label_area_size(y_area);
     if let Some(style) = title {
@@ -398,6 +418,8 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
         yr.start - by,
         yr.end - 1 - by,
     );
+    // The layout above is plotters' own, up to the labels' width of a grown axis.
+    debug_assert!(grew || frame == (x1 - x0, y1 - y0), "{frame:?}");
     area.draw(&Rectangle::new(
         [(x0, y0), (x1, y1)],
         BLACK.stroke_width(thin),
@@ -419,20 +441,7 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
     }
     draw_markers(area, fig, &xa, (x0, x1, y0, y1), s)?;
 
-    if fig.series.iter().any(|s| !s.name.is_empty()) {
-        // The legend box as a fraction of the plot: its widest label plus the marker and
-        // margins, one row per series.
-        let (mut label_w, mut label_h) = (0u32, 0u32);
-        for se in &fig.series {
-            let (w, h) = area.estimate_text_size(&se.name, &legend_font)?;
-            label_w = label_w.max(w);
-            label_h = label_h.max(h);
-        }
-        let rows = fig.series.iter().filter(|s| !s.name.is_empty()).count() as f64;
-        let legend_box = (
-            ((label_w as f64 + 60.0 * s) / (x1 - x0).max(1) as f64).min(1.0),
-            ((rows * (label_h as f64 + 8.0 * s) + 20.0 * s) / (y1 - y0).max(1) as f64).min(1.0),
-        );
+    if let Some(legend_box) = legend_box(area, fig, &legend_font, s, (x1 - x0, y1 - y0))? {
         chart
             .configure_series_labels()
             .position(legend_corner(&all, &xa, &ya, legend_box))
@@ -507,41 +516,4 @@ fn draw_markers(
         area.draw(&Text::new(m.label.clone(), (tx, ty), font.clone()))?;
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_legend_goes_to_the_corner_it_hides_least() {
-        let axes = |pts: &[(f64, f64)]| {
-            (
-                AxisScale::from_values(pts.iter().map(|p| p.0), 5),
-                AxisScale::from_values(pts.iter().map(|p| p.1), 5),
-            )
-        };
-        let frame = [(0.0, 0.0), (10.0, 0.0), (0.0, 10.0), (10.0, 10.0)];
-        // A cluster under the upper left: the upper right takes the legend.
-        let mut pts = frame.to_vec();
-        pts.extend([(0.5, 9.5), (1.0, 9.8), (1.5, 9.0)]);
-        let (xa, ya) = axes(&pts);
-        assert_eq!(
-            legend_corner(&pts, &xa, &ya, (0.4, 0.2)),
-            SeriesLabelPosition::UpperRight
-        );
-        // Both upper corners busy, the lower left too: the lower right.
-        pts.extend([(9.5, 9.5), (9.0, 9.8), (0.5, 0.5), (1.0, 1.0)]);
-        let (xa, ya) = axes(&pts);
-        assert_eq!(
-            legend_corner(&pts, &xa, &ya, (0.4, 0.2)),
-            SeriesLabelPosition::LowerRight
-        );
-        // Nothing to hide: the upper left.
-        let (xa, ya) = axes(&frame);
-        assert_eq!(
-            legend_corner(&[], &xa, &ya, (0.4, 0.2)),
-            SeriesLabelPosition::UpperLeft
-        );
-    }
 }
