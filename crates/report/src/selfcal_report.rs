@@ -328,10 +328,11 @@ fn log_series(name: &str, style: SeriesStyle, pts: &[AllanPoint], scale: f64) ->
 
 /// The overall title of `allan.png`: the noise readings, or why one was not taken.
 pub fn allan_title(a: &AllanResult) -> String {
-    // A reading that could not be taken says so instead of printing NaN.
+    // Three significant figures, as the fit beside them; a reading that could not be taken
+    // says so instead of printing NaN.
     let read = |v: f64, unit: &str| {
         if v.is_finite() {
-            format!("{v:.3e} {unit}")
+            format!("{} {unit}", sig3(v))
         } else {
             "not read (see warnings)".to_string()
         }

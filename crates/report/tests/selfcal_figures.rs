@@ -92,7 +92,8 @@ fn the_phase_deviation_has_its_own_panel_in_degrees() {
     }
     assert_eq!(
         allan_title(&a),
-        format!("Allan deviation at zero rate: ARW {arw:.3e} deg/sqrt(h), bias instability 5.000e0 deg/h")
+        // Three significant figures: ARW = 2e-3 / 0.0418 * 60 = 2.8708 deg/sqrt(h).
+        "Allan deviation at zero rate: ARW 2.87 deg/sqrt(h), bias instability 5.00 deg/h"
     );
 }
 
