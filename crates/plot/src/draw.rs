@@ -190,25 +190,40 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
             desc_h as i32 + px(14.0)
         };
     // When the legend would hide data in every corner, the y axis grows at one end to make
-    // room for it. The frame's size here is plotters' layout: the margins (the bottom one is
-    // `left`), the caption and the label areas.
-    let frame = (
-        w as i32 - left - right - y_area - 1,
-        h as i32 - top - left - caption_h - x_area - 1,
-    );
-    let mut grew = false;
-    if let Some(bx) = legend_box(area, fig, &legend_font, s, frame)? {
-        // The legend's 5 px from the frame (plotters' layout) and a hollow marker's radius.
-        let clear = f64::from(px(5.0) + 2 * px(3.5) + 2);
-        let clear = (
-            clear / f64::from(frame.0.max(1)),
-            clear / f64::from(frame.1.max(1)),
-        );
-        if let Some(grown) = headroom(&all, &xa, &ya, bx, clear, ny) {
-            grew = true;
-            ya = grown;
-            y_ticks = ya.ticks(ny);
-            y_area = y_area_of(&y_ticks, &ya)?;
+    // room for it (`legend::headroom`). The frame's size is plotters' layout: the margins (the
+    // bottom one is `left`), the caption and the label areas. A grown axis' labels may be
+    // wider and the frame narrower, so the growth is worked out again until they settle.
+    let frame_of = |y_area: i32| {
+        (
+            w as i32 - left - right - y_area - 1,
+            h as i32 - top - left - caption_h - x_area - 1,
+        )
+    };
+    let radius = px(3.5);
+    let bare = (ya.clone(), y_ticks.clone(), y_area);
+    let mut cleared = None;
+    for _ in 0..3 {
+        let frame = frame_of(y_area);
+        if frame.0 <= 0 || frame.1 <= 0 {
+            break;
+        }
+        let Some(bx) = legend_box(area, fig, &legend_font, s, frame)? else {
+            break;
+        };
+        // plotters' 5 px between the legend and the frame, and a hollow marker's radius.
+        let clear = f64::from(5 + 2 * radius + 2);
+        let clear = (clear / f64::from(frame.0), clear / f64::from(frame.1));
+        let Some((grown, corner)) = headroom(&all, &xa, &bare.0, bx, clear, ny) else {
+            (ya, y_ticks, y_area) = bare.clone();
+            cleared = None;
+            break;
+        };
+        y_ticks = grown.ticks(ny);
+        y_area = y_area_of(&y_ticks, &grown)?;
+        ya = grown;
+        cleared = Some(corner);
+        if frame_of(y_area) == frame {
+            break;
         }
     }
     let ny = y_ticks.len();
@@ -280,7 +295,6 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
     }
 
     let lw = px(2.0) as u32;
-    let radius = px(3.5);
     let glyph_w = px(24.0);
     let pts = |series: &Series| -> Vec<(f64, f64)> {
         series
@@ -418,8 +432,9 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
         yr.start - by,
         yr.end - 1 - by,
     );
-    // The layout above is plotters' own, up to the labels' width of a grown axis.
-    debug_assert!(grew || frame == (x1 - x0, y1 - y0), "{frame:?}");
+    // The layout above is plotters' own.
+    let frame = frame_of(y_area);
+    debug_assert!(frame.0 <= 0 || frame.1 <= 0 || frame == (x1 - x0, y1 - y0));
     area.draw(&Rectangle::new(
         [(x0, y0), (x1, y1)],
         BLACK.stroke_width(thin),
@@ -444,7 +459,7 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
     if let Some(legend_box) = legend_box(area, fig, &legend_font, s, (x1 - x0, y1 - y0))? {
         chart
             .configure_series_labels()
-            .position(legend_corner(&all, &xa, &ya, legend_box))
+            .position(cleared.unwrap_or_else(|| legend_corner(&all, &xa, &ya, legend_box)))
             .margin(px(10.0))
             .legend_area_size(glyph_w + px(10.0))
             .label_font(legend_font)

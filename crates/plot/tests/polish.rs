@@ -218,29 +218,39 @@ fn markers_draw_a_dashed_line_at_their_abscissa() {
 }
 
 /// A legend never hides data: with data in all four corners, the y axis grows to make room
-/// for it. Every marker of a 5 x 5 grid keeps all its pixels of its exact colour (a marker under
-/// the legend's 90 % white box loses them) against the same figure without a legend.
+/// for it. Every marker of a 5 x 5 grid (linear, and decades on a log axis) keeps all its pixels
+/// of its exact colour (a marker under the legend's 90 % white box loses them) against the
+/// same figure without a legend.
 #[test]
 fn a_legend_with_every_corner_busy_hides_no_marker() {
-    let grid: Vec<(f64, f64)> = (0..25)
-        .map(|k| (f64::from(k % 5), f64::from(k / 5)))
-        .collect();
-    let data = Series::new(
-        "",
-        SeriesStyle::Points,
-        grid.iter().map(|p| p.0).collect(),
-        grid.iter().map(|p| p.1).collect(),
-    );
-    let bare = Figure::new("", "x", "y").with(data.clone());
-    // The legend's one entry draws nothing in the plot (no finite point), in its own colour.
-    let named = bare.clone().with(Series::new(
-        "a legend entry of some length",
-        SeriesStyle::Points,
-        vec![f64::NAN],
-        vec![f64::NAN],
-    ));
-    let without = count(&render_rgb(&bare).unwrap(), PALETTE[0]);
-    let with = count(&render_rgb(&named).unwrap(), PALETTE[0]);
-    assert!(without > 25 * 20, "{without} pixels for 25 markers");
-    assert_eq!(with, without, "markers hidden under the legend");
+    for log in [false, true] {
+        let grid: Vec<(f64, f64)> = (0..25)
+            .map(|k| (f64::from(k % 5), f64::from(k / 5)))
+            .map(|(x, y)| (x, if log { 10f64.powf(y) } else { y }))
+            .collect();
+        let data = Series::new(
+            "",
+            SeriesStyle::Points,
+            grid.iter().map(|p| p.0).collect(),
+            grid.iter().map(|p| p.1).collect(),
+        );
+        let mut bare = Figure::new("", "x", "y").with(data);
+        if log {
+            bare = bare.log_y();
+        }
+        // The legend's one entry draws nothing in the plot (no finite point), in its own colour.
+        let named = bare.clone().with(Series::new(
+            "a legend entry of some length",
+            SeriesStyle::Points,
+            vec![f64::NAN],
+            vec![f64::NAN],
+        ));
+        let without = count(&render_rgb(&bare).unwrap(), PALETTE[0]);
+        let with = count(&render_rgb(&named).unwrap(), PALETTE[0]);
+        assert!(
+            without > 25 * 20,
+            "log {log}: {without} pixels for 25 markers"
+        );
+        assert_eq!(with, without, "log {log}: markers hidden under the legend");
+    }
 }
