@@ -2,15 +2,16 @@
 
 use crate::axis::AxisScale;
 use crate::figure::{Figure, Series, SeriesStyle, PALETTE};
-use crate::font::{bold, text};
-use crate::legend::{headroom, legend_corner};
+use crate::font::text;
+use crate::layout::{layout, legend_box, px, Fonts, Layout, MARKER_RADIUS};
+use crate::legend::legend_corner;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 pub(crate) type Area<'a> = DrawingArea<crate::fast_lines::FastLines<'a>, Shift>;
-type DrawError = Box<dyn std::error::Error + Send + Sync>;
+pub(crate) type DrawError = Box<dyn std::error::Error + Send + Sync>;
 type DrawResult = Result<(), DrawError>;
 
 /// A linear coordinate over `lo..hi` whose ticks are given (plotters' own choice of round
@@ -47,40 +48,6 @@ pub(crate) fn text_scale(w: u32, h: u32) -> f64 {
         .clamp(0.85, 2.0)
 }
 
-/// The legend box as fractions of a frame `frame` pixels wide and high: its widest label plus
-/// the marker and margins, one row per named series; `None` when no series is named.
-fn legend_box(
-    area: &Area,
-    fig: &Figure,
-    font: &TextStyle,
-    s: f64,
-    frame: (i32, i32),
-) -> Result<Option<(f64, f64)>, DrawError> {
-    let rows = fig.series.iter().filter(|s| !s.name.is_empty()).count();
-    if rows == 0 {
-        return Ok(None);
-    }
-    let (mut label_w, mut label_h) = (0u32, 0u32);
-    for se in &fig.series {
-        let (w, h) = area.estimate_text_size(&se.name, font)?;
-        label_w = label_w.max(w);
-        label_h = label_h.max(h);
-    }
-    Ok(Some((
-        ((label_w as f64 + 60.0 * s) / frame.0.max(1) as f64).min(1.0),
-        ((rows as f64 * (label_h as f64 + 8.0 * s) + 20.0 * s) / frame.1.max(1) as f64).min(1.0),
-    )))
-}
-
-/// The axis of one coordinate of the figure's plottable points.
-fn axis(vals: impl Iterator<Item = f64>, log: bool, n: usize) -> AxisScale {
-    if log {
-        AxisScale::log_from_values(vals)
-    } else {
-        AxisScale::from_values(vals, n)
-    }
-}
-
 /// Size of the k-th filled-marker series' markers for a base radius `r`: each shape a little
 /// smaller than the one before, so a later series over an earlier one leaves a visible rim.
 fn marker_radius(k: usize, r: i32) -> i32 {
@@ -100,20 +67,6 @@ fn marker_polygon(k: usize, r: i32) -> Vec<(i32, i32)> {
     }
 }
 
-/// The scale that fits a title `text_w` pixels wide at full size into `room` pixels: never
-/// above full size, never below half (a longer title is cut rather than made unreadable). The
-/// rule of every title, a figure's, a panel's or a set's.
-pub(crate) fn title_scale(room: f64, text_w: u32) -> f64 {
-    (room / f64::from(text_w.max(1))).clamp(0.5, 1.0)
-}
-
-/// The height plotters' `DrawingArea::titled` takes for a caption `text_h` high: the text and a
-/// padding of min(text_h / 2, 5) above and below it.
-fn caption_height(text_h: u32) -> i32 {
-    let pad = (text_h / 2).min(5) as i32;
-    text_h as i32 + 2 * pad
-}
-
 /// Draws one figure filling `area`: title, framed axes with grid, tick labels, axis labels with
 /// the scale exponent (if any) at the axis end, series (lines first, then filled markers, then
 /// hollow ones, so no marker hides under a line), markers, legend. `ss` is the supersampling
@@ -122,8 +75,12 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
     let (w, h) = area.dim_in_pixel();
     let (lw_px, lh_px) = (w as f64 / ss, h as f64 / ss);
     let s = text_scale(lw_px as u32, lh_px as u32) * ss;
-    let px = |v: f64| (v * s).round().max(1.0) as i32;
-    let (tick_font, desc_font, legend_font) = (text(15.0 * s), text(18.0 * s), text(15.0 * s));
+    let px = |v: f64| px(v, s);
+    let fonts = Fonts {
+        tick: text(15.0 * s),
+        desc: text(18.0 * s),
+        legend: text(15.0 * s),
+    };
     let nx = (lw_px / 110.0).round().clamp(3.0, 10.0) as usize;
     let ny = (lh_px / 70.0).round().clamp(3.0, 10.0) as usize;
 
@@ -136,97 +93,25 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
             .collect::<Vec<_>>()
     };
     let all: Vec<(f64, f64)> = fig.series.iter().flat_map(finite).collect();
-    let (left, right) = (px(18.0), px(28.0));
-    // A long title (a spectrum panel's notes) shrinks to fit between the margins, where
-    // plotters centres it, down to half its size, as a set's overall title does; plotters
-    // would cut it off at the figure's edges. The height plotters gives a caption follows its
-    // font, so the top margin takes up what the smaller font leaves: the frame stays where a
-    // full-size title puts it, in line with its neighbours' in a set of panels.
-    let (mut title_room, mut caption_h) = (0, 0);
-    let title = if fig.title.is_empty() {
-        None
-    } else {
-        let full = bold(20.0 * s);
-        let (tw, th_full) = area.estimate_text_size(&fig.title, &full)?;
-        let room = (w as i32 - left - right).max(1);
-        let fit = title_scale(0.98 * f64::from(room), tw);
-        let style = bold(20.0 * s * fit);
-        let (_, th) = area.estimate_text_size(&fig.title, &style)?;
-        title_room = caption_height(th_full) - caption_height(th);
-        caption_h = caption_height(th);
-        Some(style)
-    };
-    // Room for a "×10ⁿ" above the y axis is always kept so frames of panels line up.
-    let top = px(34.0) + title_room;
-
-    let xa = axis(all.iter().map(|p| p.0), fig.x_log, nx);
-    let mut ya = axis(all.iter().map(|p| p.1), fig.y_log, ny);
-    let x_ticks = xa.ticks(nx);
-    let nx = x_ticks.len();
-
-    // Size the label areas from the actual tick labels so nothing overlaps.
-    let (_, tick_h) = area.estimate_text_size("0", &tick_font)?;
-    let (_, desc_h) = area.estimate_text_size("Hg", &desc_font)?;
-    let y_area_of = |ticks: &[f64], ya: &AxisScale| -> Result<i32, DrawError> {
-        let mut y_tick_w = 0;
-        for t in ticks {
-            y_tick_w = y_tick_w.max(area.estimate_text_size(&ya.label(*t), &tick_font)?.0);
-        }
-        Ok(y_tick_w as i32
-            + px(12.0)
-            + if fig.y_label.is_empty() {
-                0
-            } else {
-                desc_h as i32 + px(14.0)
-            })
-    };
-    let mut y_ticks = ya.ticks(ny);
-    let mut y_area = y_area_of(&y_ticks, &ya)?;
-    let x_area = tick_h as i32
-        + px(14.0)
-        + if fig.x_label.is_empty() {
-            0
-        } else {
-            desc_h as i32 + px(14.0)
-        };
-    // When the legend would hide data in every corner, the y axis grows at one end to make
-    // room for it (`legend::headroom`). The frame's size is plotters' layout: the margins (the
-    // bottom one is `left`), the caption and the label areas. A grown axis' labels may be
-    // wider and the frame narrower, so the growth is worked out again until they settle.
-    let frame_of = |y_area: i32| {
-        (
-            w as i32 - left - right - y_area - 1,
-            h as i32 - top - left - caption_h - x_area - 1,
-        )
-    };
-    let radius = px(3.5);
-    let bare = (ya.clone(), y_ticks.clone(), y_area);
-    let mut cleared = None;
-    for _ in 0..3 {
-        let frame = frame_of(y_area);
-        if frame.0 <= 0 || frame.1 <= 0 {
-            break;
-        }
-        let Some(bx) = legend_box(area, fig, &legend_font, s, frame)? else {
-            break;
-        };
-        // plotters' 5 px between the legend and the frame, and a hollow marker's radius.
-        let clear = f64::from(5 + 2 * radius + 2);
-        let clear = (clear / f64::from(frame.0), clear / f64::from(frame.1));
-        let Some((grown, corner)) = headroom(&all, &xa, &bare.0, bx, clear, ny) else {
-            (ya, y_ticks, y_area) = bare.clone();
-            cleared = None;
-            break;
-        };
-        y_ticks = grown.ticks(ny);
-        y_area = y_area_of(&y_ticks, &grown)?;
-        ya = grown;
-        cleared = Some(corner);
-        if frame_of(y_area) == frame {
-            break;
-        }
-    }
-    let ny = y_ticks.len();
+    let Layout {
+        title,
+        margins: (left, right, top),
+        x_area,
+        y_area,
+        tick_h,
+        xa,
+        ya,
+        x_ticks,
+        y_ticks,
+        legend_at,
+        frame,
+    } = layout(area, fig, &all, s, (nx, ny), &fonts)?;
+    let Fonts {
+        tick: tick_font,
+        desc: desc_font,
+        legend: legend_font,
+    } = fonts;
+    let (nx, ny) = (x_ticks.len(), y_ticks.len());
     let y_exp = ya.exponent_text();
     let x_exp = xa.exponent_text();
 
@@ -295,6 +180,7 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
     }
 
     let lw = px(2.0) as u32;
+    let radius = px(MARKER_RADIUS);
     let glyph_w = px(24.0);
     let pts = |series: &Series| -> Vec<(f64, f64)> {
         series
@@ -432,8 +318,7 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
         yr.start - by,
         yr.end - 1 - by,
     );
-    // The layout above is plotters' own.
-    let frame = frame_of(y_area);
+    // The layout is plotters' own.
     debug_assert!(frame.0 <= 0 || frame.1 <= 0 || frame == (x1 - x0, y1 - y0));
     area.draw(&Rectangle::new(
         [(x0, y0), (x1, y1)],
@@ -459,7 +344,7 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
     if let Some(legend_box) = legend_box(area, fig, &legend_font, s, (x1 - x0, y1 - y0))? {
         chart
             .configure_series_labels()
-            .position(cleared.unwrap_or_else(|| legend_corner(&all, &xa, &ya, legend_box)))
+            .position(legend_at.unwrap_or_else(|| legend_corner(&all, &xa, &ya, legend_box)))
             .margin(px(10.0))
             .legend_area_size(glyph_w + px(10.0))
             .label_font(legend_font)

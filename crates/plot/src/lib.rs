@@ -12,6 +12,7 @@ mod fast_lines;
 mod figure;
 mod font;
 mod glyphs;
+mod layout;
 mod legend;
 mod polygon;
 mod render;

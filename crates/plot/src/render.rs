@@ -3,10 +3,11 @@
 //! anti-aliasing, which looks stepped on slanted lines.
 
 use crate::dirty::Dirty;
-use crate::draw::{draw_figure, text_scale, title_scale, Area};
+use crate::draw::{draw_figure, text_scale, Area};
 use crate::fast_lines::FastLines;
 use crate::figure::Figure;
 use crate::font::{bold, ensure_font};
+use crate::layout::title_scale;
 use crate::PlotError;
 use image::ImageEncoder;
 use plotters::prelude::*;
