@@ -3,7 +3,7 @@
 use crate::axis::AxisScale;
 use crate::figure::{Figure, Series, SeriesStyle, PALETTE};
 use crate::font::text;
-use crate::layout::{layout, legend_box, px, Fonts, Layout, MARKER_RADIUS};
+use crate::layout::{layout, legend_box, px, ring_radius, Fonts, Layout, MARKER_RADIUS};
 use crate::legend::legend_corner;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::coord::types::RangedCoordf64;
@@ -46,6 +46,12 @@ pub(crate) fn text_scale(w: u32, h: u32) -> f64 {
     ((w as f64 * h as f64) / (900.0 * 650.0))
         .sqrt()
         .clamp(0.85, 2.0)
+}
+
+/// The rank of series `i` among the figure's series of its own style (0 for the first).
+fn rank(fig: &Figure, i: usize) -> usize {
+    let style = fig.series[i].style;
+    fig.series[..i].iter().filter(|s| s.style == style).count()
 }
 
 /// Size of the k-th filled-marker series' markers for a base radius `r`: each shape a little
@@ -190,13 +196,6 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
             .map(|(&x, &y)| (xa.map(x), ya.map(y)))
             .collect()
     };
-    // The k-th filled-marker series of the figure, by index.
-    let filled_rank = |i: usize| {
-        fig.series[..i]
-            .iter()
-            .filter(|s| s.style == SeriesStyle::Points)
-            .count()
-    };
     // Layers: lines, filled markers, hollow markers; within a layer, series order.
     for layer in 0..3 {
         for (i, series) in fig.series.iter().enumerate() {
@@ -205,7 +204,7 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
             let ok = |p: &&(f64, f64)| p.0.is_finite() && p.1.is_finite();
             match (layer, series.style) {
                 (1, SeriesStyle::Points) => {
-                    let k = filled_rank(i);
+                    let k = rank(fig, i);
                     let r = marker_radius(k, radius);
                     let fill = color.filled();
                     if k % 4 == 0 {
@@ -221,11 +220,8 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
                 }
                 (2, SeriesStyle::OpenPoints) => {
                     let ring = color.stroke_width(lw.max(2));
-                    chart.draw_series(
-                        v.iter()
-                            .filter(ok)
-                            .map(|&p| Circle::new(p, 2 * radius, ring)),
-                    )?;
+                    let r = ring_radius(rank(fig, i), radius);
+                    chart.draw_series(v.iter().filter(ok).map(|&p| Circle::new(p, r, ring)))?;
                 }
                 (0, SeriesStyle::Line | SeriesStyle::DashedLine) => {
                     let line = color.stroke_width(lw);
@@ -269,7 +265,7 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
         let anno = anno.label(series.name.as_str());
         match series.style {
             SeriesStyle::Points => {
-                let k = filled_rank(i);
+                let k = rank(fig, i);
                 let r = marker_radius(k, radius);
                 let shape: Vec<(i32, i32)> = if k % 4 == 0 {
                     // A polygon of many sides stands for the circle in the legend.
@@ -293,10 +289,13 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
                     EmptyElement::at((x, y)) + Polygon::new(shape.clone(), color.filled())
                 })
             }
-            SeriesStyle::OpenPoints => anno.legend(move |(x, y)| {
-                EmptyElement::at((x, y))
-                    + Circle::new((glyph_w / 2, 0), 2 * radius, color.stroke_width(lw.max(2)))
-            }),
+            SeriesStyle::OpenPoints => {
+                let r = ring_radius(rank(fig, i), radius);
+                anno.legend(move |(x, y)| {
+                    EmptyElement::at((x, y))
+                        + Circle::new((glyph_w / 2, 0), r, color.stroke_width(lw.max(2)))
+                })
+            }
             SeriesStyle::Line => anno.legend(move |(x, y)| {
                 EmptyElement::at((x, y)) + PathElement::new(vec![(0, 0), (glyph_w, 0)], line)
             }),

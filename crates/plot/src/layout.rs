@@ -12,6 +12,15 @@ use plotters::prelude::*;
 /// A marker's base radius, in unscaled pixels.
 pub(crate) const MARKER_RADIUS: f64 = 3.5;
 
+/// Ring sizes of the hollow-marker series, in order (times twice the base radius): rings of
+/// series that coincide nest instead of covering one another, so each shows its colour.
+const RING_SCALES: [f64; 4] = [1.0, 1.45, 0.7, 1.2];
+
+/// Radius of the k-th hollow-marker series' rings for a base radius `r`.
+pub(crate) fn ring_radius(k: usize, r: i32) -> i32 {
+    (f64::from(2 * r) * RING_SCALES[k % RING_SCALES.len()]).round() as i32
+}
+
 /// `v` unscaled pixels at scale `s`, at least one.
 pub(crate) fn px(v: f64, s: f64) -> i32 {
     (v * s).round().max(1.0) as i32
@@ -129,8 +138,8 @@ pub(crate) fn layout(
         let Some(bx) = legend_box(area, fig, legend_font, s, frame)? else {
             break;
         };
-        // plotters' 5 px between the legend and the frame, and a hollow marker's radius.
-        let clear = f64::from(5 + 2 * radius + 2);
+        // plotters' 5 px between the legend and the frame, and the largest ring's radius.
+        let clear = f64::from(5 + ring_radius(1, radius) + 2);
         let clear = (clear / f64::from(frame.0), clear / f64::from(frame.1));
         let Some((grown, corner)) = headroom(all, &xa, &bare.0, bx, clear, ny) else {
             (ya, y_ticks, y_area) = bare.clone();

@@ -33,10 +33,17 @@ fn coincident_series_all_show_their_colour() {
             xs.clone(),
             ys.clone(),
         ))
-        .with(Series::new("estimate", SeriesStyle::OpenPoints, xs, ys));
+        .with(Series::new(
+            "estimate",
+            SeriesStyle::OpenPoints,
+            xs.clone(),
+            ys.clone(),
+        ))
+        .with(Series::new("cross", SeriesStyle::OpenPoints, xs, ys));
     let img = render_rgb(&fig).unwrap();
-    // Each series paints well beyond its legend glyph: 12 markers (or the line) of its own.
-    for (i, want) in [(0, 200), (1, 150), (2, 150), (3, 150)] {
+    // Each series paints well beyond its legend glyph: 12 markers (or the line) of its own
+    // (the two hollow ones as nested rings).
+    for (i, want) in [(0, 200), (1, 150), (2, 150), (3, 150), (4, 150)] {
         let n = count(&img, PALETTE[i]);
         assert!(n > want, "series {i} shows {n} pixels of its colour");
     }
