@@ -207,7 +207,7 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
                     let k = rank(fig, i);
                     let r = marker_radius(k, radius);
                     let fill = color.filled();
-                    if k % 4 == 0 {
+                    if k.is_multiple_of(4) {
                         chart.draw_series(v.iter().filter(ok).map(|&p| Circle::new(p, r, fill)))?;
                     } else {
                         let shape = marker_polygon(k, r);
@@ -267,7 +267,7 @@ pub(crate) fn draw_figure(area: &Area, fig: &Figure, ss: f64) -> DrawResult {
             SeriesStyle::Points => {
                 let k = rank(fig, i);
                 let r = marker_radius(k, radius);
-                let shape: Vec<(i32, i32)> = if k % 4 == 0 {
+                let shape: Vec<(i32, i32)> = if k.is_multiple_of(4) {
                     // A polygon of many sides stands for the circle in the legend.
                     (0..24)
                         .map(|j| {
