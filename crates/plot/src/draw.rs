@@ -1,17 +1,16 @@
 //! Drawing one figure into a drawing area: axes (linear or log), series, markers, legend.
 
 use crate::axis::AxisScale;
+use crate::error::DrawError;
+use crate::fast_lines::Area;
 use crate::figure::{Figure, Series, SeriesStyle, PALETTE};
 use crate::font::text;
 use crate::layout::{layout, legend_box, px, ring_radius, Fonts, Layout, MARKER_RADIUS};
 use crate::legend::legend_corner;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::coord::types::RangedCoordf64;
-use plotters::coord::Shift;
 use plotters::prelude::*;
 
-pub(crate) type Area<'a> = DrawingArea<crate::fast_lines::FastLines<'a>, Shift>;
-pub(crate) type DrawError = Box<dyn std::error::Error + Send + Sync>;
 type DrawResult = Result<(), DrawError>;
 
 /// A linear coordinate over `lo..hi` whose ticks are given (plotters' own choice of round

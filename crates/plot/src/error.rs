@@ -32,3 +32,6 @@ pub enum PlotError {
     #[error(transparent)]
     Io(#[from] gyroemu_io::IoError),
 }
+
+/// What drawing a figure can fail with: plotters' errors, boxed.
+pub(crate) type DrawError = Box<dyn std::error::Error + Send + Sync>;

@@ -11,10 +11,15 @@
 //! is given, so the average that follows reads only those stretches of the canvas.
 
 use crate::dirty::Dirty;
+use plotters::coord::Shift;
+use plotters::drawing::DrawingArea;
 use plotters::prelude::BitMapBackend;
 use plotters_backend::{
     BackendColor, BackendCoord, BackendStyle, BackendTextStyle, DrawingBackend, DrawingErrorKind,
 };
+
+/// The drawing area every figure is drawn into: plotters' over this backend.
+pub(crate) type Area<'a> = DrawingArea<FastLines<'a>, Shift>;
 
 /// [`BitMapBackend`] with axis-aligned wide lines filled as rectangles, marking what it
 /// draws on in the [`Dirty`] it holds, if any.

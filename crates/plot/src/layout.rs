@@ -3,7 +3,8 @@
 //! and room on the y axis for a legend that would otherwise hide data.
 
 use crate::axis::AxisScale;
-use crate::draw::{Area, DrawError};
+use crate::error::DrawError;
+use crate::fast_lines::Area;
 use crate::figure::Figure;
 use crate::font::bold;
 use crate::legend::headroom;

@@ -3,8 +3,9 @@
 //! anti-aliasing, which looks stepped on slanted lines.
 
 use crate::dirty::Dirty;
-use crate::draw::{draw_figure, text_scale, Area};
-use crate::fast_lines::FastLines;
+use crate::draw::{draw_figure, text_scale};
+use crate::error::DrawError;
+use crate::fast_lines::{Area, FastLines};
 use crate::figure::Figure;
 use crate::font::{bold, ensure_font};
 use crate::layout::title_scale;
@@ -21,7 +22,7 @@ pub const MAX_SIDE_PX: u32 = 16_384;
 /// Supersampling factor of the PNG renderers.
 pub const SUPERSAMPLE: u32 = 2;
 
-type DrawResult = Result<(), Box<dyn std::error::Error + Send + Sync>>;
+type DrawResult = Result<(), DrawError>;
 
 fn check_target(path: &Path, w: u32, h: u32) -> Result<(), PlotError> {
     let ok = |s: u32| (MIN_SIDE_PX..=MAX_SIDE_PX).contains(&s);
