@@ -293,18 +293,22 @@ fn spectrum_panel(
         f = f.with(Series::new(*name, SeriesStyle::Line, p.freqs_hz(), ys));
     }
     for m in marks {
+        let mut level_read = false;
         let levels: Vec<String> = psds
             .iter()
             .map(|(_, p)| match tone_near(p, m.freq_hz, 2) {
                 None => "-".into(),
                 // As `inspect` says it: a tone sharing its bins with its mirror image.
                 Some(t) if unresolved(p, &t).is_some() => "unresolved".into(),
-                Some(t) => format!("{:.1}", t.level_db()),
+                Some(t) => {
+                    level_read = true;
+                    format!("{:.1}", t.level_db())
+                }
             })
             .collect();
         // The unit only beside a level; one word for all channels once (the m2tfg presets'
         // 2 fc residual, unresolved on fs/2 in every channel, ran into its own mark).
-        let label = if levels.iter().any(|l| l.parse::<f64>().is_ok()) {
+        let label = if level_read {
             format!("{}: {} {}", m.what, levels.join(" / "), db_unit(unit))
         } else if levels.len() > 1 && levels.iter().all(|l| l == "unresolved") {
             format!("{}: unresolved (every channel)", m.what)
