@@ -53,7 +53,7 @@ impl<S: Sample> Board<S> {
         }
         match self.shape {
             Shape::Coriolis => by_plant!(CORIOLIS),
-            Shape::RateTable { .. } if self.table_lanes.is_some() => by_plant!(RATE_TABLE_LANES),
+            Shape::RateTable { .. } if !self.table_shared => by_plant!(RATE_TABLE_LANES),
             Shape::RateTable { .. } => by_plant!(RATE_TABLE),
             Shape::Rotating => by_plant!(ROTATING),
         }
@@ -75,7 +75,7 @@ impl<S: Sample> Board<S> {
         }
         match self.shape {
             Shape::Coriolis => by_plant!(CORIOLIS),
-            Shape::RateTable { .. } if self.table_lanes.is_some() => by_plant!(RATE_TABLE_LANES),
+            Shape::RateTable { .. } if !self.table_shared => by_plant!(RATE_TABLE_LANES),
             Shape::RateTable { .. } => by_plant!(RATE_TABLE),
             Shape::Rotating => by_plant!(ROTATING),
         }
@@ -354,9 +354,10 @@ impl<S: Sample> Board<S> {
                 run = run.min(u64::from(self.modulation.ready()));
             }
             if is_table(K) {
-                run = run.min(u64::from(match &mut self.table_lanes {
-                    Some(t) if K == RATE_TABLE_LANES => t.ready(),
-                    _ => self.table_nco.ready(),
+                run = run.min(u64::from(if K == RATE_TABLE_LANES {
+                    self.table_lanes.ready()
+                } else {
+                    self.table_nco.ready()
                 }));
             }
             // Nor does the TIA flicker's next chunk run inside it.
@@ -429,9 +430,10 @@ impl<S: Sample> Board<S> {
                 let mut p = if is_table(K) {
                     // The shared table is the cheaper in the loop; the lanes' only where
                     // they differ.
-                    let sin_t = match &mut self.table_lanes {
-                        Some(t) if K == RATE_TABLE_LANES => t.tick_ready().1,
-                        _ => S::splat(self.table_nco.tick_ready().1),
+                    let sin_t = if K == RATE_TABLE_LANES {
+                        self.table_lanes.tick_ready().1
+                    } else {
+                        S::splat(self.table_nco.tick_ready().1)
                     };
                     let rate = self.rate * sin_t;
                     if DECOUPLED {
@@ -558,7 +560,7 @@ impl<S: Sample> Board<S> {
             || {
                 let at =
                     |i: usize| table_reference(n + self.starts[i], self.table_f_hz[i], self.fs_hz);
-                if self.table_lanes.is_none() {
+                if self.table_shared {
                     let b = at(0);
                     return (S::splat(b.re), S::splat(b.im));
                 }

@@ -1,9 +1,11 @@
 //! divan benchmarks of the board (`cargo bench -p gyroemu-experiment`): the whole fused chain
 //! in the lanes this CPU runs it in (eight operating points per group in f64x8 lanes with
 //! AVX-512, else four in f64x4; `gyroemu_board::max_lanes_for`) on one lane group and on one
-//! group per core, noiseless and with every noise source, DAC and ADC on. Throughput is
-//! reported in point-samples (one input sample of one operating point). `gyroemu bench` prints
-//! the same chain figure and each stage alone.
+//! group per core, noiseless and with every noise source, DAC and ADC on; and the rate-table
+//! chain with one table shared by the group's lanes against a table per lane (the bandwidth
+//! sweep's groups, which `gyroemu bench` does not time). Throughput is reported in
+//! point-samples (one input sample of one operating point). `gyroemu bench` prints the same
+//! chain figure and each stage alone.
 
 use divan::counter::ItemsCount;
 use divan::{black_box, Bencher};
@@ -29,9 +31,17 @@ fn rotating(noise: bool) -> Config {
     }
 }
 
-/// Runs `groups` lane groups of N_IN samples each, one per rayon worker.
+/// The table frequencies of a group with a table per lane, Hz (the bandwidth sweep's lowest).
+const LANE_TABLES_HZ: [f64; 8] = [0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5];
+
+/// Runs `groups` lane groups of N_IN samples each of the rotating chain, one per rayon worker.
 fn run_groups(b: Bencher, noise: bool, groups: usize) {
-    let cfg = rotating(noise);
+    run_groups_of(b, &rotating(noise), groups, false);
+}
+
+/// Runs `groups` lane groups of `cfg`'s chain, N_IN samples each, one per rayon worker; with
+/// `table_per_lane` (a rate-table `cfg`) each lane on its own table ([`LANE_TABLES_HZ`]).
+fn run_groups_of(b: Bencher, cfg: &Config, groups: usize, table_per_lane: bool) {
     let lanes = max_lanes_for(&cfg.board_params());
     let listed = &cfg.experiment.rates_dps;
     let rates: Vec<f64> = (0..lanes)
@@ -53,8 +63,14 @@ fn run_groups(b: Bencher, noise: bool, groups: usize) {
         .with_inputs(|| {
             (0..groups)
                 .map(|_| {
-                    GroupBoard::with_width(lanes, &cfg.board_params(), &rates, &streams)
-                        .expect("valid preset")
+                    let p = cfg.board_params();
+                    if table_per_lane {
+                        let tables = &LANE_TABLES_HZ[..lanes];
+                        GroupBoard::with_table_hz(&p, &rates, tables, &streams)
+                    } else {
+                        GroupBoard::with_width(lanes, &p, &rates, &streams)
+                    }
+                    .expect("valid preset")
                 })
                 .collect::<Vec<_>>()
         })
@@ -83,4 +99,16 @@ fn chain_group_per_core(b: Bencher) {
 #[divan::bench(sample_count = 10, sample_size = 1)]
 fn chain_with_noise_dac_adc_1_group(b: Bencher) {
     run_groups(b, true, 1);
+}
+
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn rate_table_shared_1_group(b: Bencher) {
+    let cfg = preset("m2tfg-ratetable").expect("embedded preset");
+    run_groups_of(b, &cfg, 1, false);
+}
+
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn rate_table_per_lane_1_group(b: Bencher) {
+    let cfg = preset("m2tfg-ratetable").expect("embedded preset");
+    run_groups_of(b, &cfg, 1, true);
 }
