@@ -182,7 +182,7 @@ pub struct Board<S: Sample> {
     /// Rate-table sine of each lane, ticked in place of the shared one when the lanes follow
     /// different tables ([`Board::with_table_hz`]; `table_shared` false). Built either way, so
     /// that loop ticks a field it always has: behind an `Option`, each sample tested it and
-    /// kept its phasor in memory (the bandwidth sweep's loop 19 % slower a group-sample than
+    /// kept its phasor in memory (the bandwidth sweep's loop 17 % slower a group-sample than
     /// the shared table's; Xeon).
     pub(crate) table_lanes: RotatingNco<S>,
     /// Every lane follows the same table from the same start: the shared `table_nco` serves,
