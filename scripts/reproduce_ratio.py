@@ -10,12 +10,16 @@ threads, in the lanes a run of that chain uses on this CPU (the row without a la
 best of R runs; the bandwidth sweep at the rate-table chain's rate). The bench is run before and after the `reproduce` runs, and the prediction is
 their mean: a shared host's speed moves by 10 % or more within minutes. The binaries'
 `reproduce` runs alternate (N each), and each is reported as prediction / wall time, at the
-median and at the best run. The first binary is benched; give the same CPU's binaries only.
+median and at the best run, with the median CPU time of its runs (user + system, from the
+children's resource usage): steadier than the wall time between two binaries, it resolves
+changes of about 1 % that the wall time's spread hides. The first binary is benched; give the
+same CPU's binaries only.
 """
 
 import argparse
 import json
 import re
+import resource
 import shutil
 import statistics
 import subprocess
@@ -49,15 +53,23 @@ def bench(binary: str, repeats: int) -> tuple:
     return rates, cpu
 
 
+def children_cpu() -> float:
+    """User and system seconds of the children waited for so far."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def run_reproduce(binary: str, out: Path) -> tuple:
-    """Wall seconds and the closing line's point-samples of one full `reproduce`."""
+    """Wall seconds, the closing line's point-samples and CPU seconds of one full
+    `reproduce`."""
     shutil.rmtree(out, ignore_errors=True)
+    cpu = children_cpu()
     t = time.perf_counter()
     done = subprocess.run([binary, "reproduce", "--out", str(out)],
                           check=True, capture_output=True, text=True)
     wall = time.perf_counter() - t
     m = re.search(r"reproduce: (\d+) point-samples", done.stdout + done.stderr)
-    return wall, int(m.group(1))
+    return wall, int(m.group(1)), children_cpu() - cpu
 
 
 def point_samples(out: Path, total: int) -> dict:
@@ -82,13 +94,16 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3)
     a = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="reproduce_ratio_"))
-    _, total = run_reproduce(a.binaries[0], tmp / "first")
+    _, total, _ = run_reproduce(a.binaries[0], tmp / "first")
     samples = point_samples(tmp / "first", total)
     before, cpu = bench(a.binaries[0], a.repeats)
     walls = {b: [] for b in a.binaries}
+    cpus = {b: [] for b in a.binaries}
     for _ in range(a.runs):
         for b in a.binaries:
-            walls[b].append(run_reproduce(b, tmp / "run")[0])
+            wall, _, cpu_s = run_reproduce(b, tmp / "run")
+            walls[b].append(wall)
+            cpus[b].append(cpu_s)
     after, _ = bench(a.binaries[0], a.repeats)
     shutil.rmtree(tmp, ignore_errors=True)
     p = [predict(samples, r) for r in (before, after)]
@@ -104,7 +119,8 @@ def main() -> None:
         w.sort()
         med = statistics.median(w)
         print(f"{b}: wall {w[0]:.2f} to {w[-1]:.2f} s, median {med:.2f} (n={len(w)}): "
-              f"{100 * pred / med:.0f} % at the median, {100 * pred / w[0]:.0f} % at the best")
+              f"{100 * pred / med:.0f} % at the median, {100 * pred / w[0]:.0f} % at the best; "
+              f"CPU median {statistics.median(cpus[b]):.3f} s")
 
 
 if __name__ == "__main__":
