@@ -26,7 +26,8 @@ use std::sync::Arc;
 pub(crate) const CORIOLIS: u8 = 0;
 pub(crate) const RATE_TABLE: u8 = 1;
 pub(crate) const ROTATING: u8 = 2;
-/// A rate table whose lanes follow different tables ([`Board::with_table_hz`]).
+/// A rate table whose lanes follow different tables (another frequency,
+/// [`Board::with_table_hz`], or another start, [`Board::with_starts`]).
 pub(crate) const RATE_TABLE_LANES: u8 = 3;
 
 /// Shape `k` is a rate table (shared or per lane).
@@ -180,10 +181,11 @@ pub struct Board<S: Sample> {
     /// Rate-table sine shared by the lanes (rate-table runs).
     pub(crate) table_nco: RotatingNco<f64>,
     /// Rate-table sine of each lane, ticked in place of the shared one when the lanes follow
-    /// different tables ([`Board::with_table_hz`]; `table_shared` false). Built either way, so
+    /// different tables (another frequency, [`Board::with_table_hz`], or another start,
+    /// [`Board::with_starts`]; `table_shared` false). Built either way, so
     /// that loop ticks a field it always has: behind an `Option`, each sample tested it and
-    /// kept its phasor in memory (the bandwidth sweep's loop 17 % slower a group-sample than
-    /// the shared table's; Xeon).
+    /// kept its phasor in memory (the bandwidth sweep's loop at 0.84 of the shared table's
+    /// rate a group-sample; Xeon).
     pub(crate) table_lanes: RotatingNco<S>,
     /// Every lane follows the same table from the same start: the shared `table_nco` serves,
     /// the cheaper in the sample loop.
@@ -439,6 +441,14 @@ impl<S: Sample> Board<S> {
             Shape::RateTable { .. } => self.plant.rate_split_by_mode(),
             _ => self.plant.decoupled(),
         }
+    }
+
+    /// Whether this rate-table board's lanes follow tables of their own (another frequency
+    /// or another start on the time axis: `RATE_TABLE_LANES`, the per-lane oscillator ticked
+    /// in the sample loop) rather than one table shared by every lane. Public so tests can
+    /// check which loop a board runs.
+    pub fn table_per_lane(&self) -> bool {
+        matches!(self.shape, Shape::RateTable { .. }) && !self.table_shared
     }
 
     /// The TIA's two flicker sources run as one of eight lanes (a four-lane board where the

@@ -173,4 +173,9 @@ impl GroupBoard {
     pub fn plant_decoupled(&self) -> bool {
         on_board!(&self.0, b => b.plant_decoupled())
     }
+
+    /// See [`Board::table_per_lane`].
+    pub fn table_per_lane(&self) -> bool {
+        on_board!(&self.0, b => b.table_per_lane())
+    }
 }

@@ -41,14 +41,16 @@ fn check(name: &str, p: &BoardParams, lanes: usize, width: usize) {
             );
         }
     };
+    // Each run is known to take the per-lane loop, whose lanes are held to the scalar
+    // boards' (shared-table) bits.
     if width == 4 {
-        run(Board::<f64x4>::with_table_hz(p, &rad, freqs, &streams)
-            .unwrap()
-            .run(12, &points, RunOptions::default(), &|_| {})
-            .unwrap());
+        let mut b = Board::<f64x4>::with_table_hz(p, &rad, freqs, &streams).unwrap();
+        assert!(b.table_per_lane(), "{name}");
+        run(b.run(12, &points, RunOptions::default(), &|_| {}).unwrap());
     } else {
         let mut b = GroupBoard::with_table_hz(p, &rad, freqs, &streams).unwrap();
         assert_eq!(b.width(), 8);
+        assert!(b.table_per_lane(), "{name}");
         run(b.run(12, &points, RunOptions::default(), &|_| {}).unwrap());
     }
 }
@@ -66,17 +68,49 @@ fn each_lane_follows_its_own_table_bit_for_bit() {
 
 #[test]
 fn lanes_of_one_frequency_equal_the_shared_table() {
-    // The per-lane path with every lane at the board's frequency is the shared one.
+    // Tables given per lane that are all the board's run the shared table's loop, with the
+    // bits of the board built without them.
     let p = m2tfg(Shape::RateTable { freq_hz: 3.0 });
     let points = [point(50.0, 100), point(150.0, 90)];
     let rad = [points[0].rate_rad_s, points[1].rate_rad_s];
     let run = |b: Board<f64x4>| {
+        assert!(!b.table_per_lane());
         let mut b = b;
         b.run(12, &points, RunOptions::default(), &|_| {}).unwrap()
     };
     let shared = run(Board::new(&p, &rad, &[0, 1]).unwrap());
     let per_lane = run(Board::with_table_hz(&p, &rad, &[3.0, 3.0], &[0, 1]).unwrap());
     assert_eq!(shared.lanes, per_lane.lanes);
+}
+
+#[test]
+fn lanes_take_the_per_lane_loop_exactly_where_their_tables_differ() {
+    // Another frequency or another start on the time axis (a rate table's phase counts from
+    // its sample 0) gives a lane a table of its own; one table for all keeps the shared loop.
+    let p = m2tfg(Shape::RateTable { freq_hz: 3.0 });
+    let rad = [0.5, 1.5];
+    let per_lane = |b: Result<Board<f64x4>, gyroemu_core::ParamError>| b.unwrap().table_per_lane();
+    assert!(!per_lane(Board::new(&p, &rad, &[0, 1])));
+    assert!(!per_lane(Board::with_table_hz(
+        &p,
+        &rad,
+        &[3.0, 3.0],
+        &[0, 1]
+    )));
+    assert!(!per_lane(Board::with_starts(&p, &rad, &[0, 1], &[32, 32])));
+    assert!(per_lane(Board::with_table_hz(
+        &p,
+        &rad,
+        &[3.0, 2.0],
+        &[0, 1]
+    )));
+    assert!(per_lane(Board::with_starts(&p, &rad, &[0, 1], &[0, 16])));
+    let starts = [0, 16];
+    let b = Board::with_table_hz_starts(&p, &rad, &[3.0, 3.0], &[0, 1], &starts);
+    assert!(per_lane(b));
+    // Other shapes have no table.
+    let c = m2tfg(Shape::Coriolis);
+    assert!(!per_lane(Board::with_starts(&c, &rad, &[0, 1], &[0, 16])));
 }
 
 #[test]

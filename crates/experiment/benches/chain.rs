@@ -3,7 +3,7 @@
 //! AVX-512, else four in f64x4; `gyroemu_board::max_lanes_for`) on one lane group and on one
 //! group per core, noiseless and with every noise source, DAC and ADC on; and the rate-table
 //! chain with one table shared by the group's lanes against a table per lane (the bandwidth
-//! sweep's groups, which `gyroemu bench` does not time). Throughput is reported in
+//! sweep's loop, `RATE_TABLE_LANES`, which `gyroemu bench` does not time). Throughput is reported in
 //! point-samples (one input sample of one operating point). `gyroemu bench` prints the same
 //! chain figure and each stage alone.
 
@@ -31,7 +31,9 @@ fn rotating(noise: bool) -> Config {
     }
 }
 
-/// The table frequencies of a group with a table per lane, Hz (the bandwidth sweep's lowest).
+/// The table frequencies of a group with a table per lane, Hz: the bandwidth sweep's eight
+/// lowest (`gyroemu_analysis::bandwidth::BANDWIDTH_FREQS_HZ`, written out: this crate is
+/// below that one).
 const LANE_TABLES_HZ: [f64; 8] = [0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5];
 
 /// Runs `groups` lane groups of N_IN samples each of the rotating chain, one per rayon worker.
@@ -64,13 +66,16 @@ fn run_groups_of(b: Bencher, cfg: &Config, groups: usize, table_per_lane: bool) 
             (0..groups)
                 .map(|_| {
                     let p = cfg.board_params();
-                    if table_per_lane {
+                    let board = if table_per_lane {
                         let tables = &LANE_TABLES_HZ[..lanes];
                         GroupBoard::with_table_hz(&p, &rates, tables, &streams)
                     } else {
                         GroupBoard::with_width(lanes, &p, &rates, &streams)
                     }
-                    .expect("valid preset")
+                    .expect("valid preset");
+                    // The loop this bench is named for.
+                    assert_eq!(board.table_per_lane(), table_per_lane);
+                    board
                 })
                 .collect::<Vec<_>>()
         })
