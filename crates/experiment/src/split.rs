@@ -205,9 +205,11 @@ fn binary_cut(cfg: &Config, windows: &[(u64, f64)], lens: &[u64]) -> Option<Vec<
     // Points by window length, longest first (of equal ones, the earlier point).
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by_key(|&p| core::cmp::Reverse(windows[p].0));
+    // The longest `n - rest` run whole; the rest, in `order`, take the powers of two in
+    // `rest` from the largest down.
     let mut counts = vec![1u64; n];
     let mut next = n - rest;
-    for b in (0..3).rev() {
+    for b in (0..MAX_LANES.trailing_zeros()).rev() {
         let size = 1usize << b;
         if rest & size != 0 {
             for &p in &order[next..next + size] {
@@ -216,7 +218,6 @@ fn binary_cut(cfg: &Config, windows: &[(u64, f64)], lens: &[u64]) -> Option<Vec<
             next += size;
         }
     }
-    // The whole points go first in `order`; those cut follow it.
     let count = |n: u64, len: u64| n.div_ceil(len.max(1)).max(1);
     let p = cfg.board_params();
     let mut cut = Vec::with_capacity(n);
