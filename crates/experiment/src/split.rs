@@ -158,11 +158,10 @@ pub fn lanes_of(
 /// groups of eight and one of four; as 20 of 0.204 s and 12 of 0.255 s they fill four: 9 %
 /// fewer lane-samples in eights, 1 % more in fours.
 fn fill_eights(cfg: &Config, windows: &[(u64, f64)], lens: &[u64]) -> Option<Vec<u64>> {
-    let count = |n: u64, len: u64| n.div_ceil(len.max(1)).max(1);
     let mut counts: Vec<u64> = windows
         .iter()
         .zip(lens)
-        .map(|(w, &l)| count(w.0, l))
+        .map(|(w, &l)| segments_of(w.0, l))
         .collect();
     let idle = (8 - counts.iter().sum::<u64>() % 8) % 8;
     if idle == 0 || idle as usize > windows.len() {
@@ -174,16 +173,28 @@ fn fill_eights(cfg: &Config, windows: &[(u64, f64)], lens: &[u64]) -> Option<Vec
     for &p in &order[..idle as usize] {
         counts[p] += 1;
     }
-    let mut even = Vec::with_capacity(windows.len());
-    let p = cfg.board_params();
-    for (&(n, _), &c) in windows.iter().zip(&counts) {
-        let (len, packing) = segment_length_on(&p, n.div_ceil(c));
-        if packing != Packing::Free || count(n, len) != c {
-            return None;
-        }
-        even.push(len);
-    }
+    let even = counted_cut(&cfg.board_params(), windows, &counts)?;
     pays_off(windows, cfg.n_settle_out(), lens, &even).then_some(even)
+}
+
+/// The segments a window of `n` decimated samples runs as, cut at `len` ([`cut_each`]).
+fn segments_of(n: u64, len: u64) -> u64 {
+    n.div_ceil(len.max(1)).max(1)
+}
+
+/// Per point, the length of its `counts[p]` even segments (its window over its count, as
+/// [`segment_length_on`] rounds it), if every point then runs as exactly that many segments
+/// and they share any group ([`Packing::Free`]): the cuts of [`fill_eights`] and
+/// [`binary_cut`], which fix each point's count ([`even_cut`] fixes a common length).
+fn counted_cut(p: &BoardParams, windows: &[(u64, f64)], counts: &[u64]) -> Option<Vec<u64>> {
+    windows
+        .iter()
+        .zip(counts)
+        .map(|(&(n, _), &c)| {
+            let (len, packing) = segment_length_on(p, n.div_ceil(c));
+            (packing == Packing::Free && segments_of(n, len) == c).then_some(len)
+        })
+        .collect()
 }
 
 /// Per point, the segment lengths of the cut by the binary digits of the point count: with
@@ -218,20 +229,9 @@ fn binary_cut(cfg: &Config, windows: &[(u64, f64)], lens: &[u64]) -> Option<Vec<
             next += size;
         }
     }
-    let count = |n: u64, len: u64| n.div_ceil(len.max(1)).max(1);
-    let p = cfg.board_params();
-    let mut cut = Vec::with_capacity(n);
-    for (&(w, _), &c) in windows.iter().zip(&counts) {
-        if c == 1 {
-            cut.push(w.max(1));
-            continue;
-        }
-        let (len, packing) = segment_length_on(&p, w.div_ceil(c));
-        if packing != Packing::Free || count(w, len) != c {
-            return None;
-        }
-        cut.push(len);
-    }
+    // The whole points' windows are the longest, so they share any group wherever the cut
+    // ones do: one rule for all.
+    let cut = counted_cut(&cfg.board_params(), windows, &counts)?;
     pays_off(windows, cfg.n_settle_out(), lens, &cut).then_some(cut)
 }
 
