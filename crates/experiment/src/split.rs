@@ -59,9 +59,13 @@ pub enum Packing {
 ///   four (`4 / gcd(points, 4)`, segments that may share any group) runs at least
 ///   1/[`MIN_IDLE_SAVING`] fewer lane-samples than the whole points do with their groups'
 ///   idle lanes ([`lane_samples_in_fours`]); where those segments leave lanes of groups of
-///   eight idle, the points with the longest segments then take one segment more each to
-///   fill them, every point cut evenly (`fill_eights`): Fig. 5's seven BAW points, 1 s each, run as 32 segments (four points
-///   in five, three in four) in four full groups of eight, or eight of four.
+///   eight idle, two cuts that fill them are weighed by the same rules, the one with fewer
+///   lane-samples in groups of eight first: the points with the longest segments taking one
+///   segment more each, every point cut evenly (`fill_eights`: Fig. 5's seven 1 s points as
+///   32 segments, four points in five and three in four), and the cut by the binary digits
+///   of the point count (`binary_cut`: Fig. 5's seven as 4 + 2 + 1 points in halves,
+///   quarters and eighths, 24 segments in three full groups of eight, or six of four), which
+///   Fig. 5 takes.
 ///
 /// A dump that does not fit keeps the sweep whole: its bits are then a continuous run's, not a
 /// split one's (a dump of the first second, as `reproduce` records, always fits).
