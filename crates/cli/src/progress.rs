@@ -84,24 +84,36 @@ impl Progress {
 
 /// `label: N point-samples in T s (R M point-samples/s)`, then `; writing dumps: X MB in
 /// Y s (Z MB/s)` when files were written. Emulation and writing are timed apart: a dump's
-/// CSV can take longer to write than the emulation that produced it.
+/// CSV can take longer to write than the emulation that produced it. A rate whose time is
+/// not positive (the writing's time covered the whole run) is said to be unmeasured rather
+/// than divided by a floor into a figure no run reached.
 pub fn counted_line(label: &str, point_samples: u64, emulation_s: f64, written: Written) -> String {
     let mut line = format!(
-        "{label}: {point_samples} point-samples in {} s ({} M point-samples/s)",
+        "{label}: {point_samples} point-samples in {} s ({})",
         sig3(emulation_s),
-        sig3(point_samples as f64 / emulation_s.max(1e-9) / 1e6)
+        rate(point_samples as f64 / 1e6, emulation_s, "M point-samples/s")
     );
     if written.files > 0 {
         let mb = written.bytes as f64 / 1e6;
         line.push_str(&format!(
-            "; writing dumps: {} MB in {} files in {} s ({} MB/s)",
+            "; writing dumps: {} MB in {} files in {} s ({})",
             sig3(mb),
             written.files,
             sig3(written.seconds),
-            sig3(mb / written.seconds.max(1e-9))
+            rate(mb, written.seconds, "MB/s")
         ));
     }
     line
+}
+
+/// `amount / seconds` to three significant figures with its `unit`, or a note that no time
+/// was measured to divide by.
+fn rate(amount: f64, seconds: f64, unit: &str) -> String {
+    if seconds > 0.0 && seconds.is_finite() {
+        format!("{} {unit}", sig3(amount / seconds))
+    } else {
+        format!("{unit}: no time measured")
+    }
 }
 
 impl Task for Progress {
@@ -163,6 +175,22 @@ mod tests {
         assert!(
             with.ends_with("in 0.0104 s (0.0962 M point-samples/s); writing dumps: 2.50 MB in 3 files in 0.500 s (5.00 MB/s)"),
             "{with}"
+        );
+    }
+
+    /// A time of zero gives no rate: a floor under it once printed 1e9 times the count.
+    #[test]
+    fn a_time_of_zero_gives_no_rate() {
+        let dumps = Written {
+            files: 2,
+            bytes: 1_000_000,
+            seconds: 0.0,
+        };
+        let line = counted_line("run", 5_000_000, 0.0, dumps);
+        assert_eq!(
+            line,
+            "run: 5000000 point-samples in 0 s (M point-samples/s: no time measured); \
+             writing dumps: 1.00 MB in 2 files in 0 s (MB/s: no time measured)"
         );
     }
 }
