@@ -100,7 +100,7 @@ pub(crate) fn table_nco(p: &BoardParams) -> Result<Nco, ParamError> {
 }
 
 /// [`table_nco`] at table frequency `f_hz`.
-fn table_nco_at(f_hz: f64, fs_hz: f64) -> Result<Nco, ParamError> {
+pub(crate) fn table_nco_at(f_hz: f64, fs_hz: f64) -> Result<Nco, ParamError> {
     Nco::new(f_hz, fs_hz, core::f64::consts::PI * f_hz / fs_hz)
 }
 
@@ -427,8 +427,8 @@ impl<S: Sample> Board<S> {
         opts: RunOptions,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<RunOutput, NonFinite> {
-        self.dispatch(n_settle, points, opts, progress)
-            .map_err(|k| self.locate_fault(k))
+        self.dispatch(n_settle, points, opts, &[], progress)
+            .map_err(|k| self.locate_fault(k, &[]))
     }
 
     /// The plant takes its sparse step: at a constant rate the decoupled one (exact zeros

@@ -9,6 +9,7 @@ use crate::fault::NonFinite;
 use crate::lanes::{eight_lanes_available, max_lanes};
 use crate::params::{BoardParams, STAGE};
 use crate::point::{Point, RunOptions, RunOutput};
+use crate::refill::{Refill, RefillError};
 use gyroemu_core::{f64x4, ParamError};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -167,6 +168,17 @@ impl GroupBoard {
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<RunOutput, NonFinite> {
         on_board!(&mut self.0, b => b.run(n_settle, points, opts, progress))
+    }
+
+    /// See [`Board::run_refilled`].
+    pub fn run_refilled(
+        &mut self,
+        n_settle: u64,
+        points: &[Point],
+        refills: &[Refill],
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<RunOutput, RefillError> {
+        on_board!(&mut self.0, b => b.run_refilled(n_settle, points, refills, progress))
     }
 
     /// See [`Board::plant_decoupled`].

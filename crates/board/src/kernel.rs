@@ -10,6 +10,7 @@ use crate::health::{Counters, Health, ADC_CLIP, ADC_ZERO, DAC_CLIP, DAC_ZERO, TI
 use crate::params::Shape;
 use crate::point::{LaneResult, Point, RunOptions, RunOutput};
 use crate::probe::Probe;
+use crate::refill::Prepared;
 use core::mem::MaybeUninit;
 use gyroemu_am::AmInput;
 use gyroemu_core::{Complex64, Sample, Stage};
@@ -31,23 +32,20 @@ impl<S: Sample> Board<S> {
         n_settle: u64,
         points: &[Point],
         opts: RunOptions,
+        refills: &[Prepared],
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<RunOutput, u64> {
         macro_rules! by_plant {
             ($k:expr) => {
                 match (self.imperfect, self.plant_decoupled()) {
-                    (false, false) => {
-                        self.sample_loop::<$k, false, false>(n_settle, points, opts, progress)
-                    }
-                    (false, true) => {
-                        self.sample_loop::<$k, false, true>(n_settle, points, opts, progress)
-                    }
-                    (true, false) => {
-                        self.sample_loop::<$k, true, false>(n_settle, points, opts, progress)
-                    }
-                    (true, true) => {
-                        self.sample_loop::<$k, true, true>(n_settle, points, opts, progress)
-                    }
+                    (false, false) => self
+                        .sample_loop::<$k, false, false>(n_settle, points, opts, refills, progress),
+                    (false, true) => self
+                        .sample_loop::<$k, false, true>(n_settle, points, opts, refills, progress),
+                    (true, false) => self
+                        .sample_loop::<$k, true, false>(n_settle, points, opts, refills, progress),
+                    (true, true) => self
+                        .sample_loop::<$k, true, true>(n_settle, points, opts, refills, progress),
                 }
             };
         }
@@ -96,11 +94,16 @@ impl<S: Sample> Board<S> {
         n_settle: u64,
         points: &[Point],
         opts: RunOptions,
+        refills: &[Prepared],
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<RunOutput, u64> {
         S::with_target_features(
             #[inline(always)]
-            || self.sample_loop_body::<K, NOISY, DECOUPLED>(n_settle, points, opts, progress),
+            || {
+                self.sample_loop_body::<K, NOISY, DECOUPLED>(
+                    n_settle, points, opts, refills, progress,
+                )
+            },
         )
     }
 
@@ -112,11 +115,16 @@ impl<S: Sample> Board<S> {
         n_settle: u64,
         points: &[Point],
         mut opts: RunOptions,
+        refills: &[Prepared],
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<RunOutput, u64> {
         let lanes = self.lanes;
         let m = self.decimation as u64;
-        let n_out = n_settle + points.iter().map(|p| p.window.samples()).max().unwrap_or(1);
+        let refilled_end = refills
+            .iter()
+            .map(|p| p.r.at_block + n_settle + p.r.point.window.samples());
+        let n_out = (n_settle + points.iter().map(|p| p.window.samples()).max().unwrap_or(1))
+            .max(refilled_end.max().unwrap_or(0));
         let windows: Vec<_> = points.iter().take(lanes).map(|p| p.window).collect();
         let channels = if K == ROTATING { 8 } else { 4 };
         let mut avg = Averager::<S, 8>::new(&windows, channels)
@@ -137,7 +145,7 @@ impl<S: Sample> Board<S> {
         let mut series: Vec<Vec<[f64; 8]>> = vec![Vec::new(); lanes];
         let mut series_acc = [S::splat(0.0); 8];
         // Each lane counts its own run only, so its counts do not depend on its group.
-        let lane_end: Vec<u64> = points
+        let mut lane_end: Vec<u64> = points
             .iter()
             .take(lanes)
             .map(|p| n_settle + p.window.samples())
@@ -149,15 +157,19 @@ impl<S: Sample> Board<S> {
                 ..Default::default()
             })
             .collect();
+        // Each lane's points before its last, when refilled (noiseless: only the samples
+        // counted); the next refill.
+        let mut refilled: Vec<Vec<LaneResult>> = vec![Vec::new(); lanes];
+        let mut next_refill = 0;
         let mut counts = Counters::<S>::default();
         // Each lane's totals, and 1 in the lanes still counting (until the next lane's end).
         let mut totals = Counters::<S>::default();
-        let counting = |k: u64| {
+        let counting = |k: u64, lane_end: &[u64]| {
             let active = S::from_fn(|i| f64::from(u8::from(i < lanes && k < lane_end[i])));
             let until = lane_end.iter().copied().filter(|&e| e > k).min();
             (active, until.unwrap_or(u64::MAX))
         };
-        let (mut active, mut recount_at) = counting(0);
+        let (mut active, mut recount_at) = counting(0, &lane_end);
         // The decimated sample a cancel stopped the run at (its block not averaged).
         let mut stopped_at = None;
         // The block after which the probe is handed on, if it is asked for.
@@ -168,6 +180,25 @@ impl<S: Sample> Board<S> {
         .unwrap_or(u64::MAX);
         for k in 0..n_out {
             let n0 = k * m;
+            // Lanes whose points have ended take their next ones here (checked: at exact
+            // re-sets, after their points' ends).
+            while let Some(p) = refills.get(next_refill).filter(|p| p.r.at_block == k) {
+                let (i, w) = (p.r.lane, p.r.point.window);
+                refilled[i].push(LaneResult {
+                    health: health[i],
+                    ..lane_result::<K>(&avg.mean(i), &table_avg.mean(i), self.table_mix.harmonics())
+                });
+                self.refill_lane(p, n0);
+                for restart in [avg.restart_lane(i, w, k), table_avg.restart_lane(i, w, k)] {
+                    restart.expect("a refill starts its window after every sample pushed");
+                }
+                lane_end[i] = k + n_settle + w.samples();
+                health[i] = Health {
+                    samples: (n_settle + w.samples()) * m,
+                    ..Default::default()
+                };
+                next_refill += 1;
+            }
             // The recording path only for blocks that touch the dump window.
             let (z, r) = match opts.probe.as_deref_mut() {
                 Some(p) if p.wants_block(n0, m) => {
@@ -180,7 +211,7 @@ impl<S: Sample> Board<S> {
                     p.count_block(n0, m, k, &counts);
                 }
                 if k >= recount_at {
-                    (active, recount_at) = counting(k);
+                    (active, recount_at) = counting(k, &lane_end);
                 }
                 totals.add_where(&counts, active);
                 counts = Counters::default();
@@ -293,6 +324,7 @@ impl<S: Sample> Board<S> {
             early_reads: early,
             series,
             complete,
+            refilled,
         })
     }
 
@@ -558,8 +590,14 @@ impl<S: Sample> Board<S> {
         S::with_target_features(
             #[inline(always)]
             || {
-                let at =
-                    |i: usize| table_reference(n + self.starts[i], self.table_f_hz[i], self.fs_hz);
+                // Wrapping: a refilled lane's start is its point's less where the run took it.
+                let at = |i: usize| {
+                    table_reference(
+                        n.wrapping_add(self.starts[i]),
+                        self.table_f_hz[i],
+                        self.fs_hz,
+                    )
+                };
                 if self.table_shared {
                     let b = at(0);
                     return (S::splat(b.re), S::splat(b.im));
@@ -576,40 +614,49 @@ impl<S: Sample> Board<S> {
         )
     }
 
-    /// Replays the run from the board as built, checking every stage's output on every
-    /// sample up to block `k_bad` (where the decimated output stopped being finite), and
-    /// names the first stage and sample that went non-finite.
+    /// Replays the run (with its `refills`) from the board as built, checking every stage's
+    /// output on every sample up to block `k_bad` (where the decimated output stopped being
+    /// finite), and names the first stage and sample that went non-finite.
     #[cold]
-    pub(crate) fn locate_fault(&self, k_bad: u64) -> NonFinite {
+    pub(crate) fn locate_fault(&self, k_bad: u64, refills: &[Prepared]) -> NonFinite {
         let m = self.decimation as u64;
-        // On the run's time axis: a lane that started late counts from where it started.
-        let at = |stage: &'static str, local: u64, lane: usize| {
-            let sample = self.starts[lane] + local;
-            NonFinite {
-                stage,
-                sample,
-                time_s: sample as f64 / self.fs_hz,
-                rate_dps: self.rate.lane(lane).to_degrees(),
-            }
-        };
-        let fallback = at("lowpass", k_bad * m + m - 1, 0);
+        let fallback = self.fault_at("lowpass", k_bad * m + m - 1, 0);
         let Some(pristine) = &self.pristine else {
             return fallback;
         };
         let mut board = (**pristine).clone();
+        // The loop the run took.
+        board.table_shared = self.table_shared;
         let mut probe = Probe::finite_check(self.lanes);
+        let mut next = 0;
         S::with_target_features(
             #[inline(always)]
             || {
                 for k in 0..=k_bad {
+                    while let Some(p) = refills.get(next).filter(|p| p.r.at_block == k) {
+                        board.refill_lane(p, k * m);
+                        next += 1;
+                    }
                     board.replay_block(k * m, &mut probe);
                     if let Some((stage, sample, lane)) = probe.fault() {
-                        return at(stage, sample, lane);
+                        return board.fault_at(stage, sample, lane);
                     }
                 }
                 fallback
             },
         )
+    }
+
+    /// A fault of `stage` at input sample `n` of the run in `lane`, on the time axis of the
+    /// lane's point (a lane that started late, or was refilled, counts from its point's start).
+    fn fault_at(&self, stage: &'static str, n: u64, lane: usize) -> NonFinite {
+        let sample = self.starts[lane].wrapping_add(n);
+        NonFinite {
+            stage,
+            sample,
+            time_s: sample as f64 / self.fs_hz,
+            rate_dps: self.rate.lane(lane).to_degrees(),
+        }
     }
 }
 

@@ -24,6 +24,7 @@ mod params;
 mod point;
 mod probe;
 pub mod reference;
+mod refill;
 mod seeding;
 
 pub use board::{drive_shifter, starts_share_carrier, Board, MAX_START};
@@ -41,3 +42,4 @@ pub use lock::{lock_carrier, LockRun};
 pub use params::{BoardParams, Converter, NoiseParams, Shape};
 pub use point::{LaneResult, Point, RunOptions, RunOutput};
 pub use probe::{Probe, DUMP_NODES, EVENTS_COUNTED_KEY, EVENT_KEYS};
+pub use refill::{Refill, RefillError};

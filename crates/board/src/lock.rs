@@ -71,7 +71,7 @@ impl Board<f64> {
             };
         }
         by_plant!(false, false; false, true; true, false; true, true)
-            .map_err(|k| self.locate_fault(k))
+            .map_err(|k| self.locate_fault(k, &[]))
     }
 
     fn lock_loop<const NOISY: bool, const DECOUPLED: bool>(

@@ -77,4 +77,7 @@ pub struct RunOutput {
     /// stopped it), so its entry of `lanes` is the point's final result; the other lanes'
     /// entries are meaningless.
     pub complete: Vec<bool>,
+    /// Per lane: the results of the points it ran before its last, in order, when the run
+    /// refilled it ([`crate::Board::run_refilled`]); `lanes` holds its last point's.
+    pub refilled: Vec<Vec<LaneResult>>,
 }

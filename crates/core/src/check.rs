@@ -10,6 +10,9 @@
 //!   of a fresh clone.
 //! * [`lanes_match`]: every lane of an `f64x4` stage gives the bits of the `f64` stage fed that
 //!   lane's input.
+//! * [`lane_replaced_matches`]: a lane reset or replaced mid-run (a board's lane refilled with
+//!   another operating point) gives the bits of a fresh `f64` stage from there, and the other
+//!   lanes keep theirs.
 //! * [`response_matches_impulse`]: the DFT of the (decayed) impulse response equals
 //!   [`Response::response`](crate::Response::response) at the DFT bins, magnitude and phase.
 //! * [`latency_matches`] and [`latency_matches_response`]:
@@ -39,7 +42,7 @@ pub use gen::Gen;
 pub use impulse::{
     latency_matches, latency_matches_response, response_matches_impulse, FnResponse,
 };
-pub use lanes::lanes_match;
+pub use lanes::{lane_replaced_matches, lanes_match};
 pub use process::{tick_vs_process, BLOCK_SIZES};
 pub use reset::reset_restores;
 

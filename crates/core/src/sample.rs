@@ -69,6 +69,11 @@ pub trait Sample:
     fn with_target_features<R>(f: impl FnOnce() -> R) -> R {
         f()
     }
+    /// `self` with lane `i` replaced by `v` (the others keep their bits): a lane refilled
+    /// with another operating point between blocks, never in a per-sample path.
+    fn with_lane(self, i: usize, v: f64) -> Self {
+        Self::from_fn(|l| if l == i { v } else { self.lane(l) })
+    }
 }
 
 impl Sample for f64 {

@@ -125,6 +125,9 @@ pub struct Averager<S, const C: usize> {
     lanes: usize,
     channels: usize,
     j: u64,
+    /// Each lane's first sample: its window's sample 0 is pushed sample `from[i]` (0 but in a
+    /// lane restarted by [`Averager::restart_lane`]).
+    from: [u64; MAX_LANES],
     acc: [KahanSum<S>; C],
     wsum: [f64; MAX_LANES],
 }
@@ -157,9 +160,44 @@ impl<S: Sample, const C: usize> Averager<S, C> {
             lanes: windows.len(),
             channels,
             j: 0,
+            from: [0; MAX_LANES],
             acc: core::array::from_fn(|_| KahanSum::default()),
             wsum: [0.0; MAX_LANES],
         })
+    }
+
+    /// Lane `lane` starts over with `window`, its sample 0 the sample pushed at index
+    /// `from` (at or after the next one, [`Averager::count`]): its sums go back to zero, and
+    /// until `from` it weighs every sample 0. Adding a zero leaves a compensated sum's value
+    /// as it is, so the lane then holds the bits of a fresh averager fed from `from` on (a
+    /// lane of the board refilled with another operating point). The other lanes keep their
+    /// bits. Refused (changing nothing) for a lane past the averager's, an invalid window or a
+    /// `from` already pushed.
+    pub fn restart_lane(&mut self, lane: usize, window: Window, from: u64) -> ParamResult<()> {
+        if lane >= self.lanes {
+            return Err(ParamError::new(
+                STAGE,
+                "lane",
+                lane,
+                format!("must be below the averager's lanes ({})", self.lanes),
+            ));
+        }
+        if from < self.j {
+            return Err(ParamError::new(
+                STAGE,
+                "from",
+                from,
+                format!("must not precede the next sample ({})", self.j),
+            ));
+        }
+        window.check()?;
+        self.windows[lane] = window;
+        self.from[lane] = from;
+        for acc in &mut self.acc {
+            acc.reset_lane(lane);
+        }
+        self.wsum[lane] = 0.0;
+        Ok(())
     }
 
     /// Samples pushed so far (the index `j` of the next one).
@@ -170,8 +208,11 @@ impl<S: Sample, const C: usize> Averager<S, C> {
     /// Adds the next sample of every channel with each lane's weight.
     #[inline(always)]
     pub fn push(&mut self, x: &[S; C]) {
-        let (j, w) = (self.j, &self.windows);
-        let weight = S::from_fn(|i| w[i].weight(j));
+        let (j, w, from) = (self.j, &self.windows, &self.from);
+        let weight = S::from_fn(|i| match j.checked_sub(from[i]) {
+            Some(local) => w[i].weight(local),
+            None => 0.0,
+        });
         for i in 0..self.lanes {
             self.wsum[i] += weight.lane(i);
         }
@@ -197,9 +238,10 @@ impl<S: Sample, const C: usize> Averager<S, C> {
         })
     }
 
-    /// Forgets every sample (the windows stay).
+    /// Forgets every sample (the windows stay; every lane starts at sample 0 again).
     pub fn reset(&mut self) {
         self.j = 0;
+        self.from = [0; MAX_LANES];
         self.acc = core::array::from_fn(|_| KahanSum::default());
         self.wsum = [0.0; MAX_LANES];
     }

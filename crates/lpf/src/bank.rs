@@ -33,6 +33,16 @@ impl<S: Sample, const C: usize> LowPassBank<S, C> {
     pub fn design(&self) -> &LowPass<S> {
         &self.proto
     }
+
+    /// Lane `lane` of every channel back to rest, as [`Stage::reset`] leaves every lane; the
+    /// other lanes keep their bits (a lane refilled with another operating point).
+    pub fn reset_lane(&mut self, lane: usize) {
+        for s in self.state.s1.iter_mut().chain(self.state.s2.iter_mut()) {
+            for v in s.iter_mut() {
+                *v = v.with_lane(lane, 0.0);
+            }
+        }
+    }
 }
 
 impl<S: Sample, const C: usize> Stage for LowPassBank<S, C> {

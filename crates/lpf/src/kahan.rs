@@ -46,6 +46,12 @@ impl<S: Sample> KahanSum<S> {
     pub fn reset(&mut self) {
         *self = Self::default();
     }
+
+    /// Lane `lane` back to zero, the other lanes untouched.
+    pub fn reset_lane(&mut self, lane: usize) {
+        self.sum = self.sum.with_lane(lane, 0.0);
+        self.comp = self.comp.with_lane(lane, 0.0);
+    }
 }
 
 #[cfg(test)]

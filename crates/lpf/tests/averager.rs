@@ -296,3 +296,59 @@ fn window_response_is_the_direct_sum_of_its_weights() {
         );
     }
 }
+
+/// A lane restarted mid-run (a board's lane refilled with another point) holds the bits of a
+/// fresh averager fed that lane from its new start on; the other lanes keep theirs.
+#[test]
+fn a_restarted_lane_averages_as_a_fresh_averager_from_its_start() {
+    let mut g = gyroemu_core::check::Gen::new(41);
+    let first = [
+        Window::Boxcar { n: 300, frac: 0.25 },
+        Window::Hann { n: 280 },
+        Window::Boxcar { n: 120, frac: 0.0 },
+        Window::Boxcar { n: 90, frac: 0.5 },
+    ];
+    let xs: Vec<[f64x4; 2]> = (0..700)
+        .map(|_| [g.sample(-3.0, 3.0), g.sample(-1.0, 5.0)])
+        .collect();
+    for (next, from) in [
+        (Window::Boxcar { n: 200, frac: 0.75 }, 140),
+        (Window::Hann { n: 333 }, 133),
+    ] {
+        let mut plain = Averager::<f64x4, 2>::new(&first, 2).unwrap();
+        let mut v = plain.clone();
+        let mut fresh = Averager::<f64, 2>::new(&[next], 2).unwrap();
+        for (j, x) in xs.iter().enumerate() {
+            // Restarted once its first window has ended, some samples ahead of its start.
+            if j == 125 {
+                v.restart_lane(2, next, from).unwrap();
+            }
+            plain.push(x);
+            v.push(x);
+            if j as u64 >= from {
+                fresh.push(&x.map(|c| c.lane(2)));
+            }
+        }
+        let bits = |m: [f64; 2]| m.map(f64::to_bits);
+        assert_eq!(bits(v.mean(2)), bits(fresh.mean(0)), "{next:?}");
+        for l in [0, 1, 3] {
+            assert_eq!(bits(v.mean(l)), bits(plain.mean(l)), "lane {l}");
+        }
+    }
+}
+
+#[test]
+fn a_restart_is_refused_for_a_lane_it_lacks_a_past_start_or_a_bad_window() {
+    let w = Window::Boxcar { n: 10, frac: 0.0 };
+    let mut a = Averager::<f64x4, 1>::new(&[w, w], 1).unwrap();
+    for _ in 0..5 {
+        a.push(&[f64x4::splat(1.0)]);
+    }
+    assert_eq!(a.restart_lane(2, w, 5).unwrap_err().param, "lane");
+    assert_eq!(a.restart_lane(0, w, 4).unwrap_err().param, "from");
+    let bad = Window::Boxcar { n: 10, frac: 1.0 };
+    assert_eq!(a.restart_lane(0, bad, 5).unwrap_err().param, "window.frac");
+    // Refused: nothing changed.
+    assert_eq!(a.mean(0)[0], 1.0);
+    assert!(a.restart_lane(1, w, 5).is_ok());
+}

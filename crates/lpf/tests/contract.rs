@@ -46,6 +46,27 @@ fn lowpass_blocks_reset_and_lanes_are_bit_exact() {
 }
 
 #[test]
+fn a_lane_of_the_bank_reset_mid_run_starts_as_a_fresh_bank() {
+    // Every channel of the lane back to rest (a board's lane refilled with another point);
+    // the other lanes keep their bits.
+    let fs = 1000.0;
+    for d in designs(0.05, fs) {
+        let lp = LowPass::new(d, fs).unwrap();
+        check::lane_replaced_matches(
+            &format!("lpf bank {d:?}"),
+            &LowPassBank::<f64x4, 4>::new(&LowPass::new(d, fs).unwrap()),
+            (1, 4, 777),
+            LowPassBank::reset_lane,
+            &LowPassBank::<f64, 4>::new(&lp),
+            |g| core::array::from_fn(|_| noise::<f64x4>(g)),
+            |x: &[f64x4; 4], l| x.map(|c| c.lane(l)),
+            |y: &[f64x4; 4], l| y.map(|c| c.lane(l)),
+            check::same,
+        );
+    }
+}
+
+#[test]
 fn lowpass_response_and_latency_match_the_impulse_response() {
     // 8192 samples: the slowest of these decays below 1e-12 well within; the harness checks.
     let fs = 1000.0;

@@ -85,9 +85,62 @@ impl<S: Sample> RotatingNco<S> {
         Ok(())
     }
 
+    /// The oscillator stands at an exact re-set: every lane's phasor is computed afresh from
+    /// its phase word at the next tick (after a multiple of [`RESYNC`] ticks since it was
+    /// built or reset).
+    pub fn at_resync(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Lane `lane` takes over `nco` (its phase word and step) at an exact re-set
+    /// ([`RotatingNco::at_resync`]): from the next tick the lane gives the bits of a
+    /// `RotatingNco` built from `nco` alone, whose re-sets fall on the same ticks. The other
+    /// lanes are not touched. Refused (changing nothing) off a re-set, for a lane past
+    /// `S::LANES`, or for an `nco` of another sample rate.
+    pub fn set_lane_at_resync(&mut self, lane: usize, nco: &Nco) -> ParamResult<()> {
+        let bad = |param: &'static str, v: String, rule: &str| {
+            Err(ParamError::new("rotating_nco", param, v, rule.to_string()))
+        };
+        if lane >= S::LANES {
+            return bad(
+                "lane",
+                lane.to_string(),
+                "must be below the number of lanes",
+            );
+        }
+        if !self.at_resync() {
+            return bad(
+                "count",
+                self.count.to_string(),
+                "a lane is replaced only at an exact re-set (ticks to it: 0)",
+            );
+        }
+        if nco.fs_hz() != self.fs_hz[lane] {
+            return bad(
+                "fs_hz",
+                nco.fs_hz().to_string(),
+                "must be the lane's sample rate",
+            );
+        }
+        let (word, step) = (nco.phase_word(), nco.step_word());
+        // The next re-set computes the phasor from `phase`; the rotation is the step's, as
+        // `new` computes it.
+        self.phase[lane] = word;
+        self.step[lane] = step;
+        let r = phasor_of_word(step);
+        self.rot_re = self.rot_re.with_lane(lane, r.re);
+        self.rot_im = self.rot_im.with_lane(lane, r.im);
+        Ok(())
+    }
+
     /// Lane `lane`'s realised (step-quantised) frequency, signed, in Hz (`lane < S::LANES`).
     pub fn f_hz(&self, lane: usize) -> f64 {
         (self.step[lane] as i64) as f64 * (self.fs_hz[lane] / 18_446_744_073_709_551_616.0)
+    }
+
+    /// Lane `lane`'s phase step per sample, 2^-64 turn (`lane < S::LANES`).
+    pub fn step_word(&self, lane: usize) -> u64 {
+        self.step[lane]
     }
 
     /// Lane `lane`'s exact phase word (2^-64 turn) of the sample the next tick outputs.

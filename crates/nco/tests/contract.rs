@@ -58,6 +58,57 @@ fn rotating_nco_blocks_reset_and_lanes_are_bit_exact() {
 }
 
 #[test]
+fn a_lane_replaced_at_a_re_set_runs_as_a_fresh_oscillator() {
+    // Another frequency from another phase (a board's lane refilled with another point,
+    // started some samples into its own time axis): from the re-set on, the lane gives the
+    // bits of an oscillator built from that NCO alone, whose re-sets fall on the same ticks.
+    let mut next = Nco::new(-0.731, FS_HZ, 0.0).unwrap();
+    next.jump(123_456);
+    for at in [64, 64 * 17] {
+        check::lane_replaced_matches(
+            "rotating_nco",
+            &RotatingNco::<f64x4>::new(&ncos()),
+            (1, 4, at),
+            |v: &mut RotatingNco<f64x4>, l| v.set_lane_at_resync(l, &next).unwrap(),
+            &RotatingNco::<f64>::new(&[next.clone()]),
+            none,
+            |_, _| (),
+            |&(c, s), l| (c.lane(l), s.lane(l)),
+            check::same,
+        );
+    }
+}
+
+#[test]
+fn a_lane_is_replaced_only_at_a_re_set() {
+    let mut v = RotatingNco::<f64x4>::new(&ncos());
+    let other = Nco::new(100.0, FS_HZ, 0.0).unwrap();
+    // Built: the re-set of sample 0 is done, the next is 64 ticks away.
+    for ticks in [0, 1, 63] {
+        let mut w = v.clone();
+        for _ in 0..ticks {
+            w.tick(());
+        }
+        let before = w.clone();
+        let e = w.set_lane_at_resync(0, &other).unwrap_err();
+        assert_eq!(e.param, "count", "{e}");
+        // Refused: nothing changed (the next ticks are the untouched copy's).
+        let mut b = before;
+        for _ in 0..200 {
+            assert_eq!(w.tick(()), b.tick(()));
+        }
+    }
+    for _ in 0..64 {
+        v.tick(());
+    }
+    assert!(v.at_resync());
+    assert_eq!(v.set_lane_at_resync(4, &other).unwrap_err().param, "lane");
+    let slow = Nco::new(100.0, 48_000.0, 0.0).unwrap();
+    assert_eq!(v.set_lane_at_resync(0, &slow).unwrap_err().param, "fs_hz");
+    assert!(v.set_lane_at_resync(0, &other).is_ok());
+}
+
+#[test]
 fn phase_shifter_is_memoryless_and_bit_exact() {
     for shifter in [
         PhaseShifter::quadrature(),

@@ -62,6 +62,15 @@ impl<S: Sample> Resonator<S> {
         })
     }
 
+    /// Lane `lane`'s state back to rest, as [`Stage::reset`] leaves every lane; its
+    /// coefficients and the other lanes keep their bits (a lane refilled with another
+    /// operating point at the same plant rate).
+    pub fn reset_lane(&mut self, lane: usize) {
+        for x in &mut self.x {
+            *x = x.with_lane(lane, 0.0);
+        }
+    }
+
     /// Packs scalar plants into lanes: lane `i` takes coefficients and state of `lanes[i]`
     /// (lanes past the end of the slice repeat its last plant). Panics on an empty slice.
     pub fn from_lanes(lanes: &[Resonator<f64>]) -> Self {

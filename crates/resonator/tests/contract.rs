@@ -71,6 +71,25 @@ fn lanes_of_four_different_plants_are_bit_exact() {
 }
 
 #[test]
+fn a_lane_reset_mid_run_starts_as_a_fresh_plant() {
+    // The state of one lane back to rest, its coefficients kept (a board's lane refilled
+    // with another point at the same plant rate); the other lanes keep their bits.
+    let scalars: Vec<Resonator<f64>> = (0..4).map(plant).collect();
+    let lane = |v: [f64x4; 2], l: usize| v.map(|x| x.lane(l));
+    check::lane_replaced_matches(
+        "resonator",
+        &Resonator::<f64x4>::from_lanes(&scalars),
+        (3, 4, 901),
+        Resonator::reset_lane,
+        &scalars[3],
+        force,
+        |x, l| lane(*x, l),
+        |y, l| (lane(y.q, l), lane(y.v, l), lane(y.current, l)),
+        view,
+    );
+}
+
+#[test]
 fn lanes_past_the_slice_repeat_its_last_plant() {
     // A group with fewer points than lanes: the spare lanes run the last point's plant.
     let lane = |v: [f64x4; 2], l: usize| v.map(|x| x.lane(l));

@@ -168,6 +168,12 @@ impl Tia<f64> {
 }
 
 impl<S: Sample> Tia<S> {
+    /// Lane `lane` back to rest, as [`Stage::reset`] leaves every lane; the other lanes keep
+    /// their bits (a lane refilled with another operating point).
+    pub fn reset_lane(&mut self, lane: usize) {
+        self.y = self.y.with_lane(lane, 0.0);
+    }
+
     /// The TIA has output rails (else its rail count stays 0, and a loop can skip it).
     #[inline(always)]
     pub fn has_rails(&self) -> bool {

@@ -44,6 +44,18 @@ fn blocks_reset_and_lanes_are_bit_exact() {
             |y, l| y.lane(l),
             check::same,
         );
+        // A lane reset mid-run (refilled with another point) starts as a fresh TIA.
+        check::lane_replaced_matches(
+            "tia",
+            &v,
+            (2, 4, 1234),
+            Tia::reset_lane,
+            &Tia::<f64>::new(&p).unwrap(),
+            |g| g.sample(-2e-5, 2e-5),
+            |x, l| x.lane(l),
+            |y, l| y.lane(l),
+            check::same,
+        );
     }
 }
 

@@ -46,3 +46,56 @@ pub fn lanes_match<V, L, W>(
         }
     }
 }
+
+/// Checks a lane replaced mid-run (a board's lane refilled with another operating point):
+/// `vector` fed [`RUN`] inputs, with `replace` applied to lane `lane` after the first `at`,
+/// gives in that lane, from then on, the bits the scalar stage `fresh` gives when fed the
+/// lane's inputs from there; and in every other lane of the first `lanes`, at every sample,
+/// the bits of `vector` run without the replacement. `input`, `lane_input`, `lane_output`
+/// and `scalar_output` as in [`lanes_match`]. Panics on the first difference.
+#[allow(clippy::too_many_arguments)] // the harness's closures, as in `lanes_match`
+pub fn lane_replaced_matches<V, L, W>(
+    name: &str,
+    vector: &V,
+    (lane, lanes, at): (usize, usize, usize),
+    replace: impl Fn(&mut V, usize),
+    fresh: &L,
+    mut input: impl FnMut(&mut Gen) -> V::Input,
+    lane_input: impl Fn(&V::Input, usize) -> L::Input,
+    lane_output: impl Fn(&V::Output, usize) -> W,
+    scalar_output: impl Fn(&L::Output) -> W,
+) where
+    V: Stage + Clone,
+    L: Stage + Clone,
+    W: Bits + Debug,
+{
+    let mut gen = Gen::new(SEED ^ 3);
+    let (mut plain, mut v, mut s) = (vector.clone(), vector.clone(), fresh.clone());
+    for n in 0..RUN {
+        if n == at {
+            replace(&mut v, lane);
+        }
+        let x = input(&mut gen);
+        let (y, y_plain) = (v.tick(x), plain.tick(x));
+        for l in 0..lanes {
+            let got = lane_output(&y, l);
+            let (want, what) = if l == lane && n >= at {
+                (
+                    scalar_output(&s.tick(lane_input(&x, l))),
+                    "the fresh scalar stage",
+                )
+            } else {
+                (
+                    lane_output(&y_plain, l),
+                    "the stage without the replacement",
+                )
+            };
+            if got.words() != want.words() {
+                panic!(
+                    "{name}: lane_replaced_matches: lane {l} sample {n} (lane {lane} replaced \
+                     at {at}): {what} gave {want:?}, the replaced stage gave {got:?}"
+                );
+            }
+        }
+    }
+}
