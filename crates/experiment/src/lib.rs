@@ -13,6 +13,7 @@ pub mod prepared;
 pub mod progress;
 pub mod queue;
 pub mod readout;
+pub mod refill_plan;
 pub mod split;
 pub mod sweep;
 pub mod table_sweep;

@@ -339,17 +339,8 @@ pub fn cut_to_fill(
     segment: &dyn Fn(u64) -> (u64, Packing),
 ) -> Option<Vec<u64>> {
     let whole: Vec<u64> = windows.iter().map(|w| w.0.max(1)).collect();
-    // Every common length a point's even cut gives, before and after `segment` rounds it.
-    let mut targets: Vec<u64> = windows
-        .iter()
-        .flat_map(|w| (1..=MAX_SEGMENTS).map(move |c| w.0.div_ceil(c)))
-        .flat_map(|t| [t, segment(t).0])
-        .filter(|&t| t > 0)
-        .collect();
-    targets.sort_unstable();
-    targets.dedup();
     let mut best: Option<(u64, usize, Vec<u64>)> = None;
-    for &t in &targets {
+    for t in cut_targets(windows, segment) {
         let Some(lens) = even_cut(windows, t, segment) else {
             continue;
         };
@@ -368,9 +359,27 @@ pub fn cut_to_fill(
     (lens != whole && pays_off(windows, n_settle, &whole, &lens)).then_some(lens)
 }
 
+/// Every common length a point's even cut gives (each point in 1 to [`MAX_SEGMENTS`]
+/// segments), before and after `segment` rounds it, ascending: the lengths a cut of
+/// [`even_cut`] is weighed at.
+pub(crate) fn cut_targets(
+    windows: &[(u64, f64)],
+    segment: &dyn Fn(u64) -> (u64, Packing),
+) -> Vec<u64> {
+    let mut targets: Vec<u64> = windows
+        .iter()
+        .flat_map(|w| (1..=MAX_SEGMENTS).map(move |c| w.0.div_ceil(c)))
+        .flat_map(|t| [t, segment(t).0])
+        .filter(|&t| t > 0)
+        .collect();
+    targets.sort_unstable();
+    targets.dedup();
+    targets
+}
+
 /// Per point, the length of its fewest even segments within `t` decimated samples (rounded
 /// up by `segment`), if every point's segments may share any group and stay within `t`.
-fn even_cut(
+pub(crate) fn even_cut(
     windows: &[(u64, f64)],
     t: u64,
     segment: &dyn Fn(u64) -> (u64, Packing),

@@ -2,14 +2,22 @@
 //! bandwidth sweep: one point per frequency), run in shared lane groups, each lane on its own
 //! table. Run one by one, each would be a group of one point; packed, nine frequencies take
 //! two groups. Every point keeps the bits of its own sweep; asked to split
-//! ([`PreparedTables::new`]), long points run as segments side by side (`split::cut_to_fill`),
-//! each settling anew, within what that settling leaves of a whole run's average.
+//! ([`PreparedTables::new`]), long points run as segments side by side, each settling anew,
+//! within what that settling leaves of a whole run's average, and lanes whose points have
+//! ended take the next (`refill_plan`, `Board::run_refilled`: the same bits as alone), so the
+//! nine frequencies run in one group of eight.
 
 use crate::mutex::lock;
 use crate::readout::SweepResult;
-use crate::split::{combine, cut_each, cut_to_fill, segment_length_on, splittable};
-use crate::sweep::{finish_sweep, group_samples, SweepError};
-use gyroemu_board::{group_sizes, BoardParams, GroupBoard, LaneResult, RunOptions, Shape};
+use crate::refill_plan::{cut_to_refill, pack_refilled, refill_grain, RefilledGroup};
+use crate::split::{
+    combine, cut_each, cut_to_fill, lane_samples_in, segment_length_on, splittable, MIN_IDLE_SAVING,
+};
+use crate::sweep::{finish_sweep, SweepError};
+use gyroemu_board::{
+    group_sizes, max_lanes_for, BoardParams, GroupBoard, LaneResult, Refill, RefillError,
+    RunOptions, Shape,
+};
 use gyroemu_config::Config;
 use gyroemu_mixer::MAX_TABLE_HARMONIC;
 use rayon::prelude::*;
@@ -22,6 +30,39 @@ type Finished = (usize, usize, u64, gyroemu_lpf::Window, LaneResult);
 
 /// A group's finished lanes, or why it failed.
 type GroupOutcome = Result<Vec<Finished>, SweepError>;
+
+/// A point (or segment) as a lane of a planned group runs it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PlannedPoint {
+    /// Its sweep (index in the configs) and its index in that sweep's rates.
+    pub sweep: usize,
+    pub index: usize,
+    /// Where the segment starts on the point's averaging axis, decimated samples (0 whole).
+    pub start_block: u64,
+    /// Its window's decimated samples.
+    pub window_samples: u64,
+    /// The block its lane starts it at (0 but for a refilled lane's later points).
+    pub at_block: u64,
+}
+
+/// One lane group: its board (until its run takes it), per lane its points in order with the
+/// block each starts at (one at 0 but in refilled lanes, `refill_plan`), and the settling.
+struct Group {
+    board: Mutex<Option<GroupBoard>>,
+    lanes: Vec<Vec<(Job, u64)>>,
+    n_settle: u64,
+}
+
+impl Group {
+    /// The input samples the group runs: to its longest lane's end.
+    fn samples(&self, m: u64) -> u64 {
+        let end = |l: &Vec<(Job, u64)>| {
+            l.last()
+                .map_or(0, |(j, at)| at + self.n_settle + j.point.window.samples())
+        };
+        self.lanes.iter().map(end).max().unwrap_or(0) * m
+    }
+}
 
 /// One point of one of the sweeps.
 #[derive(Clone)]
@@ -79,20 +120,22 @@ fn run_table_lanes(
 /// to run in any order on any threads ([`crate::queue`]).
 pub struct PreparedTables<'c> {
     cfgs: &'c [Config],
-    /// Each group's board (until its run takes it), its points and its settling.
-    groups: Vec<(Mutex<Option<GroupBoard>>, Vec<Job>, u64)>,
+    groups: Vec<Group>,
     outcomes: Vec<Mutex<Option<GroupOutcome>>>,
     /// The lanes (segments) each point runs as, by (sweep, index).
     segments: BTreeMap<(usize, usize), usize>,
 }
 
-/// The classes of `cfgs` that can share a lane group (the board but for the table, and the
-/// settling), each with its points, cut into segments with `split` ([`split_jobs`]).
-#[allow(clippy::type_complexity)]
-fn plan_classes(
-    cfgs: &[Config],
-    split: bool,
-) -> Result<Vec<((BoardParams, u64), Vec<Job>)>, SweepError> {
+/// A class of configs that can share lane groups (the board but for the table, and the
+/// settling), its points (or their segments), and, where its lanes are refilled, their
+/// packing: groups, lanes, each lane's points (indices into the class's) with their start
+/// blocks.
+type Class = ((BoardParams, u64), Vec<Job>, Option<Vec<RefilledGroup>>);
+
+/// The classes of `cfgs` that can share a lane group, each with its points, cut into segments
+/// with `split` ([`split_jobs`]) and, where that runs fewer lane-samples, packed into
+/// refilled lanes.
+fn plan_classes(cfgs: &[Config], split: bool) -> Result<Vec<Class>, SweepError> {
     let mut classes: Vec<((BoardParams, u64), Vec<Job>)> = Vec::new();
     for (sweep, cfg) in cfgs.iter().enumerate() {
         let p = cfg.board_params();
@@ -123,12 +166,16 @@ fn plan_classes(
             });
         }
     }
-    if split {
-        for ((_, n_settle), jobs) in &mut classes {
-            *jobs = split_jobs(cfgs, jobs, *n_settle);
-        }
-    }
-    Ok(classes)
+    Ok(classes
+        .into_iter()
+        .map(|((key, n_settle), jobs)| {
+            if !split {
+                return ((key, n_settle), jobs, None);
+            }
+            let (jobs, refilled) = split_jobs(cfgs, &jobs, n_settle);
+            ((key, n_settle), jobs, refilled)
+        })
+        .collect())
 }
 
 /// The work of `cfgs`' table sweeps ([`crate::sweep_work`] of each, the points as each would
@@ -141,12 +188,22 @@ pub fn tables_work(cfgs: &[Config], split: bool) -> Result<crate::Work, SweepErr
         .reduce(|a, b| a.plus(b))
         .unwrap_or_default();
     // `longest_s` stays the longest point's signal; its lane may be a segment of it.
+    // A refilled lane runs its points back to back: its end is what a group waits for.
     work.longest_samples = plan_classes(cfgs, split)?
         .iter()
-        .flat_map(|((_, n_settle), jobs)| {
-            jobs.iter().map(move |j| {
-                (n_settle + j.point.window.samples()) * cfgs[j.sweep].decimation() as u64
-            })
+        .flat_map(|((_, n_settle), jobs, refilled)| {
+            let m = cfgs[jobs[0].sweep].decimation() as u64;
+            let alone = jobs
+                .iter()
+                .map(move |j| (n_settle + j.point.window.samples()) * m);
+            let lanes = refilled.iter().flatten().flatten().map(move |l| {
+                l.iter()
+                    .map(|&(j, at)| at + n_settle + jobs[j].point.window.samples())
+                    .max()
+                    .unwrap_or(0)
+                    * m
+            });
+            alone.chain(lanes).collect::<Vec<_>>()
         })
         .max()
         .unwrap_or(0);
@@ -156,8 +213,10 @@ pub fn tables_work(cfgs: &[Config], split: bool) -> Result<crate::Work, SweepErr
 impl<'c> PreparedTables<'c> {
     /// Plans the lane groups of `cfgs` and builds every board (so a bad parameter fails
     /// before any sample is computed). With `split`, the points of configs that can run as
-    /// segments (`split::splittable`, boxcar windows) are cut where that fills lane groups
-    /// (`split::cut_to_fill`); the cut depends on the configs alone.
+    /// segments (`split::splittable`, boxcar windows) are cut where that fills lane groups,
+    /// their lanes refilled where that runs fewer lane-samples ([`split_jobs`]); the cut
+    /// depends on the configs alone, the packing of refilled lanes on the lane width (not on
+    /// `group_threads`: it runs the fewest lane-samples, as `reproduce`'s queue wants).
     pub fn new(
         cfgs: &'c [Config],
         group_threads: Option<usize>,
@@ -165,13 +224,22 @@ impl<'c> PreparedTables<'c> {
     ) -> Result<Self, SweepError> {
         let classes = plan_classes(cfgs, split)?;
         let mut segments: BTreeMap<(usize, usize), usize> = BTreeMap::new();
-        for j in classes.iter().flat_map(|(_, jobs)| jobs) {
+        for j in classes.iter().flat_map(|(_, jobs, _)| jobs) {
             *segments.entry((j.sweep, j.index)).or_default() += 1;
         }
         let threads = group_threads.unwrap_or_else(rayon::current_num_threads);
-        let m_of = |j: &Job| cfgs[j.sweep].decimation() as u64;
         let mut groups = Vec::new();
-        for ((key, n_settle), jobs) in &classes {
+        for ((key, n_settle), jobs, refilled) in &classes {
+            if let Some(plan) = refilled {
+                for lanes in plan {
+                    let lanes: Vec<Vec<(Job, u64)>> = lanes
+                        .iter()
+                        .map(|l| l.iter().map(|&(j, at)| (jobs[j].clone(), at)).collect())
+                        .collect();
+                    groups.push(build_group(cfgs, key, *n_settle, lanes)?);
+                }
+                continue;
+            }
             let mut order: Vec<&Job> = jobs.iter().collect();
             // Longest window first, so a group's lanes end together (as in a sweep).
             order.sort_by_key(|j| core::cmp::Reverse(j.point.window.samples()));
@@ -183,24 +251,8 @@ impl<'c> PreparedTables<'c> {
             for size in group_sizes(key, &runs, threads) {
                 let (g, r) = rest.split_at(size);
                 rest = r;
-                // The board demodulates the most harmonics any of its lanes needs; a lane's
-                // harmonics do not depend on how many others are demodulated beside them.
-                let p = BoardParams {
-                    shape: Shape::RateTable {
-                        freq_hz: g[0].table_hz,
-                    },
-                    table_harmonics: g.iter().map(|j| j.harmonics).max().unwrap_or(1),
-                    ..*key
-                };
-                let rates: Vec<f64> = g.iter().map(|j| j.point.rate_rad_s).collect();
-                let table_hz: Vec<f64> = g.iter().map(|j| j.table_hz).collect();
-                // Each point draws the stream of its index in its own sweep.
-                let streams: Vec<u64> = g.iter().map(|j| j.index as u64).collect();
-                let starts: Vec<u64> = g.iter().map(|j| j.start_block * m_of(j)).collect();
-                let board =
-                    GroupBoard::with_table_hz_starts(&p, &rates, &table_hz, &streams, &starts)?;
-                let jobs = g.iter().map(|&j| j.clone()).collect();
-                groups.push((Mutex::new(Some(board)), jobs, *n_settle));
+                let lanes = g.iter().map(|&j| vec![(j.clone(), 0)]).collect();
+                groups.push(build_group(cfgs, key, *n_settle, lanes)?);
             }
         }
         Ok(Self {
@@ -216,39 +268,87 @@ impl<'c> PreparedTables<'c> {
         self.groups.len()
     }
 
+    /// Group `g`'s lanes: per lane, the points it runs in order.
+    pub fn group_lanes(&self, g: usize) -> Vec<Vec<PlannedPoint>> {
+        self.groups[g]
+            .lanes
+            .iter()
+            .map(|l| {
+                l.iter()
+                    .map(|(j, at)| PlannedPoint {
+                        sweep: j.sweep,
+                        index: j.index,
+                        start_block: j.start_block,
+                        window_samples: j.point.window.samples(),
+                        at_block: *at,
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
     /// The input samples group `g` runs.
     pub fn group_samples(&self, g: usize) -> u64 {
-        let (_, jobs, _) = &self.groups[g];
-        let points: Vec<_> = jobs.iter().map(|j| j.point).collect();
-        group_samples(&self.cfgs[jobs[0].sweep], &points)
+        let group = &self.groups[g];
+        let m = self.cfgs[group.lanes[0][0].0.sweep].decimation() as u64;
+        group.samples(m)
     }
 
     /// Runs group `g` (once) on this thread.
     pub fn run_group(&self, g: usize) {
-        let (board, jobs, n_settle) = &self.groups[g];
-        let Some(mut board) = lock(board).take() else {
+        let group = &self.groups[g];
+        let Some(mut board) = lock(&group.board).take() else {
             return;
         };
-        let points: Vec<_> = jobs.iter().map(|j| j.point).collect();
-        let done = board
-            .run(*n_settle, &points, RunOptions::default(), &|_| {})
-            .map_err(SweepError::from)
-            .map(|out| {
-                jobs.iter()
-                    .zip(out.lanes)
-                    .map(|(j, mut lane)| {
-                        // Harmonics beyond the point's own are zero in its own sweep.
-                        for md in 0..2 {
-                            for (i, h) in lane.table_z[md].iter_mut().enumerate() {
-                                if i.abs_diff(MAX_TABLE_HARMONIC) > j.harmonics {
-                                    *h = Default::default();
-                                }
+        let firsts: Vec<&Job> = group.lanes.iter().map(|l| &l[0].0).collect();
+        let points: Vec<_> = firsts.iter().map(|j| j.point).collect();
+        let m = self.cfgs[firsts[0].sweep].decimation() as u64;
+        let mut refills: Vec<Refill> = group
+            .lanes
+            .iter()
+            .enumerate()
+            .flat_map(|(lane, l)| {
+                l[1..].iter().map(move |(j, at)| Refill {
+                    lane,
+                    at_block: *at,
+                    point: j.point,
+                    start: j.start_block * m,
+                    table_hz: Some(j.table_hz),
+                })
+            })
+            .collect();
+        refills.sort_by_key(|r| (r.at_block, r.lane));
+        let run = if refills.is_empty() {
+            board
+                .run(group.n_settle, &points, RunOptions::default(), &|_| {})
+                .map_err(SweepError::from)
+        } else {
+            board
+                .run_refilled(group.n_settle, &points, &refills, &|_| {})
+                .map_err(|e| match e {
+                    RefillError::Refused(e) => SweepError::from(e),
+                    RefillError::NonFinite(f) => SweepError::from(f),
+                })
+        };
+        let done = run.map(|out| {
+            let mut finished = Vec::new();
+            for (lane, l) in group.lanes.iter().enumerate() {
+                // The lane's points in order: those before its last, then its last.
+                let results = out.refilled.get(lane).into_iter().flatten().copied();
+                for ((j, _), mut res) in l.iter().zip(results.chain([out.lanes[lane]])) {
+                    // Harmonics beyond the point's own are zero in its own sweep.
+                    for md in 0..2 {
+                        for (i, h) in res.table_z[md].iter_mut().enumerate() {
+                            if i.abs_diff(MAX_TABLE_HARMONIC) > j.harmonics {
+                                *h = Default::default();
                             }
                         }
-                        (j.sweep, j.index, j.start_block, j.point.window, lane)
-                    })
-                    .collect()
-            });
+                    }
+                    finished.push((j.sweep, j.index, j.start_block, j.point.window, res));
+                }
+            }
+            finished
+        });
         *lock(&self.outcomes[g]) = Some(done);
     }
 
@@ -318,10 +418,59 @@ impl<'c> PreparedTables<'c> {
     }
 }
 
+/// The board of a group of `lanes` (per lane its points in order, each with its start block)
+/// of the class `key` (the board but for the table) settling `n_settle`: each lane built for
+/// its first point. It demodulates the most harmonics any of its points needs (a point's
+/// harmonics do not depend on how many others are demodulated beside them).
+fn build_group(
+    cfgs: &[Config],
+    key: &BoardParams,
+    n_settle: u64,
+    lanes: Vec<Vec<(Job, u64)>>,
+) -> Result<Group, SweepError> {
+    let firsts: Vec<&Job> = lanes.iter().map(|l| &l[0].0).collect();
+    let m = cfgs[firsts[0].sweep].decimation() as u64;
+    let p = BoardParams {
+        shape: Shape::RateTable {
+            freq_hz: firsts[0].table_hz,
+        },
+        table_harmonics: lanes
+            .iter()
+            .flatten()
+            .map(|(j, _)| j.harmonics)
+            .max()
+            .unwrap_or(1),
+        ..*key
+    };
+    let rates: Vec<f64> = firsts.iter().map(|j| j.point.rate_rad_s).collect();
+    let table_hz: Vec<f64> = firsts.iter().map(|j| j.table_hz).collect();
+    // Each point draws the stream of its index in its own sweep.
+    let streams: Vec<u64> = firsts.iter().map(|j| j.index as u64).collect();
+    let starts: Vec<u64> = firsts.iter().map(|j| j.start_block * m).collect();
+    let board = GroupBoard::with_table_hz_starts(&p, &rates, &table_hz, &streams, &starts)?;
+    Ok(Group {
+        board: Mutex::new(Some(board)),
+        lanes,
+        n_settle,
+    })
+}
+
 /// A class's points (`jobs`, of one board and settling `n_settle`) as the segments of their
-/// cut (`split::cut_to_fill`) when every config they come from can run segments and every
-/// window is a boxcar; else as they are.
-fn split_jobs(cfgs: &[Config], jobs: &[Job], n_settle: u64) -> Vec<Job> {
+/// cut when every config they come from can run segments and every window is a boxcar (else
+/// as they are). Where the carrier allows refills (`refill_plan::refill_grain`), the cut for
+/// refilled lanes (`refill_plan::cut_to_refill`) with its packing into this machine's lane
+/// groups, if it runs at least 1/[`MIN_IDLE_SAVING`] fewer lane-samples in groups of eight
+/// than the cut without refill and no more than 1/`MIN_IDLE_SAVING` more in groups of four
+/// (the same cut on every machine); else the cut that fills groups (`split::cut_to_fill`), if
+/// one pays off. The bandwidth sweep's nine points (settling 12.25 s) run refilled: its 40 s
+/// point in halves, the rest whole, two lanes running two 4 s points back to back, in one
+/// group of eight lanes of 32.5 s (624 296 lane-samples counted in eights, 16 % fewer than
+/// `cut_to_fill`'s 13 lanes in groups of 22.25 and 16.25 s, 739 408).
+fn split_jobs(
+    cfgs: &[Config],
+    jobs: &[Job],
+    n_settle: u64,
+) -> (Vec<Job>, Option<Vec<RefilledGroup>>) {
     let windows: Option<Vec<(u64, f64)>> = jobs
         .iter()
         .map(|j| match j.point.window {
@@ -332,26 +481,52 @@ fn split_jobs(cfgs: &[Config], jobs: &[Job], n_settle: u64) -> Vec<Job> {
         })
         .collect();
     let (Some(windows), Some(first)) = (windows, jobs.first()) else {
-        return jobs.to_vec();
+        return (jobs.to_vec(), None);
     };
     // The carrier, sample rate and decimation are the class's: any of its configs rounds
     // (its board parameters built once: a rate table's take steady-state solves).
     let p = cfgs[first.sweep].board_params();
-    let Some(lens) = cut_to_fill(&windows, n_settle, &|len| segment_length_on(&p, len)) else {
-        return jobs.to_vec();
-    };
+    let segment = |len| segment_length_on(&p, len);
     let todo: Vec<usize> = (0..jobs.len()).collect();
-    cut_each(&todo, &windows, &lens)
-        .into_iter()
-        .map(|lane| Job {
-            point: gyroemu_board::Point {
-                window: lane.window,
-                ..jobs[lane.point].point
-            },
-            start_block: lane.start_block,
-            ..jobs[lane.point].clone()
-        })
-        .collect()
+    let segments = |lens: &[u64]| -> Vec<Job> {
+        cut_each(&todo, &windows, lens)
+            .into_iter()
+            .map(|lane| Job {
+                point: gyroemu_board::Point {
+                    window: lane.window,
+                    ..jobs[lane.point].point
+                },
+                start_block: lane.start_block,
+                ..jobs[lane.point].clone()
+            })
+            .collect()
+    };
+    let fill = cut_to_fill(&windows, n_settle, &segment);
+    if let Some(grain) = refill_grain(&p) {
+        let plain = fill
+            .clone()
+            .unwrap_or_else(|| windows.iter().map(|w| w.0.max(1)).collect());
+        let plain_cost =
+            |width| lane_samples_in(&cut_each(&todo, &windows, &plain), n_settle, width);
+        let (lens, in_eights) = cut_to_refill(&windows, n_settle, grain, &segment);
+        let cut = segments(&lens);
+        let runs: Vec<u64> = cut
+            .iter()
+            .map(|j| n_settle + j.point.window.samples())
+            .collect();
+        let (eights, fours) = (plain_cost(8), plain_cost(4));
+        let in_fours = pack_refilled(&runs, 4, grain).1;
+        let gains = in_eights.saturating_add(eights / MIN_IDLE_SAVING) <= eights;
+        let fair = in_fours <= fours.saturating_add(fours / MIN_IDLE_SAVING);
+        if gains && fair {
+            let groups = pack_refilled(&runs, max_lanes_for(&p), grain).0;
+            return (cut, Some(groups));
+        }
+    }
+    match fill {
+        Some(lens) => (segments(&lens), None),
+        None => (jobs.to_vec(), None),
+    }
 }
 
 #[cfg(test)]
