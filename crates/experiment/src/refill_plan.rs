@@ -70,7 +70,7 @@ fn pack_into(runs: &[u64], lanes: usize, width: usize, grain: u64) -> (Vec<Refil
 }
 
 /// The packing of jobs of `runs[j]` blocks into groups of `width` refilled lanes that runs
-/// the fewest lane-blocks ([`pack_into`] for every number of groups up to one job a lane; of
+/// the fewest lane-blocks (`pack_into` for every number of groups up to one job a lane; of
 /// equal costs, the more groups), with its cost.
 pub fn pack_refilled(runs: &[u64], width: usize, grain: u64) -> (Vec<RefilledGroup>, u64) {
     let width = width.max(1);

@@ -214,7 +214,7 @@ impl<'c> PreparedTables<'c> {
     /// Plans the lane groups of `cfgs` and builds every board (so a bad parameter fails
     /// before any sample is computed). With `split`, the points of configs that can run as
     /// segments (`split::splittable`, boxcar windows) are cut where that fills lane groups,
-    /// their lanes refilled where that runs fewer lane-samples ([`split_jobs`]); the cut
+    /// their lanes refilled where that runs fewer lane-samples (`split_jobs`); the cut
     /// depends on the configs alone, the packing of refilled lanes on the lane width (not on
     /// `group_threads`: it runs the fewest lane-samples, as `reproduce`'s queue wants).
     pub fn new(
