@@ -181,8 +181,12 @@ impl<S: Sample> Board<S> {
         for k in 0..n_out {
             let n0 = k * m;
             // Lanes whose points have ended take their next ones here (checked: at exact
-            // re-sets, after their points' ends).
-            while let Some(p) = refills.get(next_refill).filter(|p| p.r.at_block == k) {
+            // re-sets, after their points' ends; noiseless boards only, so the noisy loops
+            // are compiled without the test).
+            while let Some(p) = refills
+                .get(next_refill)
+                .filter(|p| !NOISY && p.r.at_block == k)
+            {
                 let (i, w) = (p.r.lane, p.r.point.window);
                 refilled[i].push(LaneResult {
                     health: health[i],
