@@ -226,6 +226,9 @@ pub struct Board<S: Sample> {
     pub(crate) pristine: Option<Box<Board<S>>>,
     /// Raised: the run stops at its next progress report (see [`Board::set_cancel`]).
     pub(crate) cancel: Option<Arc<AtomicBool>>,
+    /// The board has run (its oscillators no longer stand where it was built): refills,
+    /// checked against a run from the start, are refused on it.
+    pub(crate) ran: bool,
 }
 
 impl<S: Sample> Board<S> {
@@ -398,6 +401,7 @@ impl<S: Sample> Board<S> {
             imperfect,
             pristine: None,
             cancel: None,
+            ran: false,
         };
         board.pristine = Some(Box::new(board.clone()));
         Ok(board)

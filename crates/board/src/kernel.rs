@@ -35,6 +35,7 @@ impl<S: Sample> Board<S> {
         refills: &[Prepared],
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<RunOutput, u64> {
+        self.ran = true;
         macro_rules! by_plant {
             ($k:expr) => {
                 match (self.imperfect, self.plant_decoupled()) {

@@ -96,6 +96,13 @@ impl<S: Sample> Board<S> {
                 "a Coriolis lane's plant depends on its rate: refill rotating or rate-table boards",
             );
         }
+        if self.ran {
+            return refuse(
+                "refills",
+                refills.len(),
+                "refill a board on its first run (the refills' blocks count from where it was built)",
+            );
+        }
         if self.imperfect {
             return refuse(
                 "refills",

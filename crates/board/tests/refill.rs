@@ -183,11 +183,16 @@ fn refills_off_the_rules_are_refused_before_any_sample() {
     let coriolis = m2tfg(Shape::Coriolis);
     assert_eq!(refused(&coriolis, &points, &[ok]), "refills");
     assert_eq!(refused(&noisy(p, 3), &points, &[ok]), "refills");
-    // The rules kept, the same run goes through.
+    // The rules kept, the same run goes through, once: a board that has run no longer
+    // stands where its refills' blocks count from.
     let rates: Vec<f64> = points.iter().map(|q| q.rate_rad_s).collect();
     let mut b = GroupBoard::new(&p, &rates, &[0, 1]).unwrap();
     let out = b.run_refilled(SETTLE, &points, &[ok], &|_| {}).unwrap();
     assert_eq!(out.refilled[0].len(), 1);
+    match b.run_refilled(SETTLE, &points, &[ok], &|_| {}) {
+        Err(RefillError::Refused(e)) => assert_eq!(e.param, "refills", "{e}"),
+        other => panic!("a second run's refills went through: {other:?}"),
+    }
 }
 
 #[test]
