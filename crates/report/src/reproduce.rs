@@ -712,13 +712,15 @@ mod tests {
             job_work(rot).longest_samples,
             gyroemu_experiment::sweep_work(rot).longest_samples
         );
-        // The bandwidth sweep's longest lane is a 10 s segment of its 0.05 Hz point (12.25 s
-        // of settling), not the point's 52.25 s; its points and point-samples are the same.
+        // The bandwidth sweep's longest lane is a refilled one running two of its 4 s points
+        // back to back (16.26 s each with the settling, the second from the refill grain's
+        // block: 32.515 s), not the 0.05 Hz point's 52.25 s; its points and point-samples are
+        // the same.
         let lane_s = |samples: u64| samples as f64 / 240_000.0;
         let split = tables_work(&quick.bandwidth, true).unwrap();
         let whole = tables_work(&quick.bandwidth, false).unwrap();
         assert!(
-            (lane_s(split.longest_samples) - 22.25).abs() < 0.01,
+            (lane_s(split.longest_samples) - 32.515).abs() < 0.001,
             "{split:?}"
         );
         assert!(
