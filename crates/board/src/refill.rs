@@ -118,11 +118,29 @@ impl<S: Sample> Board<S> {
             );
         }
         let m = self.decimation as u64;
+        // A point from block `at` ends at block `at + n_settle + samples`, its input sample
+        // within 2^53 (the kernel's block and sample counts then stay exact, far from u64's end).
+        let end_of = |at: u64, p: &Point, key: &'static str| -> Result<u64, ParamError> {
+            Averager::<f64, 1>::new(&[p.window], 1)?;
+            at.checked_add(n_settle)
+                .and_then(|e| e.checked_add(p.window.samples()))
+                .filter(|e| e.checked_mul(m).is_some_and(|n| n <= crate::MAX_START))
+                .map_or_else(
+                    || {
+                        refuse(
+                            key,
+                            p.window.samples(),
+                            "the point must end within 2^53 input samples of the run",
+                        )
+                    },
+                    Ok,
+                )
+        };
         // Each lane's block where its current point ends.
-        let mut end: Vec<u64> = points[..self.lanes]
+        let mut end = points[..self.lanes]
             .iter()
-            .map(|p| n_settle.saturating_add(p.window.samples()))
-            .collect();
+            .map(|p| end_of(0, p, "points.window"))
+            .collect::<Result<Vec<u64>, _>>()?;
         let mut last = 0;
         let mut out = Vec::with_capacity(refills.len());
         for r in refills {
@@ -171,7 +189,7 @@ impl<S: Sample> Board<S> {
             if !r.point.rate_rad_s.is_finite() {
                 return refuse("refill.rate_rad_s", r.point.rate_rad_s, "must be finite");
             }
-            Averager::<f64, 1>::new(&[r.point.window], 1)?;
+            let ends = end_of(r.at_block, &r.point, "refill.window")?;
             let mut nco = if is_table_shape(self.shape) {
                 let f = match (r.table_hz, self.shape) {
                     (Some(f), _) => gyroemu_core::error::positive(STAGE, "table_freq_hz", f)?,
@@ -187,10 +205,7 @@ impl<S: Sample> Board<S> {
                 )?
             };
             nco.jump(r.start);
-            end[r.lane] = r
-                .at_block
-                .saturating_add(n_settle)
-                .saturating_add(r.point.window.samples());
+            end[r.lane] = ends;
             out.push(Prepared { r: *r, nco });
         }
         Ok(out)

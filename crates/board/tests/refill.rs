@@ -10,6 +10,7 @@ use common::{imperfect, m2tfg, noisy, point};
 use gyroemu_board::{
     eight_lanes_available, BoardParams, GroupBoard, LaneResult, Point, Refill, RefillError, Shape,
 };
+use gyroemu_lpf::Window;
 
 const SETTLE: u64 = 12;
 /// Blocks of 100 input samples between possible refills: 16 blocks are 1600 samples, a
@@ -41,17 +42,24 @@ fn alone(p: &BoardParams, j: &Job) -> LaneResult {
 }
 
 /// `lanes` lanes, lane `i` running `per_lane` jobs back to back, each refill at the first
-/// grain block after its lane's job ends; every job against its run alone.
-fn check(name: &str, p: &BoardParams, lanes: usize, per_lane: usize) {
+/// grain block after its lane's job ends; every job against its run alone. `shared`: every
+/// point on the board's own table (refills naming none) and the first points from one start,
+/// so the board is built on the shared table and the refills switch it to per-lane tables.
+fn check(name: &str, p: &BoardParams, lanes: usize, per_lane: usize, shared: bool) {
+    let own_hz = match p.shape {
+        Shape::RateTable { freq_hz } => freq_hz,
+        _ => 0.0,
+    };
     let jobs: Vec<Vec<Job>> = (0..lanes)
         .map(|i| {
             (0..per_lane)
                 .map(|k| {
                     let s = (i * per_lane + k) as f64;
+                    let start = 3 * k + if shared && k == 0 { 0 } else { i % 2 };
                     Job {
                         point: point(20.0 + 13.0 * s, 40 + 29 * ((i + 2 * k) % 5) as u64),
-                        start_block: GRAIN * (3 * k + i % 2) as u64,
-                        table_hz: 0.5 + 1.75 * s,
+                        start_block: GRAIN * start as u64,
+                        table_hz: if shared { own_hz } else { 0.5 + 1.75 * s },
                     }
                 })
                 .collect()
@@ -68,7 +76,7 @@ fn check(name: &str, p: &BoardParams, lanes: usize, per_lane: usize) {
                 at_block,
                 point: j.point,
                 start: j.start_block * p.decimation as u64,
-                table_hz: Some(j.table_hz),
+                table_hz: (!shared).then_some(j.table_hz),
             });
             end = at_block + SETTLE + j.point.window.samples();
         }
@@ -81,12 +89,15 @@ fn check(name: &str, p: &BoardParams, lanes: usize, per_lane: usize) {
         .map(|j| j.start_block * p.decimation as u64)
         .collect();
     let mut b = match p.shape {
-        Shape::RateTable { .. } => {
+        Shape::RateTable { .. } if !shared => {
             let hz: Vec<f64> = firsts.iter().map(|j| j.table_hz).collect();
             GroupBoard::with_table_hz_starts(p, &rates, &hz, &streams, &starts).unwrap()
         }
         _ => GroupBoard::with_starts(p, &rates, &streams, &starts).unwrap(),
     };
+    if shared {
+        assert!(!b.table_per_lane(), "{name}: built on the shared table");
+    }
     let points: Vec<Point> = firsts.iter().map(|j| j.point).collect();
     let out = b.run_refilled(SETTLE, &points, &refills, &|_| {}).unwrap();
     for (lane, l) in jobs.iter().enumerate() {
@@ -116,9 +127,12 @@ fn boards() -> Vec<(&'static str, BoardParams)> {
 #[test]
 fn refilled_lanes_hold_the_bits_of_their_points_alone() {
     for (name, p) in boards() {
-        check(&format!("{name}, four lanes"), &p, 3, 3);
-        if eight_lanes_available() {
-            check(&format!("{name}, eight lanes"), &p, 7, 2);
+        for shared in [false, true] {
+            let name = format!("{name}, shared table {shared}");
+            check(&format!("{name}, four lanes"), &p, 3, 3, shared);
+            if eight_lanes_available() {
+                check(&format!("{name}, eight lanes"), &p, 7, 2, shared);
+            }
         }
     }
 }
@@ -168,6 +182,20 @@ fn refills_off_the_rules_are_refused_before_any_sample() {
     // A start whose carrier phase is not the one at the refill (8 samples: half a period).
     assert_eq!(with(&|r| r.start = 8), "refill.start");
     assert_eq!(with(&|r| r.lane = 2), "refill.lane");
+    // Points that would end past 2^53 input samples (the block counts would overflow).
+    let huge = Window::Boxcar {
+        n: u64::MAX - 3,
+        frac: 0.0,
+    };
+    assert_eq!(with(&|r| r.point.window = huge), "refill.window");
+    let long_first = [
+        Point {
+            window: huge,
+            ..points[0]
+        },
+        points[1],
+    ];
+    assert_eq!(refused(&p, &long_first, &[ok]), "points.window");
     assert_eq!(
         with(&|r| r.point.rate_rad_s = f64::NAN),
         "refill.rate_rad_s"
@@ -215,10 +243,13 @@ fn a_fault_in_a_refilled_lane_is_located_on_its_points_axis() {
     let mut b = GroupBoard::new(&p, &rates, &[0, 1]).unwrap();
     match b.run_refilled(SETTLE, &points, &[huge], &|_| {}) {
         Err(RefillError::NonFinite(f)) => {
-            // Found by a replay that refilled the lane too: the point's rate, and a sample of
-            // its own axis within its first block, not the run's 4800 and on.
+            // Found by a replay that refilled the lane too: in the plant (the fallback names
+            // the low-pass), at the point's rate, at sample 1601 of its own axis (the plant
+            // outputs its state before each step: at 1600 its rest, at 1601 the first state
+            // stepped at that rate), not at the run's 4801.
+            assert_eq!(f.stage, "resonator", "{f}");
             assert_eq!(f.rate_dps, 1e200f64.to_degrees(), "{f}");
-            assert!((1600..1700).contains(&f.sample), "{f}");
+            assert_eq!(f.sample, 1601, "{f}");
         }
         other => panic!("expected a located fault: {other:?}"),
     }

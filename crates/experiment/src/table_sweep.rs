@@ -192,7 +192,9 @@ pub fn tables_work(cfgs: &[Config], split: bool) -> Result<crate::Work, SweepErr
     work.longest_samples = plan_classes(cfgs, split)?
         .iter()
         .flat_map(|((_, n_settle), jobs, refilled)| {
-            let m = cfgs[jobs[0].sweep].decimation() as u64;
+            let m = jobs
+                .first()
+                .map_or(1, |j| cfgs[j.sweep].decimation() as u64);
             let alone = jobs
                 .iter()
                 .map(move |j| (n_settle + j.point.window.samples()) * m);
@@ -330,12 +332,25 @@ impl<'c> PreparedTables<'c> {
                     RefillError::NonFinite(f) => SweepError::from(f),
                 })
         };
-        let done = run.map(|out| {
+        let done = run.and_then(|out| {
             let mut finished = Vec::new();
             for (lane, l) in group.lanes.iter().enumerate() {
-                // The lane's points in order: those before its last, then its last.
-                let results = out.refilled.get(lane).into_iter().flatten().copied();
-                for ((j, _), mut res) in l.iter().zip(results.chain([out.lanes[lane]])) {
+                // The lane's points in order: those before its last, then its last; a lane
+                // that ran other than its plan would credit a point with another's result.
+                let before = out.refilled.get(lane).map_or(&[][..], |r| &r[..]);
+                if before.len() + 1 != l.len() {
+                    return Err(SweepError::Param(gyroemu_core::ParamError::new(
+                        "experiment",
+                        "refills",
+                        before.len(),
+                        format!(
+                            "lane {lane} was to run {} points before its last",
+                            l.len() - 1
+                        ),
+                    )));
+                }
+                let results = before.iter().copied().chain([out.lanes[lane]]);
+                for ((j, _), mut res) in l.iter().zip(results) {
                     // Harmonics beyond the point's own are zero in its own sweep.
                     for md in 0..2 {
                         for (i, h) in res.table_z[md].iter_mut().enumerate() {
@@ -347,7 +362,7 @@ impl<'c> PreparedTables<'c> {
                     finished.push((j.sweep, j.index, j.start_block, j.point.window, res));
                 }
             }
-            finished
+            Ok(finished)
         });
         *lock(&self.outcomes[g]) = Some(done);
     }
@@ -502,7 +517,9 @@ fn split_jobs(
             .collect()
     };
     let fill = cut_to_fill(&windows, n_settle, &segment);
-    if let Some(grain) = refill_grain(&p) {
+    // Refills keep the bits only of a board without converters or rails (`run_refilled`
+    // refuses others; noise is not splittable already).
+    if let Some(grain) = refill_grain(&p).filter(|_| !p.imperfect()) {
         let plain = fill
             .clone()
             .unwrap_or_else(|| windows.iter().map(|w| w.0.max(1)).collect());

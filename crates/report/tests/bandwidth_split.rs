@@ -91,3 +91,24 @@ fn the_bandwidth_sweep_runs_in_one_group_of_refilled_lanes() {
         assert_eq!(t.group_samples(0), 7_803_700);
     }
 }
+
+#[test]
+fn a_board_with_converters_keeps_its_lanes_unrefilled_and_runs() {
+    // Refills keep the bits only without converters or rails (`run_refilled` refuses such a
+    // board): with a 16-bit DAC the same sweep plans no refill, and every group runs.
+    let cfgs: Vec<Config> = cfgs()
+        .into_iter()
+        .map(|mut c| {
+            c.board.dac_bits = Some(16);
+            c.board.dac_full_scale = 1.5;
+            c.validate().unwrap();
+            c
+        })
+        .collect();
+    let t = PreparedTables::new(&cfgs, Some(1), true).unwrap();
+    for g in 0..t.groups() {
+        assert!(t.group_lanes(g).iter().all(|l| l.len() == 1), "group {g}");
+        t.run_group(g);
+    }
+    assert_eq!(t.finish().unwrap().len(), 9);
+}
