@@ -96,20 +96,28 @@ pub fn cut_to_refill(
     segment: &dyn Fn(u64) -> (u64, Packing),
 ) -> (Vec<u64>, u64) {
     let whole: Vec<u64> = windows.iter().map(|w| w.0.max(1)).collect();
-    let cost = |lens: &[u64]| -> (u64, usize) {
+    let runs_of = |lens: &[u64]| -> Vec<u64> {
         let todo: Vec<usize> = (0..windows.len()).collect();
-        let runs: Vec<u64> = cut_each(&todo, windows, lens)
+        cut_each(&todo, windows, lens)
             .iter()
             .map(|l| n_settle + l.window.samples())
-            .collect();
-        (pack_refilled(&runs, 8, grain).1, runs.len())
+            .collect()
     };
-    let mut best = (cost(&whole), whole);
-    for t in cut_targets(windows, segment) {
+    let cost = |runs: &[u64]| (pack_refilled(runs, 8, grain).1, runs.len());
+    let mut best = (cost(&runs_of(&whole)), whole);
+    // From the longest common length down: a shorter one cuts more segments, each settling,
+    // so the lane-blocks the segments themselves run only grow, and once they reach the best
+    // packing's, no packing of a finer cut can beat it (the weighing stays a few
+    // milliseconds where every cut's packing took twelve).
+    for t in cut_targets(windows, segment).into_iter().rev() {
         let Some(lens) = even_cut(windows, t, segment) else {
             continue;
         };
-        let c = cost(&lens);
+        let runs = runs_of(&lens);
+        if runs.iter().sum::<u64>() >= best.0 .0 {
+            break;
+        }
+        let c = cost(&runs);
         // Of equal lane-samples, the fewer segments (the less settling, the fewer other bits).
         if c < best.0 {
             best = (c, lens);
@@ -212,6 +220,60 @@ mod tests {
         );
         // A grain of 5 starts the second and third 4 at 5 and 10: 14, no better than 28 / 2.
         assert_eq!(check_packing(&[10, 4, 4, 4], 2, 5), 28);
+    }
+
+    /// `cut_to_refill` weighing every cut, with no early stop: the reference its pruned
+    /// search must equal.
+    fn cut_to_refill_exhaustive(
+        windows: &[(u64, f64)],
+        n_settle: u64,
+        grain: u64,
+        segment: &dyn Fn(u64) -> (u64, Packing),
+    ) -> (Vec<u64>, u64) {
+        let todo: Vec<usize> = (0..windows.len()).collect();
+        let cost = |lens: &[u64]| {
+            let runs: Vec<u64> = cut_each(&todo, windows, lens)
+                .iter()
+                .map(|l| n_settle + l.window.samples())
+                .collect();
+            (pack_refilled(&runs, 8, grain).1, runs.len())
+        };
+        let whole: Vec<u64> = windows.iter().map(|w| w.0.max(1)).collect();
+        let mut best = (cost(&whole), whole);
+        for t in cut_targets(windows, segment) {
+            if let Some(lens) = even_cut(windows, t, segment) {
+                let c = cost(&lens);
+                if c < best.0 {
+                    best = (c, lens);
+                }
+            }
+        }
+        (best.1, best.0 .0)
+    }
+
+    #[test]
+    fn the_pruned_search_finds_the_exhaustive_ones_cost_and_cut() {
+        let mut g = gyroemu_core::check::Gen::new(11);
+        for _ in 0..60 {
+            let n = 1 + (g.u64() % 9) as usize;
+            let windows: Vec<(u64, f64)> = (0..n).map(|_| (1 + g.u64() % 3000, 0.0)).collect();
+            let n_settle = 1 + g.u64() % 400;
+            let step = 1 + g.u64() % 8;
+            let segment = |len: u64| (len.div_ceil(step) * step, Packing::Free);
+            let fast = cut_to_refill(&windows, n_settle, 16, &segment);
+            let slow = cut_to_refill_exhaustive(&windows, n_settle, 16, &segment);
+            // The same cost; of equal costs the fewest segments (the exhaustive search may
+            // meet another cut of that count first).
+            assert_eq!(fast.1, slow.1, "{windows:?} settling {n_settle}");
+            let count = |lens: &[u64]| -> u64 {
+                windows
+                    .iter()
+                    .zip(lens)
+                    .map(|(w, &l)| w.0.div_ceil(l).max(1))
+                    .sum()
+            };
+            assert_eq!(count(&fast.0), count(&slow.0), "{windows:?}");
+        }
     }
 
     #[test]
