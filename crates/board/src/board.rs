@@ -92,16 +92,42 @@ pub(crate) fn plant_rate(shape: Shape, rate_rad_s: f64) -> f64 {
 /// The table oscillator: the plant holds the rate over each step and its midpoint value makes
 /// that step second-order accurate, so the table NCO runs half a sample ahead.
 pub(crate) fn table_nco(p: &BoardParams) -> Result<Nco, ParamError> {
-    let f = match p.shape {
+    table_nco_at(own_table_hz(p.shape), p.fs_hz())
+}
+
+/// The table frequency a board of `shape` follows, Hz (0 outside rate tables).
+pub(crate) fn own_table_hz(shape: Shape) -> f64 {
+    match shape {
         Shape::RateTable { freq_hz } => freq_hz,
         _ => 0.0,
-    };
-    table_nco_at(f, p.fs_hz())
+    }
 }
 
 /// [`table_nco`] at table frequency `f_hz`.
-pub(crate) fn table_nco_at(f_hz: f64, fs_hz: f64) -> Result<Nco, ParamError> {
+fn table_nco_at(f_hz: f64, fs_hz: f64) -> Result<Nco, ParamError> {
     Nco::new(f_hz, fs_hz, core::f64::consts::PI * f_hz / fs_hz)
+}
+
+/// A lane's modulation oscillator for the operating point at `rate_rad_s` of `shape`, as a
+/// board that has run `start` samples holds it (built and refilled lanes alike).
+pub(crate) fn lane_modulation(
+    shape: Shape,
+    rate_rad_s: f64,
+    fs_hz: f64,
+    start: u64,
+) -> Result<Nco, ParamError> {
+    let mut n = Nco::new(modulation_hz(shape, rate_rad_s), fs_hz, 0.0)?;
+    n.jump(start);
+    Ok(n)
+}
+
+/// A lane's rate-table oscillator at table frequency `f_hz`, where the lane starts on the
+/// time axis (a rate table's phase counts from sample 0 of that axis; built and refilled
+/// lanes alike).
+pub(crate) fn lane_table(f_hz: f64, fs_hz: f64, start: u64) -> Result<Nco, ParamError> {
+    let mut n = table_nco_at(f_hz, fs_hz)?;
+    n.jump(start);
+    Ok(n)
 }
 
 /// The table harmonics a board demodulates (none but the mean outside rate-table runs).
@@ -325,27 +351,17 @@ impl<S: Sample> Board<S> {
         let mut carrier = Nco::new(p.carrier_hz, fs, 0.0)?;
         carrier.jump(starts[0]);
         let modulation: Vec<Nco> = (0..S::LANES)
-            .map(|i| {
-                let mut n = Nco::new(modulation_hz(p.shape, lane_rate(i)), fs, 0.0)?;
-                n.jump(lane_start(i));
-                Ok(n)
-            })
+            .map(|i| lane_modulation(p.shape, lane_rate(i), fs, lane_start(i)))
             .collect::<Result<_, ParamError>>()?;
-        // Each lane's table, where its lane starts on the time axis (a rate table's phase
-        // counts from sample 0 of that axis).
         let table: Vec<Nco> = (0..S::LANES)
             .map(|i| {
-                let mut n = match table_hz {
-                    Some(f) => table_nco_at(f[i.min(lanes - 1)], fs)?,
-                    None => table_nco(p)?,
-                };
-                n.jump(lane_start(i));
-                Ok(n)
+                let f = table_hz.map_or(own_table_hz(p.shape), |f| f[i.min(lanes - 1)]);
+                lane_table(f, fs, lane_start(i))
             })
             .collect::<Result<_, ParamError>>()?;
         let table_f_hz: [f64; MAX_LANES] =
             core::array::from_fn(|i| table[i.min(S::LANES - 1)].f_hz());
-        let on_table = matches!(p.shape, Shape::RateTable { .. });
+        let on_table = p.shape.is_rate_table();
         let table_shared = (0..S::LANES).all(|i| {
             table_f_hz[i] == table_f_hz[0] && (!on_table || lane_start(i) == lane_start(0))
         });
@@ -452,7 +468,7 @@ impl<S: Sample> Board<S> {
     /// in the sample loop) rather than one table shared by every lane. Public so tests can
     /// check which loop a board runs.
     pub fn table_per_lane(&self) -> bool {
-        matches!(self.shape, Shape::RateTable { .. }) && !self.table_shared
+        self.shape.is_rate_table() && !self.table_shared
     }
 
     /// The TIA's two flicker sources run as one of eight lanes (a four-lane board where the

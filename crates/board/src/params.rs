@@ -32,6 +32,11 @@ impl Shape {
     pub fn is_rotating(self) -> bool {
         self == Shape::Rotating
     }
+
+    /// True for a rate table (its lanes' table oscillators shared or one each).
+    pub fn is_rate_table(self) -> bool {
+        matches!(self, Shape::RateTable { .. })
+    }
 }
 
 /// A converter's quantiser: resolution and full scale (input range -fs .. +fs).

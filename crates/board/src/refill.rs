@@ -5,7 +5,7 @@
 //! phase word exactly where a fresh board's would be (an exact re-set), and its average
 //! starts anew. Noiseless boards only (a lane's noise streams belong to its first point).
 
-use crate::board::{modulation_hz, table_nco_at, Board};
+use crate::board::{lane_modulation, lane_table, own_table_hz, Board};
 use crate::fault::NonFinite;
 use crate::params::{Shape, STAGE};
 use crate::point::{Point, RunOptions, RunOutput};
@@ -70,7 +70,7 @@ impl<S: Sample> Board<S> {
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<RunOutput, RefillError> {
         let prepared = self.check_refills(n_settle, points, refills)?;
-        if !prepared.is_empty() && is_table_shape(self.shape) {
+        if !prepared.is_empty() && self.shape.is_rate_table() {
             // Lanes that change tables mid-run follow their own.
             self.table_shared = false;
         }
@@ -190,21 +190,16 @@ impl<S: Sample> Board<S> {
                 return refuse("refill.rate_rad_s", r.point.rate_rad_s, "must be finite");
             }
             let ends = end_of(r.at_block, &r.point, "refill.window")?;
-            let mut nco = if is_table_shape(self.shape) {
-                let f = match (r.table_hz, self.shape) {
-                    (Some(f), _) => gyroemu_core::error::positive(STAGE, "table_freq_hz", f)?,
-                    (None, Shape::RateTable { freq_hz }) => freq_hz,
-                    (None, _) => unreachable!("a rate-table shape"),
+            // The oscillator the lane takes over, built as a board of the point alone builds it.
+            let nco = if self.shape.is_rate_table() {
+                let f = match r.table_hz {
+                    Some(f) => gyroemu_core::error::positive(STAGE, "table_freq_hz", f)?,
+                    None => own_table_hz(self.shape),
                 };
-                table_nco_at(f, self.fs_hz)?
+                lane_table(f, self.fs_hz, r.start)?
             } else {
-                Nco::new(
-                    modulation_hz(self.shape, r.point.rate_rad_s),
-                    self.fs_hz,
-                    0.0,
-                )?
+                lane_modulation(self.shape, r.point.rate_rad_s, self.fs_hz, r.start)?
             };
-            nco.jump(r.start);
             end[r.lane] = ends;
             out.push(Prepared { r: *r, nco });
         }
@@ -222,7 +217,7 @@ impl<S: Sample> Board<S> {
         }
         self.lp.reset_lane(i);
         self.rate = self.rate.with_lane(i, p.r.point.rate_rad_s);
-        let osc = if is_table_shape(self.shape) {
+        let osc = if self.shape.is_rate_table() {
             self.table_f_hz[i] = p.nco.f_hz();
             &mut self.table_lanes
         } else {
@@ -233,9 +228,4 @@ impl<S: Sample> Board<S> {
         // The lane's time axis: its input sample `n` of the run is `n + starts[i]` of its own.
         self.starts[i] = p.r.start.wrapping_sub(n0);
     }
-}
-
-/// The shape is a rate table (shared or per lane).
-fn is_table_shape(shape: Shape) -> bool {
-    matches!(shape, Shape::RateTable { .. })
 }
