@@ -5,7 +5,7 @@
 //! configs alone, while the packing (which lane runs what, when) may depend on the machine,
 //! which changes no bit.
 
-use crate::split::{cut_each, cut_targets, even_cut, Packing};
+use crate::split::{cut_each, cut_targets, even_cut, gcd, Packing};
 use gyroemu_board::{starts_share_carrier, BoardParams};
 
 /// Input samples between the oscillators' exact re-sets, where a lane may be refilled.
@@ -18,7 +18,7 @@ const RESYNC: u64 = gyroemu_nco::RESYNC as u64;
 /// carrier: refill would not keep the bits).
 pub fn refill_grain(p: &BoardParams) -> Option<u64> {
     let m = p.decimation.max(1) as u64;
-    let base = RESYNC / gcd(m, RESYNC);
+    let base = RESYNC / gcd(m as usize, RESYNC as usize) as u64;
     (0..=20)
         .map(|e| base << e)
         .find(|&g| starts_share_carrier(p, &[0, g * m]))
@@ -124,14 +124,6 @@ pub fn cut_to_refill(
         }
     }
     (best.1, best.0 .0)
-}
-
-fn gcd(a: u64, b: u64) -> u64 {
-    if b == 0 {
-        a
-    } else {
-        gcd(b, a % b)
-    }
 }
 
 #[cfg(test)]

@@ -249,10 +249,18 @@ fn cut_cost(windows: &[(u64, f64)], n_settle: u64, lens: &[u64], width: usize) -
 /// 1/[`MIN_IDLE_SAVING`] fewer lane-samples in groups of eight and at most 1/`MIN_IDLE_SAVING`
 /// more in groups of four (a gain where eight lanes run, no real loss where four do).
 fn pays_off(windows: &[(u64, f64)], n_settle: u64, before: &[u64], after: &[u64]) -> bool {
-    let cost = |lens: &[u64], width: usize| cut_cost(windows, n_settle, lens, width);
-    let (eights, fours) = (cost(before, 8), cost(before, 4));
-    let gains = cost(after, 8).saturating_add(eights / MIN_IDLE_SAVING) <= eights;
-    let fair = cost(after, 4) <= fours.saturating_add(fours / MIN_IDLE_SAVING);
+    let cost = |lens: &[u64]| [8, 4].map(|width| cut_cost(windows, n_settle, lens, width));
+    saves_enough(cost(before), cost(after))
+}
+
+/// A plan that runs `after` lane-samples in groups of eight and of four (`[eights, fours]`)
+/// is worth taking over one that runs `before`: at least 1/[`MIN_IDLE_SAVING`] fewer in
+/// eights and at most 1/`MIN_IDLE_SAVING` more in fours (the rule of [`pays_off`], for plans
+/// costed otherwise: refilled lanes).
+pub(crate) fn saves_enough(before: [u64; 2], after: [u64; 2]) -> bool {
+    let [eights, fours] = before;
+    let gains = after[0].saturating_add(eights / MIN_IDLE_SAVING) <= eights;
+    let fair = after[1] <= fours.saturating_add(fours / MIN_IDLE_SAVING);
     gains && fair
 }
 
@@ -423,7 +431,7 @@ pub fn segment_length_on(p: &BoardParams, len: u64) -> (u64, Packing) {
         })
 }
 
-fn gcd(a: usize, b: usize) -> usize {
+pub(crate) fn gcd(a: usize, b: usize) -> usize {
     if b == 0 {
         a
     } else {

@@ -11,7 +11,7 @@ use crate::mutex::lock;
 use crate::readout::SweepResult;
 use crate::refill_plan::{cut_to_refill, pack_refilled, refill_grain, RefilledGroup};
 use crate::split::{
-    combine, cut_each, cut_to_fill, lane_samples_in, segment_length_on, splittable, MIN_IDLE_SAVING,
+    combine, cut_each, cut_to_fill, lane_samples_in, saves_enough, segment_length_on, splittable,
 };
 use crate::sweep::{finish_sweep, SweepError};
 use gyroemu_board::{
@@ -474,9 +474,9 @@ fn build_group(
 /// cut when every config they come from can run segments and every window is a boxcar (else
 /// as they are). Where the carrier allows refills (`refill_plan::refill_grain`), the cut for
 /// refilled lanes (`refill_plan::cut_to_refill`) with its packing into this machine's lane
-/// groups, if it runs at least 1/[`MIN_IDLE_SAVING`] fewer lane-samples in groups of eight
-/// than the cut without refill and no more than 1/`MIN_IDLE_SAVING` more in groups of four
-/// (the same cut on every machine); else the cut that fills groups (`split::cut_to_fill`), if
+/// groups, if it runs at least 1/[`crate::split::MIN_IDLE_SAVING`] fewer lane-samples in
+/// groups of eight than the cut without refill and no more than 1/`MIN_IDLE_SAVING` more in
+/// groups of four (`split::saves_enough`; the same cut on every machine); else the cut that fills groups (`split::cut_to_fill`), if
 /// one pays off. The bandwidth sweep's nine points (settling 12.25 s) run refilled: its 40 s
 /// point in halves, the rest whole, two lanes running two 4 s points back to back, in one
 /// group of eight lanes of 32.5 s (624 296 lane-samples counted in eights, 16 % fewer than
@@ -523,19 +523,16 @@ fn split_jobs(
         let plain = fill
             .clone()
             .unwrap_or_else(|| windows.iter().map(|w| w.0.max(1)).collect());
-        let plain_cost =
-            |width| lane_samples_in(&cut_each(&todo, &windows, &plain), n_settle, width);
+        let plain = cut_each(&todo, &windows, &plain);
+        let before = [8, 4].map(|width| lane_samples_in(&plain, n_settle, width));
         let (lens, in_eights) = cut_to_refill(&windows, n_settle, grain, &segment);
         let cut = segments(&lens);
         let runs: Vec<u64> = cut
             .iter()
             .map(|j| n_settle + j.point.window.samples())
             .collect();
-        let (eights, fours) = (plain_cost(8), plain_cost(4));
         let in_fours = pack_refilled(&runs, 4, grain).1;
-        let gains = in_eights.saturating_add(eights / MIN_IDLE_SAVING) <= eights;
-        let fair = in_fours <= fours.saturating_add(fours / MIN_IDLE_SAVING);
-        if gains && fair {
+        if saves_enough(before, [in_eights, in_fours]) {
             let groups = pack_refilled(&runs, max_lanes_for(&p), grain).0;
             return (cut, Some(groups));
         }
