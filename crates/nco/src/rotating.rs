@@ -77,11 +77,10 @@ impl<S: Sample> RotatingNco<S> {
         self.step[lane] = step;
         self.phase[lane] = next.wrapping_add(step.wrapping_mul(u64::from(self.count)));
         let (p, r) = (phasor_of_word(next), phasor_of_word(step));
-        let set = |v: S, new: f64| S::from_fn(|l| if l == lane { new } else { v.lane(l) });
-        self.re = set(self.re, p.re);
-        self.im = set(self.im, p.im);
-        self.rot_re = set(self.rot_re, r.re);
-        self.rot_im = set(self.rot_im, r.im);
+        self.re = self.re.with_lane(lane, p.re);
+        self.im = self.im.with_lane(lane, p.im);
+        self.rot_re = self.rot_re.with_lane(lane, r.re);
+        self.rot_im = self.rot_im.with_lane(lane, r.im);
         Ok(())
     }
 
