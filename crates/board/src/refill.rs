@@ -10,7 +10,6 @@ use crate::fault::NonFinite;
 use crate::params::{Shape, STAGE};
 use crate::point::{Point, RunOptions, RunOutput};
 use gyroemu_core::{ParamError, Sample};
-use gyroemu_lpf::Averager;
 use gyroemu_nco::{Nco, RESYNC};
 
 /// Another point for a lane of a running board (see [`Board::run_refilled`]).
@@ -121,7 +120,7 @@ impl<S: Sample> Board<S> {
         // A point from block `at` ends at block `at + n_settle + samples`, its input sample
         // within 2^53 (the kernel's block and sample counts then stay exact, far from u64's end).
         let end_of = |at: u64, p: &Point, key: &'static str| -> Result<u64, ParamError> {
-            Averager::<f64, 1>::new(&[p.window], 1)?;
+            p.window.check()?;
             at.checked_add(n_settle)
                 .and_then(|e| e.checked_add(p.window.samples()))
                 .filter(|e| e.checked_mul(m).is_some_and(|n| n <= crate::MAX_START))

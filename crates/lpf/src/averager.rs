@@ -86,7 +86,9 @@ impl Window {
         }
     }
 
-    fn check(&self) -> ParamResult<()> {
+    /// Refuses a window no averager takes (a boxcar's `frac` outside [0, 1), a Hann window of
+    /// no samples), naming the rule.
+    pub fn check(&self) -> ParamResult<()> {
         match *self {
             Window::Boxcar { frac, .. } if !(0.0..1.0).contains(&frac) => Err(ParamError::new(
                 STAGE,
