@@ -81,7 +81,7 @@ fn stage_contract_blocks_reset_and_lanes() {
 
 #[test]
 fn blocks_are_ticks_for_every_pole_count() {
-    // `process` runs the poles four at a time and the rest one by one (eight at a time first
+    // `process` runs the poles four at a time and the rest in one pass (eight at a time first
     // in eight lanes: `board`'s f64x8 tests): spans of 2 to 12 decades give 4 to 24 poles,
     // every remainder modulo four, each checked on blocks of every size of the contract
     // against `tick`, in one lane and in four.

@@ -137,9 +137,11 @@ impl<S: Sample> Stage for Flicker<S> {
             self.poles::<POLES_AT_ONCE>(k, w, y);
             k += POLES_AT_ONCE;
         }
-        while k < n {
-            self.poles::<1>(k, w, y);
-            k += 1;
+        match n - k {
+            3 => self.poles::<3>(k, w, y),
+            2 => self.poles::<2>(k, w, y),
+            1 => self.poles::<1>(k, w, y),
+            _ => {}
         }
     }
 
@@ -152,9 +154,9 @@ impl<S: Sample> Stage for Flicker<S> {
 /// radii and residues in registers and give each sample's chain of four dependent
 /// multiply-adds enough independent work beside it. Eight-lane sources (compiled for
 /// AVX-512: 32 registers) run twice as many per pass first, so the sums are read and written
-/// fewer times (docs/performance.md). The last one to three poles still run one by one: a
-/// pass of two or three was faster there, but it changed the machine code of the noisy
-/// sample loop, which does not call it, and cost that loop 4 %.
+/// fewer times (docs/performance.md). The last one to three poles run in one pass: one by
+/// one, each pole's state waits a multiply-add's latency per sample (three of the 19 poles
+/// of the presets' TIA source took as long as the other 16).
 const POLES_AT_ONCE: usize = 4;
 
 impl<S: Sample> Flicker<S> {
