@@ -350,7 +350,7 @@ mod tests {
     }
 
     /// A flicker source in eight lanes (the joined TIA sources, and each TIA source of an
-    /// eight-lane board) runs eight poles per pass, then four, then the rest in one pass:
+    /// eight-lane board) runs eight poles per pass, then the rest, up to seven, in one pass:
     /// `process` against `tick` on every block size of the stage contract, for 4 to 24 poles
     /// (every remainder modulo eight among them), and lane by lane against a scalar source.
     #[test]

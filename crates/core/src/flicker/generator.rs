@@ -129,20 +129,26 @@ impl<S: Sample> Stage for Flicker<S> {
         let mut k = 0;
         if S::LANES >= 8 {
             while k + 2 * POLES_AT_ONCE <= n {
-                self.poles::<{ 2 * POLES_AT_ONCE }>(k, w, y);
-                k += 2 * POLES_AT_ONCE;
+                k += self.poles::<{ 2 * POLES_AT_ONCE }>(k, w, y);
             }
+            // The rest, up to seven poles, in one pass (32 registers hold them): a pass
+            // takes at least a multiply-add's latency per sample, so one of five beats two.
+            k += match n - k {
+                7 => self.poles::<7>(k, w, y),
+                6 => self.poles::<6>(k, w, y),
+                5 => self.poles::<5>(k, w, y),
+                _ => 0,
+            };
         }
         while k + POLES_AT_ONCE <= n {
-            self.poles::<POLES_AT_ONCE>(k, w, y);
-            k += POLES_AT_ONCE;
+            k += self.poles::<POLES_AT_ONCE>(k, w, y);
         }
         match n - k {
             3 => self.poles::<3>(k, w, y),
             2 => self.poles::<2>(k, w, y),
             1 => self.poles::<1>(k, w, y),
-            _ => {}
-        }
+            _ => 0,
+        };
     }
 
     fn reset(&mut self) {
@@ -154,16 +160,18 @@ impl<S: Sample> Stage for Flicker<S> {
 /// radii and residues in registers and give each sample's chain of four dependent
 /// multiply-adds enough independent work beside it. Eight-lane sources (compiled for
 /// AVX-512: 32 registers) run twice as many per pass first, so the sums are read and written
-/// fewer times (docs/performance.md). The last one to three poles run in one pass: one by
-/// one, each pole's state waits a multiply-add's latency per sample (three of the 19 poles
-/// of the presets' TIA source took as long as the other 16).
+/// fewer times (docs/performance.md), and the rest, up to seven, in one pass; four-lane
+/// sources the last one to three in one pass. One by one, each pole's state waited a
+/// multiply-add's latency per sample: three of the 19 poles of the bench's TIA source took
+/// as long as the other 16.
 const POLES_AT_ONCE: usize = 4;
 
 impl<S: Sample> Flicker<S> {
     /// Adds poles `k .. k + P` to every sample's sum in `y` (started by `process`), advancing
     /// their states over the block `w`: per sample the multiply-adds of `tick`, in its order.
+    /// Returns `P`, the poles done.
     #[inline(always)]
-    fn poles<const P: usize>(&mut self, k: usize, w: &[S], y: &mut [S]) {
+    fn poles<const P: usize>(&mut self, k: usize, w: &[S], y: &mut [S]) -> usize {
         let a: [S; P] = core::array::from_fn(|i| self.a[k + i]);
         let r: [S; P] = core::array::from_fn(|i| self.rho[k + i]);
         let mut m: [S; P] = core::array::from_fn(|i| self.state[k + i]);
@@ -176,6 +184,7 @@ impl<S: Sample> Flicker<S> {
             *y = acc;
         }
         self.state[k..k + P].copy_from_slice(&m);
+        P
     }
 }
 
