@@ -56,10 +56,7 @@ struct Group {
 impl Group {
     /// The input samples the group runs: to its longest lane's end.
     fn samples(&self, m: u64) -> u64 {
-        let end = |l: &Vec<(Job, u64)>| {
-            l.last()
-                .map_or(0, |(j, at)| at + self.n_settle + j.point.window.samples())
-        };
+        let end = |l: &Vec<(Job, u64)>| l.last().map_or(0, |(j, at)| at + j.blocks(self.n_settle));
         self.lanes.iter().map(end).max().unwrap_or(0) * m
     }
 }
@@ -77,6 +74,13 @@ struct Job {
     table_hz: f64,
     /// The table harmonics its own board would demodulate.
     harmonics: usize,
+}
+
+impl Job {
+    /// The decimation blocks a lane runs for this point: the settling, then its window.
+    fn blocks(&self, n_settle: u64) -> u64 {
+        n_settle + self.point.window.samples()
+    }
 }
 
 /// What the sweeps of one lane group must share: the board but for the table's frequency and
@@ -195,12 +199,10 @@ pub fn tables_work(cfgs: &[Config], split: bool) -> Result<crate::Work, SweepErr
             let m = jobs
                 .first()
                 .map_or(1, |j| cfgs[j.sweep].decimation() as u64);
-            let alone = jobs
-                .iter()
-                .map(move |j| (n_settle + j.point.window.samples()) * m);
+            let alone = jobs.iter().map(move |j| j.blocks(*n_settle) * m);
             let lanes = refilled.iter().flatten().flatten().map(move |l| {
                 l.iter()
-                    .map(|&(j, at)| at + n_settle + jobs[j].point.window.samples())
+                    .map(|&(j, at)| at + jobs[j].blocks(*n_settle))
                     .max()
                     .unwrap_or(0)
                     * m
@@ -246,10 +248,7 @@ impl<'c> PreparedTables<'c> {
             // Longest window first, so a group's lanes end together (as in a sweep).
             order.sort_by_key(|j| core::cmp::Reverse(j.point.window.samples()));
             let mut rest = &order[..];
-            let runs: Vec<u64> = order
-                .iter()
-                .map(|j| n_settle + j.point.window.samples())
-                .collect();
+            let runs: Vec<u64> = order.iter().map(|j| j.blocks(*n_settle)).collect();
             for size in group_sizes(key, &runs, threads) {
                 let (g, r) = rest.split_at(size);
                 rest = r;
@@ -527,10 +526,7 @@ fn split_jobs(
         let before = [8, 4].map(|width| lane_samples_in(&plain, n_settle, width));
         let (lens, in_eights) = cut_to_refill(&windows, n_settle, grain, &segment);
         let cut = segments(&lens);
-        let runs: Vec<u64> = cut
-            .iter()
-            .map(|j| n_settle + j.point.window.samples())
-            .collect();
+        let runs: Vec<u64> = cut.iter().map(|j| j.blocks(n_settle)).collect();
         let in_fours = pack_refilled(&runs, 4, grain).1;
         if saves_enough(before, [in_eights, in_fours]) {
             let groups = pack_refilled(&runs, max_lanes_for(&p), grain).0;
