@@ -64,24 +64,24 @@ impl<S: Sample> RotatingNco<S> {
     /// frequency is refused and changes nothing. [`Stage::reset`] restores the frequencies the
     /// oscillator was built with.
     pub fn set_frequency_hz(&mut self, lane: usize, f_hz: f64) -> ParamResult<()> {
-        if lane >= S::LANES {
-            return Err(ParamError::new(
-                "rotating_nco",
-                "lane",
-                lane,
-                format!("must be below the number of lanes ({})", S::LANES),
-            ));
-        }
+        check_lane::<S>(lane)?;
         let step = step_of(f_hz, self.fs_hz[lane])?;
         let next = self.next_phase_word(lane);
-        self.step[lane] = step;
+        self.set_step(lane, step);
         self.phase[lane] = next.wrapping_add(step.wrapping_mul(u64::from(self.count)));
-        let (p, r) = (phasor_of_word(next), phasor_of_word(step));
+        let p = phasor_of_word(next);
         self.re = self.re.with_lane(lane, p.re);
         self.im = self.im.with_lane(lane, p.im);
+        Ok(())
+    }
+
+    /// Lane `lane` steps by `step` from the next tick: its step word and its rotation, as
+    /// `new` computes them (the other lanes untouched).
+    fn set_step(&mut self, lane: usize, step: u64) {
+        self.step[lane] = step;
+        let r = phasor_of_word(step);
         self.rot_re = self.rot_re.with_lane(lane, r.re);
         self.rot_im = self.rot_im.with_lane(lane, r.im);
-        Ok(())
     }
 
     /// The oscillator stands at an exact re-set: every lane's phasor is computed afresh from
@@ -100,13 +100,7 @@ impl<S: Sample> RotatingNco<S> {
         let bad = |param: &'static str, v: String, rule: &str| {
             Err(ParamError::new("rotating_nco", param, v, rule.to_string()))
         };
-        if lane >= S::LANES {
-            return bad(
-                "lane",
-                lane.to_string(),
-                "must be below the number of lanes",
-            );
-        }
+        check_lane::<S>(lane)?;
         if !self.at_resync() {
             return bad(
                 "count",
@@ -121,14 +115,9 @@ impl<S: Sample> RotatingNco<S> {
                 "must be the lane's sample rate",
             );
         }
-        let (word, step) = (nco.phase_word(), nco.step_word());
-        // The next re-set computes the phasor from `phase`; the rotation is the step's, as
-        // `new` computes it.
-        self.phase[lane] = word;
-        self.step[lane] = step;
-        let r = phasor_of_word(step);
-        self.rot_re = self.rot_re.with_lane(lane, r.re);
-        self.rot_im = self.rot_im.with_lane(lane, r.im);
+        // The next re-set computes the phasor from `phase`.
+        self.phase[lane] = nco.phase_word();
+        self.set_step(lane, nco.step_word());
         Ok(())
     }
 
@@ -206,6 +195,19 @@ impl<S: Sample> RotatingNco<S> {
             }
         })
     }
+}
+
+/// Refuses a lane past `S::LANES`, naming the lanes there are.
+fn check_lane<S: Sample>(lane: usize) -> ParamResult<()> {
+    if lane < S::LANES {
+        return Ok(());
+    }
+    Err(ParamError::new(
+        "rotating_nco",
+        "lane",
+        lane,
+        format!("must be below the number of lanes ({})", S::LANES),
+    ))
 }
 
 impl<S: Sample> Stage for RotatingNco<S> {
