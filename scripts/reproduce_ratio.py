@@ -14,6 +14,12 @@ median and at the best run, with the median CPU time of its runs (user + system,
 children's resource usage): steadier than the wall time between two binaries, it resolves
 changes of about 1 % that the wall time's spread hides. The first binary is benched; give the
 same CPU's binaries only.
+
+A second figure divides CPU time, not wall time: the point-samples at the bench's one-thread
+rates (the same bench's rows on one thread) against each binary's median CPU time. It is the
+share of the run's CPU that its sample loops would take at the bench's speed, and it does not
+move when the host slows one vCPU and not the other (a two-thread bench then reads low, and the
+wall-time figure high), though it moves with the speed of the host as a whole.
 """
 
 import argparse
@@ -33,9 +39,9 @@ PRESETS = ["m2tfg-rotating", "baw-rotating", "m2tfg-ratetable", "m2tfg-coriolis"
 
 
 def bench(binary: str, repeats: int) -> tuple:
-    """The best `whole chain` rate on all threads of each preset, point-samples/s, and the
-    bench's line naming the CPU."""
-    rates, cpu = {}, "cpu: not named by this binary"
+    """The best `whole chain` rate of each preset on all threads and on one, point-samples/s,
+    and the bench's line naming the CPU."""
+    rates, ones, cpu = {}, {}, "cpu: not named by this binary"
     for preset in PRESETS:
         done = subprocess.run(
             [binary, "bench", "--preset", preset, "--repeats", str(repeats)],
@@ -47,10 +53,12 @@ def bench(binary: str, repeats: int) -> tuple:
         # (eight, or four where they run faster: `gyroemu_board::max_lanes_for`).
         rows = [line.split() for line in out.splitlines()
                 if re.match(r"whole chain +\d", line)]
-        # On the most threads.
+        # On the most threads, and on one.
         best = max(rows, key=lambda r: int(r[-3]))
         rates[preset] = float(best[-2]) * 1e6
-    return rates, cpu
+        one = min(rows, key=lambda r: int(r[-3]))
+        ones[preset] = float(one[-2]) * 1e6
+    return rates, ones, cpu
 
 
 def children_cpu() -> float:
@@ -96,7 +104,7 @@ def main() -> None:
     tmp = Path(tempfile.mkdtemp(prefix="reproduce_ratio_"))
     _, total, _ = run_reproduce(a.binaries[0], tmp / "first")
     samples = point_samples(tmp / "first", total)
-    before, cpu = bench(a.binaries[0], a.repeats)
+    before, before1, cpu = bench(a.binaries[0], a.repeats)
     walls = {b: [] for b in a.binaries}
     cpus = {b: [] for b in a.binaries}
     for _ in range(a.runs):
@@ -104,10 +112,12 @@ def main() -> None:
             wall, _, cpu_s = run_reproduce(b, tmp / "run")
             walls[b].append(wall)
             cpus[b].append(cpu_s)
-    after, _ = bench(a.binaries[0], a.repeats)
+    after, after1, _ = bench(a.binaries[0], a.repeats)
     shutil.rmtree(tmp, ignore_errors=True)
     p = [predict(samples, r) for r in (before, after)]
     pred = statistics.mean(p)
+    p1 = [predict(samples, r) for r in (before1, after1)]
+    pred1 = statistics.mean(p1)
     print(cpu)
     print("point-samples:", {k: f"{v:.4g}" for k, v in samples.items()})
     for name, r in (("before", before), ("after", after)):
@@ -115,12 +125,19 @@ def main() -> None:
               {k: round(v / 1e6, 1) for k, v in r.items()})
     print(f"prediction {p[0]:.3f} s before, {p[1]:.3f} s after: {pred:.3f} s; "
           f"80 % asks {pred / 0.8:.3f} s")
+    for name, r in (("before", before1), ("after", after1)):
+        print(f"bench {name}, one thread (M point-samples/s):",
+              {k: round(v / 1e6, 1) for k, v in r.items()})
+    print(f"the loops' CPU at the one-thread rates: {p1[0]:.3f} s before, {p1[1]:.3f} s after: "
+          f"{pred1:.3f} CPU-s")
     for b, w in walls.items():
         w.sort()
         med = statistics.median(w)
         print(f"{b}: wall {w[0]:.2f} to {w[-1]:.2f} s, median {med:.2f} (n={len(w)}): "
               f"{100 * pred / med:.0f} % at the median, {100 * pred / w[0]:.0f} % at the best; "
-              f"CPU median {statistics.median(cpus[b]):.3f} s")
+              f"CPU median {statistics.median(cpus[b]):.3f} s, "
+              f"{100 * pred1 / statistics.median(cpus[b]):.0f} % of it the loops at the bench's "
+              f"one-thread rates")
 
 
 if __name__ == "__main__":
