@@ -389,7 +389,7 @@ fn inspect_refuses_missing_or_damaged_dumps_with_exit_2() {
 }
 
 /// `bench` measures the whole chain, noiseless, with noise and with flicker too, in the lanes a run uses here and
-/// in each lane type the CPU runs, and every stage, on 1 and on all threads (the figures are
+/// in each lane type the CPU runs, the noisy chain's normal generator, and every stage, on 1 and on all threads (the figures are
 /// timing, so only their presence and sign are checked), and refuses repeats and samples out of range.
 #[test]
 fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
@@ -493,6 +493,8 @@ fn bench_prints_the_chain_and_every_stage_for_one_and_all_threads() {
         "low-pass bank (I1, Q1, I2, Q2)".to_string(),
         "tia".to_string(),
     ];
+    // The noisy chain's normals alone, in its lanes (the widest).
+    names.push(format!("normal generator (4 per point-sample, {widest})"));
     for t in ["f64x4", "f64x8"].iter().take(if eight { 2 } else { 1 }) {
         names.push(format!("whole chain ({t})"));
         names.push(format!("whole chain with noise ({t})"));

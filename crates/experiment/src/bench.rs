@@ -4,6 +4,8 @@
 
 use gyroemu_board::{max_lanes, max_lanes_for, GroupBoard, Point, RunOptions};
 use gyroemu_config::Config;
+use gyroemu_core::gauss::NormalBlock;
+use gyroemu_core::noise::NoiseRng;
 use gyroemu_core::{f64x4, Sample, Stage};
 use gyroemu_lpf::Window;
 use rayon::prelude::*;
@@ -163,6 +165,40 @@ fn stage<T: Stage + Clone + Send + Sync>(
     (n as f64 * lanes as f64 * threads as f64) / t.elapsed().as_secs_f64()
 }
 
+/// Draws the normals of `n` input samples of one lane group of `width` lanes (four rows of a
+/// [`NormalBlock`] per sample, read as the noisy chain's loop reads them) on each of
+/// `threads` threads; returns point-samples per second over all of them. A noisy sample's
+/// time is the noiseless chain's, these normals' and the rest of the noise's work (the block
+/// refills between runs of the loop, so little of it overlaps): the bound the generator puts
+/// on the noisy chain.
+fn normals(width: usize, n: u64, threads: usize) -> f64 {
+    let one = |t: usize| {
+        // Streams of their own per thread, as each lane group has.
+        let rng = |seed: u64| NoiseRng::new(core::array::from_fn(|l| seed + l as u64));
+        let base = 16 * t as u64;
+        let mut block = if width == 8 {
+            NormalBlock::wide(rng(base), rng(base + 4))
+        } else {
+            NormalBlock::new(rng(base))
+        };
+        let (mut left, mut acc) = (n, 0.0);
+        while left > 0 {
+            let run = block.ready(left);
+            acc += block.row(block.pos(), width)[0];
+            block.advance(run);
+            left -= run;
+        }
+        black_box(acc);
+    };
+    let t = Instant::now();
+    if threads == 1 {
+        one(0);
+    } else {
+        (0..threads).into_par_iter().for_each(one);
+    }
+    (n as f64 * width as f64 * threads as f64) / t.elapsed().as_secs_f64()
+}
+
 /// A plant driven through its decoupled step (what the board runs when the modes are
 /// uncoupled), as a stage.
 #[derive(Clone)]
@@ -184,7 +220,7 @@ impl Stage for DecoupledPlant {
 /// threads: the chain, noiseless, with noise and with noise and flicker, each in the lanes this
 /// CPU runs it in (rows `whole chain`, `whole chain with noise`, `whole chain with noise and
 /// flicker`), then in each lane type it can run (the same rows with `(f64x4)` or `(f64x8)`),
-/// then each stage.
+/// then the noisy chain's normal generator alone, in that chain's lanes, then each stage.
 pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     use gyroemu_am::{AmInput, AmModulator, DrivePattern};
     use gyroemu_lpf::{LowPass, LowPassBank, LowPassDesign};
@@ -231,6 +267,17 @@ pub fn all(cfg: &Config, n_in: u64, repeats: usize) -> Vec<Throughput> {
     let mut push_n = |name: &str, threads: usize, measure: &mut dyn FnMut() -> f64| {
         out.push(row(name, threads, measure));
     };
+    // The noisy chain's normals alone, in its lanes: with its row, the bound its generator
+    // puts on it (docs/performance.md, issue 15's first goal).
+    let noisy_width = max_lanes_for(&with_noise(cfg).board_params());
+    let name = format!(
+        "normal generator (4 per point-sample, {})",
+        lane_type(noisy_width)
+    );
+    push_n(&name, 1, &mut || normals(noisy_width, n_in, 1));
+    if threads > 1 {
+        push_n(&name, threads, &mut || normals(noisy_width, n_in, threads));
+    }
     let x = |i: u64| f64x4::splat((i & 1023) as f64 * 1e-3);
     let fs = cfg.fs_hz();
     let mut push = |name: &str, measure: Box<dyn Fn(usize) -> f64 + '_>| {

@@ -51,7 +51,7 @@ pub fn bench_command(preset_name: &str, samples: u64, repeats: usize) -> Result<
     );
     note!(
         "bench: preset {preset_name}, fs = {} Hz, {samples} input samples per lane group, best and median of {repeats} runs; \
-         whole chain (the preset's / with noise / with noise and flicker): {} per group (what a run uses on this CPU), {typed}; stages: 4 lanes",
+         whole chain (the preset's / with noise / with noise and flicker): {} per group (what a run uses on this CPU), {typed}; the normal generator: the noisy chain's lanes; stages: 4 lanes",
         cfg.fs_hz(),
         widths.join(" / ")
     );
