@@ -17,9 +17,10 @@ same CPU's binaries only.
 
 A second figure divides CPU time, not wall time: the point-samples at the bench's one-thread
 rates (the same bench's rows on one thread) against each binary's median CPU time. It is the
-share of the run's CPU that its sample loops would take at the bench's speed, and it does not
-move when the host slows one vCPU and not the other (a two-thread bench then reads low, and the
-wall-time figure high), though it moves with the speed of the host as a whole.
+share of the run's CPU that its sample loops would take at the bench's speed. It does not
+depend on the two-thread bench, which reads low when the host slows one vCPU and not the other
+(the wall-time figure then reads high); like the wall-time figure, it moves with the host's
+speed during the runs.
 """
 
 import argparse

@@ -1,6 +1,7 @@
-//! Throughput measurement of the emulated board: the whole chain in f64x4 lanes on one thread
-//! and on all threads, and each stage alone. Used by `gyroemu bench` and the criterion-free
-//! benchmark; timing lives here, never in tests.
+//! Throughput measurement of the emulated board: the whole chain (noiseless, with noise, with
+//! noise and flicker) in each lane type on one thread and on all threads, the noisy chain's
+//! normal generator alone, and each stage alone. Used by `gyroemu bench` and the
+//! criterion-free benchmark; timing lives here, never in tests.
 
 use gyroemu_board::{max_lanes, max_lanes_for, GroupBoard, Point, RunOptions};
 use gyroemu_config::Config;
