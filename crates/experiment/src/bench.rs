@@ -151,19 +151,25 @@ fn stage<T: Stage + Clone + Send + Sync>(
     threads: usize,
     input: impl Fn(u64) -> T::Input + Sync,
 ) -> f64 {
-    let one = || {
+    let one = |_| {
         let mut st = st.clone();
         for i in 0..n {
             black_box(st.tick(black_box(input(i))));
         }
     };
+    on_threads(threads, n * lanes as u64, one)
+}
+
+/// Runs `one(t)` on each of `threads` threads (`t` = 0, 1, ...; on the calling thread alone
+/// for one) and returns `items` (point-samples per thread) times `threads` per second.
+fn on_threads(threads: usize, items: u64, one: impl Fn(usize) + Sync + Send) -> f64 {
     let t = Instant::now();
     if threads == 1 {
-        one();
+        one(0);
     } else {
-        (0..threads).into_par_iter().for_each(|_| one());
+        (0..threads).into_par_iter().for_each(one);
     }
-    (n as f64 * lanes as f64 * threads as f64) / t.elapsed().as_secs_f64()
+    (items as f64 * threads as f64) / t.elapsed().as_secs_f64()
 }
 
 /// Draws the normals of `n` input samples of one lane group of `width` lanes (four rows of a
@@ -191,13 +197,7 @@ fn normals(width: usize, n: u64, threads: usize) -> f64 {
         }
         black_box(acc);
     };
-    let t = Instant::now();
-    if threads == 1 {
-        one(0);
-    } else {
-        (0..threads).into_par_iter().for_each(one);
-    }
-    (n as f64 * width as f64 * threads as f64) / t.elapsed().as_secs_f64()
+    on_threads(threads, n * width as u64, one)
 }
 
 /// A plant driven through its decoupled step (what the board runs when the modes are
