@@ -25,6 +25,7 @@ speed during the runs.
 
 import argparse
 import json
+import os
 import re
 import resource
 import shutil
@@ -78,6 +79,8 @@ def run_reproduce(binary: str, out: Path) -> tuple:
                           check=True, capture_output=True, text=True)
     wall = time.perf_counter() - t
     m = re.search(r"reproduce: (\d+) point-samples", done.stdout + done.stderr)
+    if m is None:
+        sys.exit(f"{binary} reproduce printed no closing line with its point-samples")
     return wall, int(m.group(1)), children_cpu() - cpu
 
 
@@ -96,13 +99,32 @@ def predict(samples: dict, rates: dict) -> float:
     return t + samples["bandwidth"] / rates["m2tfg-ratetable"]
 
 
+def check_args(ap: argparse.ArgumentParser, a: argparse.Namespace) -> None:
+    """Refuses, before anything runs, what would end in a traceback or an empty median."""
+    for name in ("runs", "repeats"):
+        if getattr(a, name) < 1:
+            ap.error(f"--{name} {getattr(a, name)}: must be at least 1")
+    for b in a.binaries:
+        if not (os.path.isfile(b) and os.access(b, os.X_OK)):
+            ap.error(f"binary {b!r}: not an executable file")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("binaries", nargs="+")
     ap.add_argument("--runs", type=int, default=7)
     ap.add_argument("--repeats", type=int, default=3)
     a = ap.parse_args()
+    check_args(ap, a)
     tmp = Path(tempfile.mkdtemp(prefix="reproduce_ratio_"))
+    try:
+        measure(a, tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def measure(a: argparse.Namespace, tmp: Path) -> None:
+    """Runs the benches and the alternating `reproduce` runs in `tmp`, and prints the figures."""
     _, total, _ = run_reproduce(a.binaries[0], tmp / "first")
     samples = point_samples(tmp / "first", total)
     before, before1, cpu = bench(a.binaries[0], a.repeats)
@@ -114,7 +136,6 @@ def main() -> None:
             walls[b].append(wall)
             cpus[b].append(cpu_s)
     after, after1, _ = bench(a.binaries[0], a.repeats)
-    shutil.rmtree(tmp, ignore_errors=True)
     p = [predict(samples, r) for r in (before, after)]
     pred = statistics.mean(p)
     p1 = [predict(samples, r) for r in (before1, after1)]
@@ -142,4 +163,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        sys.exit(main())
+    except subprocess.CalledProcessError as e:
+        # A failed run gives no figure: say which command failed and what it printed.
+        sys.exit(f"{' '.join(e.cmd)} exited with {e.returncode}:\n{e.stderr}")
