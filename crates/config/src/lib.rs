@@ -37,7 +37,7 @@ pub use resolve::{
     Derived, DECIMATION_CANDIDATES, SWEEP_AVERAGE_TAUS, SWEEP_SETTLE_TAUS,
     SWEEP_SPAN_HALF_BANDWIDTHS,
 };
-pub use validate::{EXPERIMENT_WARNING, MAX_RUN_SAMPLES};
+pub use validate::{EXPERIMENT_WARNING, MAX_CORIOLIS_COUPLING, MAX_RUN_SAMPLES};
 pub use validate_noise_phase::{phase_variance_rad2, NoisePhase, WARN_NOISE_PHASE_FRACTION};
 pub use validate_regime::{MAX_HOLD_ERROR_MDEG, NODE_RANGE, WARN_HOLD_ERROR_MDEG};
 pub use validate_sweep::{MAX_SWEEP_POINTS, MIN_POINTS_NEAR_RESONANCE, MIN_SWEEP_POINTS};
