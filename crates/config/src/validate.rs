@@ -214,7 +214,7 @@ impl Config {
             }
         }
         if let Some(r) = b.tia_rail_v {
-            p.positive("board.tia_rail_v", r);
+            p.level("board.tia_rail_v", r);
         }
         p.check(
             LPF_ORDER.contains(b.lpf_order),
@@ -268,7 +268,7 @@ impl Config {
                 CONVERTER_BITS.rule(),
             );
         }
-        p.positive("board.dac_full_scale", b.dac_full_scale);
+        p.level("board.dac_full_scale", b.dac_full_scale);
         p.check(
             b.phase_shifter_error_deg.is_finite() && b.phase_shifter_error_deg.abs() < 90.0,
             "board.phase_shifter_error_deg",

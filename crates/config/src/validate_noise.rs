@@ -39,7 +39,7 @@ impl Config {
                 CONVERTER_BITS.rule(),
             );
         }
-        p.positive("board.adc_full_scale_v", b.adc_full_scale_v);
+        p.level("board.adc_full_scale_v", b.adc_full_scale_v);
         if let Some(n) = &self.noise {
             p.positive("noise.temperature_k", n.temperature_k);
             if let Some(m) = n.effective_mass_kg {
