@@ -20,6 +20,7 @@ mod validate_montecarlo;
 mod validate_noise;
 mod validate_noise_phase;
 mod validate_regime;
+mod validate_resolution;
 mod validate_settling;
 mod validate_sweep;
 mod validate_sweep_dac;
@@ -40,5 +41,6 @@ pub use resolve::{
 pub use validate::{EXPERIMENT_WARNING, MAX_CORIOLIS_COUPLING, MAX_RUN_SAMPLES};
 pub use validate_noise_phase::{phase_variance_rad2, NoisePhase, WARN_NOISE_PHASE_FRACTION};
 pub use validate_regime::{MAX_HOLD_ERROR_MDEG, NODE_RANGE, WARN_HOLD_ERROR_MDEG};
+pub use validate_resolution::MIN_RESOLVED_PHASE_MDEG;
 pub use validate_sweep::{MAX_SWEEP_POINTS, MIN_POINTS_NEAR_RESONANCE, MIN_SWEEP_POINTS};
 pub use validate_sweep_dac::WARN_SWEEP_DAC_REL;

@@ -193,6 +193,7 @@ impl Config {
             self.validate_table_nyquist(warnings);
         }
         self.validate_hold(p, warnings);
+        self.warn_unresolved_phases(warnings);
     }
 
     /// A rate table whose demodulated harmonics reach past the decimated output's Nyquist:
