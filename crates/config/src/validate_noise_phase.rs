@@ -174,8 +174,11 @@ impl Config {
     /// and the stage-1 reference alike, so only `1 - |H|^2` of it stays; the stage-1 low-pass
     /// weighs both. A Coriolis phase is the mean of that over the span (0 Hz), a rate table's
     /// amplitude the in-phase part of its fundamental. A rotating psi keeps neither to first
-    /// order (the slow part turns both sidebands alike, into alpha), so it is not asked. The
-    /// drive's amplitude flicker moves no phase to first order.
+    /// order (the slow part turns both sidebands alike, into alpha), so it is not asked.
+    /// Each drive's amplitude flicker moves a mode's phase only through the other drive's
+    /// share of its response (a Coriolis phase is that of F2/F1 times the coupling: to first
+    /// order, sin(2 theta)/2 times the two amplitudes' difference), so it is 0 at rest and
+    /// uncoupled, and is counted likewise, with sidebands F_j / 2 in place of j F_j / 2.
     ///
     /// The response follows its drives' phase through the plant rotating at `omega_rad_s` (the
     /// reading's rate; a rate table's and the rotating runs' at rest): per mode k and drive j,
@@ -199,12 +202,13 @@ impl Config {
     ) -> [f64; 2] {
         let fs_out = self.fs_out_hz();
         // As the board draws them: once per decimation block, up to fs_out / 2.
-        let [_, _, drive_s1, carrier_s1] = self.flicker_psds_at_1hz();
-        let (drive, carrier) = (
+        let [_, amplitude_s1, drive_s1, carrier_s1] = self.flicker_psds_at_1hz();
+        let (amplitude, drive, carrier) = (
+            self.flicker_design(amplitude_s1, fs_out),
             self.flicker_design(drive_s1, fs_out),
             self.flicker_design(carrier_s1, fs_out),
         );
-        if drive.is_none() && carrier.is_none() {
+        if amplitude.is_none() && drive.is_none() && carrier.is_none() {
             return [0.0; 2];
         }
         let chain = ChainResponse::new(&self.board_params()).ok();
@@ -224,32 +228,37 @@ impl Config {
         };
         let carrier_x = gyroemu_resonator::continuous_steady_state(&plant, omega_rad_s, fc, force);
         let j_unit = Complex64::new(0.0, 1.0);
-        // Per mode, the phase transfer of each drive's phase at f (Hz).
-        let follow = |f: f64| -> [[Complex64; 2]; 2] {
+        // Per mode, the phase transfer at f (Hz) of each drive's phase (`e` = j: sidebands
+        // j F_j / 2) or of its relative amplitude (`e` = 1: sidebands F_j / 2).
+        let follow = |f: f64, e: Complex64| -> [[Complex64; 2]; 2] {
             let up = [respond(f, 0), respond(f, 1)];
             let down = [respond(-f, 0), respond(-f, 1)];
             core::array::from_fn(|k| {
                 core::array::from_fn(|j| {
-                    // Sidebands j F_j / 2: the responses to F_j, times j / 2.
+                    // The responses to F_j, times e / 2.
                     let x0 = carrier_x[2 + k];
                     if x0.norm() == 0.0 {
                         // An undriven mode has no phase to turn (other rules name it).
                         return Complex64::new(0.0, 0.0);
                     }
-                    let a = up[j][2 + k] * (0.5 * j_unit) / x0;
-                    let b = down[j][2 + k] * (0.5 * j_unit) / x0;
+                    let a = up[j][2 + k] * (0.5 * e) / x0;
+                    let b = down[j][2 + k] * (0.5 * e) / x0;
                     (a - b.conj()) / j_unit
                 })
             })
         };
         [0, 1].map(|k| {
             let density = |f: f64| {
-                let t = follow(f)[k];
+                let t = follow(f, j_unit)[k];
                 let d =
                     drive.as_ref().map_or(0.0, |d| d.psd(f)) * (t[0].norm_sqr() + t[1].norm_sqr());
                 let c = carrier.as_ref().map_or(0.0, |d| d.psd(f))
                     * (Complex64::new(1.0, 0.0) - t[0] - t[1]).norm_sqr();
-                (d + c) * low(f)
+                let a = amplitude.as_ref().map_or(0.0, |d| {
+                    let t = follow(f, Complex64::new(1.0, 0.0))[k];
+                    d.psd(f) * (t[0].norm_sqr() + t[1].norm_sqr())
+                });
+                (d + c + a) * low(f)
             };
             reading.variance(&density, self.flicker_f_lo_hz(), f_top)
         })
@@ -375,7 +384,9 @@ impl Config {
         // points (the zero-rate reference's span among them). Only with flicker.
         let span = |rate: f64| self.plan_point(rate).span_samples() / fs_out;
         let flicker_on = self.noise.as_ref().is_some_and(|n| {
-            n.drive_phase_flicker_rad_per_rthz > 0.0 || n.carrier_phase_flicker_rad_per_rthz > 0.0
+            n.drive_phase_flicker_rad_per_rthz > 0.0
+                || n.carrier_phase_flicker_rad_per_rthz > 0.0
+                || n.drive_amplitude_flicker_per_rthz > 0.0
         });
         let key = |rate: f64| {
             let r = if shape == Shape::Coriolis { rate } else { 0.0 };
@@ -528,16 +539,17 @@ impl Config {
                     p.theory_rad[k].abs() / DEG
                 )
             };
-            // The slow phase flicker is in the sigma, not in the carrier's density.
+            // The slow flicker is in the sigma, not in the carrier's density.
             let slow = self.noise.as_ref().is_some_and(|n| {
                 n.drive_phase_flicker_rad_per_rthz > 0.0
                     || n.carrier_phase_flicker_rad_per_rthz > 0.0
+                    || n.drive_amplitude_flicker_per_rthz > 0.0
             }) && self.shape() != Shape::Rotating;
             warnings.push(format!(
                 "the noise at the carrier (about {:.3e} V/sqrt(Hz) at the ADC input, the white sources and the TIA's voltage flicker together, with the noise the decimation folds onto the output){}, averaged over the point's span, against the TIA output of mode {} at {} deg/s (about {amplitude:.3e} V) {scatter}; average longer (experiment.average_s) or lower the noise",
                 density.sqrt(),
                 if slow {
-                    ", and the drive and carrier phase flicker the reading sees"
+                    ", and the drives' and the carrier's flicker the reading sees"
                 } else {
                     ""
                 },
