@@ -264,6 +264,34 @@ impl Config {
         })
     }
 
+    /// Per mode, the variance (rad^2) the drives' amplitude flicker leaves on a rotating psi
+    /// at `rate_dps` over `span_s`. Mode k's drive is `F_k (1 + a_k(t)) cos(Omega t)` (or
+    /// `sin`): the part of `a_k` at 2 Omega carries each sideband onto the other (at +-Omega,
+    /// through the same plant response), so the sidebands' phases move by `-+<a_k sin(2 Omega
+    /// t)>` and psi, half their difference, by that: the quadrature part of a tone at
+    /// 2 Omega, a quarter of [`SlowReading::Tone`]'s in-phase fundamental `2 <a cos>`. (The
+    /// mean of `a_k` scales both sidebands alike, and the phase flicker turns them alike:
+    /// neither moves psi to first order.)
+    fn rotating_amplitude_flicker_variance(
+        &self,
+        span_s: f64,
+        hann: bool,
+        rate_dps: f64,
+    ) -> [f64; 2] {
+        let fs_out = self.fs_out_hz();
+        let [_, amplitude_s1, _, _] = self.flicker_psds_at_1hz();
+        let Some(d) = self.flicker_design(amplitude_s1, fs_out) else {
+            return [0.0; 2];
+        };
+        let tone = SlowReading::Tone {
+            freq_hz: 2.0 * rate_dps.abs() / 360.0,
+            span_s,
+            hann,
+        };
+        let v = 0.25 * tone.variance(&|f| d.psd(f), self.flicker_f_lo_hz(), 0.5 * fs_out);
+        [v, v]
+    }
+
     /// `sum_k |L(k fs_out)|^2 / |L(0)|^2 g(k fs_out)` over the multiples of the output rate of
     /// both signs in the input band, k = 0 included (L the stage-1 low-pass), for each of the
     /// `N` values `g` gives: what a density `g` at the carrier offset `f` (demodulated to `f`)
@@ -316,8 +344,10 @@ impl Config {
     /// Brownian part is the resonance's, correlated over a mode's Q / (pi f0): an average
     /// shorter than a few of those sees less of it than stated (the warning errs towards
     /// warning). Of flicker, the TIA's voltage flicker near the carrier is counted, and the
-    /// drive and carrier phase flicker (`Config::slow_flicker_variance`) on a Coriolis or
-    /// rate-table reading; a rotating psi keeps neither to first order.
+    /// drives' amplitude and phase flicker and the carrier's (`Config::slow_flicker_variance`)
+    /// on a Coriolis or rate-table reading; on a rotating psi, which keeps neither phase
+    /// flicker to first order, the amplitude flicker at twice the modulation
+    /// (`Config::rotating_amplitude_flicker_variance`).
     pub fn noise_phase(&self) -> Option<Vec<NoisePhase>> {
         // With a [pll], the reading's noise and phase at the carrier the lock holds.
         if let Some(held) = self.expected_lock() {
@@ -377,9 +407,10 @@ impl Config {
                 span_s,
                 hann,
             }),
-            Shape::Rotating => [0.0; 2],
+            Shape::Rotating => self.rotating_amplitude_flicker_variance(span_s, hann, rate),
         };
-        // Once per span (and per rate for a Coriolis reading, whose plant rotates at it): a
+        // Once per span (and per rate for a Coriolis reading, whose plant rotates at it, and
+        // a rotating one, whose modulation sets what of the amplitude flicker it reads): a
         // sweep may list 1e5 rates of one span, and each is a quadrature of hundreds of
         // points (the zero-rate reference's span among them). Only with flicker.
         let span = |rate: f64| self.plan_point(rate).span_samples() / fs_out;
@@ -389,7 +420,11 @@ impl Config {
                 || n.drive_amplitude_flicker_per_rthz > 0.0
         });
         let key = |rate: f64| {
-            let r = if shape == Shape::Coriolis { rate } else { 0.0 };
+            let r = if matches!(shape, Shape::RateTable { .. }) {
+                0.0
+            } else {
+                rate
+            };
             (span(rate).to_bits(), r.to_bits())
         };
         let mut slow_by_key: std::collections::HashMap<(u64, u64), [f64; 2]> = Default::default();

@@ -67,3 +67,38 @@ fn the_stated_scatter_is_the_boards() {
         "board {rms:e} rad against {sigma:e} stated"
     );
 }
+
+/// A rotating psi reads the amplitude flicker's part at twice the modulation: each drive's
+/// `(1 + a(t)) cos(Omega t)` carries one sideband onto the other. It had been left out with
+/// the phase flicker, which turns both sidebands alike; 1e-2/sqrt(Hz) read the 25 deg/s
+/// point of `m2tfg-rotating` (8 s) 101 and 246 mdeg off with no word.
+#[test]
+fn a_rotating_psi_reads_it_at_twice_the_modulation_as_stated() {
+    let rotating = |seed: u64| {
+        let mut c = preset("m2tfg-rotating").unwrap();
+        c.experiment.rates_dps = vec![25.0];
+        c.experiment.average_s = 8.0;
+        c.noise = Some(NoiseConfig {
+            seed,
+            drive_amplitude_flicker_per_rthz: 1e-2,
+            ..NoiseConfig::default()
+        });
+        c
+    };
+    let seeds = 16u64;
+    for k in 0..2 {
+        let sigma = stated(&rotating(0), k)[0].0;
+        let sum2: f64 = (0..seeds)
+            .map(|seed| {
+                let p = &finished(&rotating(seed)).points[0];
+                ((p.phase_deg[k] - p.theory_deg[k]).to_radians()).powi(2)
+            })
+            .sum();
+        let rms = (sum2 / seeds as f64).sqrt();
+        assert!(
+            (0.6..1.6).contains(&(rms / sigma)),
+            "mode {}: board {rms:e} rad against {sigma:e} stated",
+            k + 1
+        );
+    }
+}
