@@ -3,7 +3,6 @@
 //! bring a cascade of follow-on errors.
 
 use crate::error::ConfigError;
-use crate::validate_regime::NODE_RANGE;
 use std::fmt::Display;
 
 /// The problems found so far, and which keys they are about.
@@ -113,21 +112,6 @@ impl Rules {
             v,
             "must be a finite number > 0",
         )
-    }
-
-    /// A clamp level (a converter's full scale, the TIA's rails): > 0 and inside
-    /// [`NODE_RANGE`], since a clipped sample takes it as its value.
-    pub fn level(&mut self, key: &str, v: f64) -> bool {
-        let (lo, hi) = NODE_RANGE;
-        self.positive(key, v)
-            && self.check(
-                (lo..=hi).contains(&v),
-                key,
-                v,
-                format!(
-                    "must lie in {lo:e} ..= {hi:e}, the band every node's signal is held to: a clipped sample takes this level, and beyond the band the chain's products leave the normal numbers (at 1e-300 a run went 30 to 80 times slower and ended in NaN phases)"
-                ),
-            )
     }
 
     pub fn finite(&mut self, key: &str, v: f64) -> bool {

@@ -7,6 +7,7 @@ use crate::error::ConfigError;
 use crate::plan::DEG;
 use crate::rules::Rules;
 use crate::schema::{CONVERTER_BITS, LPF_ORDER};
+use crate::validate_regime::check_level;
 use gyroemu_board::DUMP_NODES;
 
 /// Most input samples one operating point may run: 2^53, so every sample index and count
@@ -214,7 +215,7 @@ impl Config {
             }
         }
         if let Some(r) = b.tia_rail_v {
-            p.level("board.tia_rail_v", r);
+            check_level(p, "board.tia_rail_v", r);
         }
         p.check(
             LPF_ORDER.contains(b.lpf_order),
@@ -268,7 +269,7 @@ impl Config {
                 CONVERTER_BITS.rule(),
             );
         }
-        p.level("board.dac_full_scale", b.dac_full_scale);
+        check_level(p, "board.dac_full_scale", b.dac_full_scale);
         p.check(
             b.phase_shifter_error_deg.is_finite() && b.phase_shifter_error_deg.abs() < 90.0,
             "board.phase_shifter_error_deg",

@@ -5,7 +5,7 @@ use crate::config::Config;
 use crate::rules::Rules;
 use crate::schema::{CONVERTER_BITS, PLL_MODE};
 use crate::validate::MAX_RUN_SAMPLES;
-use crate::validate_regime::NODE_RANGE;
+use crate::validate_regime::{check_level, NODE_RANGE};
 use gyroemu_core::noise::{held_white_sigma, white_sigma};
 use gyroemu_core::Response;
 use gyroemu_tia::Tia;
@@ -39,7 +39,7 @@ impl Config {
                 CONVERTER_BITS.rule(),
             );
         }
-        p.level("board.adc_full_scale_v", b.adc_full_scale_v);
+        check_level(p, "board.adc_full_scale_v", b.adc_full_scale_v);
         if let Some(n) = &self.noise {
             p.positive("noise.temperature_k", n.temperature_k);
             if let Some(m) = n.effective_mass_kg {
