@@ -43,17 +43,58 @@ fn density_unit(unit: &str) -> String {
 
 /// Writes `signals.png` and `spectrum.png` of `set` into `dir`; returns their paths.
 pub fn write_dump_figures(set: &DumpSet, dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
-    let render = |file: &str, (title, panels): (String, Vec<Figure>)| {
-        let path = dir.join(file);
-        let rows = panels.len().div_ceil(2).max(1) as u32;
-        render_panels_png(&title, &panels, 2, WIDTH_PX, 80 + ROW_PX * rows, &path).map(|_| path)
-    };
-    // The two figures are independent: draw them on two threads.
-    let (a, b) = rayon::join(
-        || render("signals.png", signal_panels(set)),
-        || render("spectrum.png", spectrum_panels(set)),
-    );
-    Ok(vec![a?, b?])
+    dump_figures(set)?.write(dir)
+}
+
+/// Both figures of a dump, laid out and checked, not yet drawn.
+pub struct DumpFigures([(&'static str, String, Vec<Figure>); 2]);
+
+/// Lays out both figures of `set` and checks their size before either is drawn: a dump of
+/// many channels (80 and more) had written `spectrum.png`, then failed on `signals.png`'s
+/// height, leaving half of what was asked.
+pub fn dump_figures(set: &DumpSet) -> Result<DumpFigures, ReportError> {
+    // The two figures are independent: laid out (their spectra computed) on two threads.
+    let (signals, spectrum) = rayon::join(|| signal_panels(set), || spectrum_panels(set));
+    let figures = [
+        ("signals.png", signals.0, signals.1),
+        ("spectrum.png", spectrum.0, spectrum.1),
+    ];
+    for (file, _, panels) in &figures {
+        let height = figure_height(panels.len());
+        if height > gyroemu_plot::MAX_SIDE_PX as usize {
+            return Err(gyroemu_plot::PlotError::InvalidLayout {
+                path: PathBuf::from(file),
+                reason: format!(
+                    "{} panels, {WIDTH_PX} x {height} px, beyond the {} px a figure may take (at most {} panels); nothing was written: inspect fewer channels",
+                    panels.len(),
+                    gyroemu_plot::MAX_SIDE_PX,
+                    2 * ((gyroemu_plot::MAX_SIDE_PX - 80) / ROW_PX)
+                )
+                .into(),
+            }
+            .into());
+        }
+    }
+    Ok(DumpFigures(figures))
+}
+
+/// A figure's height for `panels` panels, two to a row.
+fn figure_height(panels: usize) -> usize {
+    80 + ROW_PX as usize * panels.div_ceil(2).max(1)
+}
+
+impl DumpFigures {
+    /// Draws both figures into `dir` (on two threads); returns their paths.
+    pub fn write(self, dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
+        let render = |(file, title, panels): (&str, String, Vec<Figure>)| {
+            let path = dir.join(file);
+            let h = figure_height(panels.len()) as u32;
+            render_panels_png(&title, &panels, 2, WIDTH_PX, h, &path).map(|_| path)
+        };
+        let [a, b] = self.0;
+        let (a, b) = rayon::join(|| render(a), || render(b));
+        Ok(vec![a?, b?])
+    }
 }
 
 /// "m2tfg-rotating/dump at 175 deg/s": the dump's folder and name, and the operating point

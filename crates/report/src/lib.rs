@@ -13,7 +13,7 @@ pub mod reproduce;
 pub mod selfcal_report;
 pub mod sweep_report;
 
-pub use dump_figures::write_dump_figures;
+pub use dump_figures::{dump_figures, write_dump_figures, DumpFigures};
 pub use dump_set::{read_dump_set, DumpSet};
 pub use dump_stats::{channel_stats, inspect_text, ChannelStats};
 pub use error::{check_problems, ReportError};
