@@ -25,7 +25,6 @@ speed during the runs.
 
 import argparse
 import json
-import os
 import re
 import resource
 import shutil
@@ -56,6 +55,8 @@ def bench(binary: str, repeats: int) -> tuple:
         rows = [line.split() for line in out.splitlines()
                 if re.match(r"whole chain +\d", line)]
         # On the most threads, and on one.
+        if not rows:
+            sys.exit(f"{binary} bench --preset {preset} printed no `whole chain` row")
         best = max(rows, key=lambda r: int(r[-3]))
         rates[preset] = float(best[-2]) * 1e6
         one = min(rows, key=lambda r: int(r[-3]))
@@ -105,8 +106,9 @@ def check_args(ap: argparse.ArgumentParser, a: argparse.Namespace) -> None:
         if getattr(a, name) < 1:
             ap.error(f"--{name} {getattr(a, name)}: must be at least 1")
     for b in a.binaries:
-        if not (os.path.isfile(b) and os.access(b, os.X_OK)):
-            ap.error(f"binary {b!r}: not an executable file")
+        # A bare name is looked up on PATH, as the runs will.
+        if shutil.which(b) is None:
+            ap.error(f"binary {b!r}: not an executable file (nor a command on PATH)")
 
 
 def main() -> None:

@@ -274,13 +274,13 @@ impl Config {
     /// neither moves psi to first order.)
     fn rotating_amplitude_flicker_variance(
         &self,
+        design: Option<&gyroemu_core::flicker::FlickerDesign>,
         span_s: f64,
         hann: bool,
         rate_dps: f64,
     ) -> [f64; 2] {
         let fs_out = self.fs_out_hz();
-        let [_, amplitude_s1, _, _] = self.flicker_psds_at_1hz();
-        let Some(d) = self.flicker_design(amplitude_s1, fs_out) else {
+        let Some(d) = design else {
             return [0.0; 2];
         };
         let tone = SlowReading::Tone {
@@ -397,6 +397,11 @@ impl Config {
         // the window's own weight (not its white-noise bandwidth: a Hann window takes 1.06 to
         // 1.12 times the boxcar's of the drive's 1/f phase, not 1.5).
         let hann = self.experiment.window == WindowKind::Hann;
+        // A rotating psi's amplitude flicker: designed once (a sweep may list 1e5 rates).
+        let amplitude_design = match shape {
+            Shape::Rotating => self.flicker_design(self.flicker_psds_at_1hz()[1], fs_out),
+            _ => None,
+        };
         let slow_of = |span_s: f64, rate: f64| match shape {
             // The plant rotates at a Coriolis reading's rate (a rate table's swings: at rest).
             Shape::Coriolis => {
@@ -407,7 +412,12 @@ impl Config {
                 span_s,
                 hann,
             }),
-            Shape::Rotating => self.rotating_amplitude_flicker_variance(span_s, hann, rate),
+            Shape::Rotating => self.rotating_amplitude_flicker_variance(
+                amplitude_design.as_ref(),
+                span_s,
+                hann,
+                rate,
+            ),
         };
         // Once per span (and per rate for a Coriolis reading, whose plant rotates at it, and
         // a rotating one, whose modulation sets what of the amplitude flicker it reads): a
@@ -497,6 +507,54 @@ impl Config {
             (factors, Some(peak))
         };
         let reference_flicker = slow(0.0);
+        // A rate table's amplitude scales with F2/F1 as a Coriolis phase does, so the drives'
+        // amplitude flicker moves it by `d ln A / d ln F2` times their difference, to first
+        // order (at rest, where `slow` weighs the flicker, that transfer is 0). The reading
+        // `2 <A (1 + s a(t)) cos^2(w_t t)>` takes the flicker's mean and a quarter of its tone
+        // at 2 f_t; the derivative by a step of F2 (the device, once; its solves per rate).
+        let table_amplitude = match (shape, self.noise.as_ref()) {
+            (Shape::RateTable { freq_hz }, Some(n)) if n.drive_amplitude_flicker_per_rthz > 0.0 => {
+                let design = self.flicker_design(self.flicker_psds_at_1hz()[1], fs_out);
+                let mut c = self.clone();
+                c.drive.f2 = Some(self.f2() * (1.0 + TABLE_F2_STEP));
+                design.map(|d| (d, freq_hz, c.driven_device()))
+            }
+            _ => None,
+        };
+        let mean_and_tone_by_span: std::cell::RefCell<std::collections::HashMap<u64, f64>> =
+            Default::default();
+        let table_amplitude_flicker = |rate: f64, theory: [f64; 2]| -> [f64; 2] {
+            let Some((d, freq_hz, stepped)) = table_amplitude.as_ref() else {
+                return [0.0; 2];
+            };
+            let span_s = span(rate);
+            let v = *mean_and_tone_by_span
+                .borrow_mut()
+                .entry(span_s.to_bits())
+                .or_insert_with(|| {
+                    let psd = |f: f64| d.psd(f);
+                    let (f_lo, f_top) = (self.flicker_f_lo_hz(), 0.5 * fs_out);
+                    let mean = SlowReading::Mean { span_s, hann }.variance(&psd, f_lo, f_top);
+                    let tone = SlowReading::Tone {
+                        freq_hz: 2.0 * freq_hz,
+                        span_s,
+                        hann,
+                    }
+                    .variance(&psd, f_lo, f_top);
+                    mean + 0.25 * tone
+                });
+            let up = stepped.rate_table_response(rate * DEG, *freq_hz).0;
+            [0, 1].map(|k| {
+                let s = (up[k] / theory[k]).abs().ln() / TABLE_F2_STEP.ln_1p();
+                // Two drives, each its own flicker: s for F2, -s for F1.
+                let v_k = 2.0 * theory[k] * theory[k] * s * s * v;
+                if v_k.is_finite() {
+                    v_k
+                } else {
+                    0.0
+                }
+            })
+        };
         let points = self
             .experiment
             .rates_dps
@@ -509,7 +567,8 @@ impl Config {
                     Shape::RateTable { freq_hz } => dev.rate_table_response(omega, freq_hz).0,
                     Shape::Rotating => dev.rotating_psi_rad(omega),
                 };
-                let flicker = slow(rate);
+                let table_amp = table_amplitude_flicker(rate, theory_rad);
+                let flicker = [0, 1].map(|k| slow(rate)[k] + table_amp[k]);
                 let (gain, table_noise_gain_peak) = match shape {
                     Shape::RateTable { .. } => table_gain(rate),
                     _ => ([(2.0, 0.0); 2], None),
@@ -574,20 +633,24 @@ impl Config {
                     p.theory_rad[k].abs() / DEG
                 )
             };
-            // The slow flicker is in the sigma, not in the carrier's density.
-            let slow = self.noise.as_ref().is_some_and(|n| {
-                n.drive_phase_flicker_rad_per_rthz > 0.0
-                    || n.carrier_phase_flicker_rad_per_rthz > 0.0
-                    || n.drive_amplitude_flicker_per_rthz > 0.0
-            }) && self.shape() != Shape::Rotating;
+            // The slow flicker is in the sigma, not in the carrier's density (of a rotating psi,
+            // only the amplitude flicker at twice the modulation).
+            let slow = self.noise.as_ref().and_then(|n| {
+                let amplitude = n.drive_amplitude_flicker_per_rthz > 0.0;
+                let phase = n.drive_phase_flicker_rad_per_rthz > 0.0
+                    || n.carrier_phase_flicker_rad_per_rthz > 0.0;
+                match self.shape() {
+                    Shape::Rotating => amplitude.then_some(
+                        ", and the drives' amplitude flicker at twice the modulation, which the reading sees",
+                    ),
+                    _ => (amplitude || phase)
+                        .then_some(", and the drives' and the carrier's flicker the reading sees"),
+                }
+            });
             warnings.push(format!(
                 "the noise at the carrier (about {:.3e} V/sqrt(Hz) at the ADC input, the white sources and the TIA's voltage flicker together, with the noise the decimation folds onto the output){}, averaged over the point's span, against the TIA output of mode {} at {} deg/s (about {amplitude:.3e} V) {scatter}; average longer (experiment.average_s) or lower the noise",
                 density.sqrt(),
-                if slow {
-                    ", and the drives' and the carrier's flicker the reading sees"
-                } else {
-                    ""
-                },
+                slow.unwrap_or(""),
                 k + 1,
                 p.rate_dps,
             ));
@@ -631,6 +694,9 @@ impl Config {
         ));
     }
 }
+
+/// The relative step of F2 by which a rate table's amplitude is differentiated.
+const TABLE_F2_STEP: f64 = 1e-4;
 
 /// A rate table's read harmonic whose noise power comes back above this many times the DC
 /// reading's is warned ([`Config::validate_table_noise_skirt`]).

@@ -28,6 +28,24 @@ impl Config {
             Shape::RateTable { freq_hz } => Some(dev.rate_table_response(r.abs() * DEG, freq_hz).0),
             Shape::Rotating => None,
         };
+        // The phase grows with |rate| wherever the rule can fire: the largest rate alone
+        // clears it, and only a run it does not clear (rare) is weighed at every rate (a
+        // sweep may list 1e5 rates, each a solve on a rate table).
+        let top = self
+            .experiment
+            .rates_dps
+            .iter()
+            .copied()
+            .max_by(|a, b| a.abs().total_cmp(&b.abs()));
+        let clears = |r: f64| {
+            phase(r).is_none_or(|th| {
+                th.iter()
+                    .any(|t| !((t / DEG * 1e3).abs() < MIN_RESOLVED_PHASE_MDEG))
+            })
+        };
+        if top.is_none_or(|r| r == 0.0 || clears(r)) {
+            return;
+        }
         let mut largest: Option<(f64, f64)> = None;
         for &r in self.experiment.rates_dps.iter().filter(|&&r| r != 0.0) {
             let Some(th) = phase(r) else { return };
