@@ -40,7 +40,7 @@ impl Config {
         let clears = |r: f64| {
             phase(r).is_none_or(|th| {
                 th.iter()
-                    .any(|t| !((t / DEG * 1e3).abs() < MIN_RESOLVED_PHASE_MDEG))
+                    .any(|t| (t / DEG * 1e3).abs() >= MIN_RESOLVED_PHASE_MDEG || t.is_nan())
             })
         };
         if top.is_none_or(|r| r == 0.0 || clears(r)) {

@@ -69,8 +69,7 @@ pub fn dump_figures(set: &DumpSet) -> Result<DumpFigures, ReportError> {
                     panels.len(),
                     gyroemu_plot::MAX_SIDE_PX,
                     2 * ((gyroemu_plot::MAX_SIDE_PX - 80) / ROW_PX)
-                )
-                .into(),
+                ),
             }
             .into());
         }
