@@ -59,8 +59,12 @@ impl Config {
         }
         if let Some((mdeg, r)) = largest.filter(|&(m, _)| m < MIN_RESOLVED_PHASE_MDEG) {
             warnings.push(format!(
-                "experiment.rates_dps: the largest phase the rates give is {mdeg:.3e} mdeg (at {r:e} deg/s), below {MIN_RESOLVED_PHASE_MDEG:e} mdeg, about a hundred times the floor of the chain's own rounding ({ROUNDING_FLOOR_MDEG:e} mdeg): the phases carry that rounding ({:.1e} times the largest of them here), and so does any slope or fit read from them; raise the rates or device.angular_gain",
-                ROUNDING_FLOOR_MDEG / mdeg
+                "experiment.rates_dps: the largest phase the rates give is {mdeg:.3e} mdeg (at {r:e} deg/s), below {MIN_RESOLVED_PHASE_MDEG:e} mdeg, about a hundred times the floor of the chain's own rounding ({ROUNDING_FLOOR_MDEG:e} mdeg): the phases carry that rounding ({}), and so does any slope or fit read from them; raise the rates or device.angular_gain",
+                if mdeg > 0.0 {
+                    format!("{:.1e} times the largest of them here", ROUNDING_FLOOR_MDEG / mdeg)
+                } else {
+                    "every phase is 0 in the theory".to_string()
+                }
             ));
         }
     }
