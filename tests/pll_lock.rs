@@ -177,6 +177,35 @@ fn a_lock_the_phase_noise_spoils_says_so_not_that_it_needs_time() {
 }
 
 #[test]
+fn a_noisy_lock_cut_short_inside_its_threshold_is_told_to_take_longer() {
+    // Started 100 Hz off (27 half-bandwidths) with weak noise and the default lock run: the
+    // loop ends on the resonance with its phase error inside the lock threshold, but not
+    // yet for a natural period. It had been told that the phase noise kept its error above
+    // the threshold (printing 1.24e-2 rad against 0.05) and to lower the noise, not to
+    // raise pll.lock_s (which locks it).
+    let mut c = with_pll(fork(), 100.0);
+    c.noise = Some(gyroemu::config::NoiseConfig {
+        seed: 1,
+        temperature_k: 300.0,
+        effective_mass_kg: Some(1e-9),
+        tia_current_noise_a_per_rthz: 5e-14,
+        tia_voltage_noise_v_per_rthz: 2e-8,
+        ..Default::default()
+    });
+    let e = lock_config_carrier(&c, &c).unwrap_err().to_string();
+    assert!(
+        e.contains("inside the lock threshold")
+            && e.contains("raise pll.lock_s")
+            && !e.contains("kept its phase error above"),
+        "{e}"
+    );
+    // And a lock run five times as long locks.
+    let natural = c.pll_natural_hz().unwrap();
+    c.pll.as_mut().unwrap().lock_s = Some(5.0 * c.pll_lock_s().unwrap());
+    assert!(lock_config_carrier(&c, &c).unwrap().is_some(), "{natural}");
+}
+
+#[test]
 fn a_loop_that_cannot_be_built_is_refused_before_any_sample() {
     // A 20 Hz low-pass (group delay ~ 13 ms) allows at most 0.6 Hz; a Q of 200 needs at
     // least 26 Hz for a PI on the frequency.

@@ -124,26 +124,45 @@ pub fn lock_config_carrier_with(
     // The locked mode's configured resonance and half-bandwidth.
     let (resonance, half_bw) = cfg.mode_resonances_hz()[mode];
     if !run.locked {
+        let error = pll.phase_error_rad();
+        let threshold = params.lock_threshold_rad;
         let cause = format!(
-            "the carrier PLL did not lock within {lock_s} s: it ended at {} Hz with a phase error of {:.3e} rad (started at {} Hz, mode {} resonates at {} Hz as configured)",
+            "the carrier PLL did not lock within {lock_s} s: it ended at {} Hz with a phase error of {error:.3e} rad (started at {} Hz, mode {} resonates at {} Hz as configured)",
             run.carrier_hz,
-            pll.phase_error_rad(),
             params.carrier_hz,
             pll_cfg.mode,
             resonance,
         );
-        // Settled within 5 % of a half-bandwidth yet never held the phase within the lock
-        // threshold for a natural period: the phase noise at its input, not the time, keeps
-        // it from locking (a longer pll.lock_s did not help).
+        // Settled within 5 % of a half-bandwidth of the resonance yet never held the
+        // phase within the lock threshold for a natural period. Either the phase noise at its
+        // input keeps breaking the lock (a longer pll.lock_s did not help: its error's last
+        // stretch inside the threshold was 80 of the 753 updates a lock takes), or the run
+        // ended while it held (316 of 753, the error 1.24e-2 rad against 0.05: it had been
+        // told to lower the noise, and a longer lock run locks). A last stretch of a quarter
+        // of a lock's updates tells them apart.
         let near = (run.carrier_hz - resonance).abs() < 0.05 * half_bw;
         let noisy = cfg.noise.is_some();
-        let (cause, advice) = if near && noisy {
+        let holding = 4 * u64::from(pll.in_band_updates()) >= u64::from(params.lock_updates);
+        let (cause, advice) = if near && noisy && !holding {
             (
                 format!(
-                    "{cause}: its frequency settled near the resonance, but the phase noise at its input kept its phase error above the lock threshold ({} rad) for a whole natural period",
-                    params.lock_threshold_rad
+                    "{cause}: its frequency settled near the resonance, but the phase noise at its input kept its phase error above the lock threshold ({threshold} rad) for a whole natural period"
                 ),
                 "lower the [noise] sources (a longer pll.lock_s does not help)".to_string(),
+            )
+        } else if near && holding {
+            (
+                format!(
+                    "{cause}: its frequency settled near the resonance and its phase error had been inside the lock threshold ({threshold} rad) for {} of the {} updates a lock takes when the lock run ended",
+                    pll.in_band_updates(),
+                    params.lock_updates
+                ),
+                if noisy {
+                    "raise pll.lock_s (and, if it still does not lock, lower the [noise] sources)"
+                } else {
+                    "raise pll.lock_s"
+                }
+                .to_string(),
             )
         } else {
             (

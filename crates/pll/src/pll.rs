@@ -108,6 +108,12 @@ impl Pll {
     pub fn is_locked(&self) -> bool {
         self.run >= self.params.lock_updates
     }
+
+    /// The ticks since the phase error last left the lock threshold (or the signal or a
+    /// limit was lost): [`Pll::is_locked`] once it reaches `lock_updates`.
+    pub fn in_band_updates(&self) -> u32 {
+        self.run
+    }
 }
 
 impl Stage for Pll {
