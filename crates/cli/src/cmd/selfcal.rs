@@ -53,22 +53,22 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
     }
     let m = report.core.modes[0];
     say!(
-        "self-calibration (mode 1): rotating slope {:.9} deg per deg/s x lambda {} = predicted Coriolis {:.9}; \
-         rate table measured {:.9}; relative error {:+.3e} +- {:.2e} (95 %), averaging {} s",
-        m.rotating.slope_deg_per_dps,
+        "self-calibration (mode 1): rotating slope {} deg per deg/s x lambda {} = predicted Coriolis {}; \
+         rate table measured {}; relative error {:+.3e} +- {:.2e} (95 %), averaging {} s",
+        slope(m.rotating.slope_deg_per_dps),
         report.core.angular_gain,
-        m.predicted_deg_per_dps,
-        m.coriolis.slope_deg_per_dps,
+        slope(m.predicted_deg_per_dps),
+        slope(m.coriolis.slope_deg_per_dps),
         m.relative_error,
         m.relative_error_ci95,
         cfg.experiment.average_s
     );
     let c = report.core.combined;
     say!(
-        "self-calibration (both modes, geometric mean): predicted Coriolis {:.9}; rate table measured {:.9}; \
+        "self-calibration (both modes, geometric mean): predicted Coriolis {}; rate table measured {}; \
          relative error {:+.3e} +- {:.2e} (95 %), mode 2 alone {:+.3e}",
-        c.predicted_deg_per_dps,
-        c.coriolis.slope_deg_per_dps,
+        slope(c.predicted_deg_per_dps),
+        slope(c.coriolis.slope_deg_per_dps),
         c.relative_error,
         c.relative_error_ci95,
         report.core.modes[1].relative_error
@@ -80,4 +80,28 @@ pub fn selfcal_command(config: &Path, out: &Path, force: bool) -> Result<()> {
         .collect();
     check_problems("selfcal", &problems)?;
     Ok(())
+}
+
+/// A slope in deg per deg/s as the headline prints it: nine decimals (the presets' 0.04 read
+/// to seven figures), or nine figures in exponent form below 1e-3, where the decimals had
+/// read a gain of 1e-9's slopes as 0.000000000.
+fn slope(v: f64) -> String {
+    if v != 0.0 && v.abs() < 1e-3 {
+        format!("{v:.8e}")
+    } else {
+        format!("{v:.9}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::slope;
+
+    #[test]
+    fn small_slopes_keep_their_figures() {
+        assert_eq!(slope(0.0424384), "0.042438400");
+        assert_eq!(slope(4.069e-11), "4.06900000e-11");
+        assert_eq!(slope(0.0), "0.000000000");
+        assert_eq!(slope(f64::NAN), "NaN");
+    }
 }
