@@ -264,32 +264,33 @@ impl Config {
         })
     }
 
-    /// Per mode, the variance (rad^2) the drives' amplitude flicker leaves on a rotating psi
-    /// at `rate_dps` over `span_s`. Mode k's drive is `F_k (1 + a_k(t)) cos(Omega t)` (or
-    /// `sin`): the part of `a_k` at 2 Omega carries each sideband onto the other (at +-Omega,
-    /// through the same plant response), so the sidebands' phases move by `-+<a_k sin(2 Omega
-    /// t)>` and psi, half their difference, by that: the quadrature part of a tone at
-    /// 2 Omega, a quarter of [`SlowReading::Tone`]'s in-phase fundamental `2 <a cos>`. (The
-    /// mean of `a_k` scales both sidebands alike, and the phase flicker turns them alike:
-    /// neither moves psi to first order.)
-    fn rotating_amplitude_flicker_variance(
+    /// The variance of the quadrature part of the amplitude flicker `d`'s tone at `freq_hz`
+    /// over `span_s`, `<a sin(2 pi freq t)>`: a quarter of [`SlowReading::Tone`]'s in-phase
+    /// fundamental `2 <a cos>`. What a rotating psi reads of each drive's amplitude at twice
+    /// the modulation, and a rate table's amplitude at twice the table's.
+    ///
+    /// On a rotating psi, mode k's drive is `F_k (1 + a_k(t)) cos(Omega t)` (or `sin`): the
+    /// part of `a_k` at 2 Omega carries each sideband onto the other (at +-Omega, through the
+    /// same plant response), so the sidebands' phases move by `-+<a_k sin(2 Omega t)>` and
+    /// psi, half their difference, by that. (The mean of `a_k` scales both sidebands alike,
+    /// and the phase flicker turns them alike: neither moves psi to first order.)
+    fn amplitude_quarter_tone(
         &self,
-        design: Option<&gyroemu_core::flicker::FlickerDesign>,
+        d: &gyroemu_core::flicker::FlickerDesign,
+        freq_hz: f64,
         span_s: f64,
         hann: bool,
-        rate_dps: f64,
-    ) -> [f64; 2] {
-        let fs_out = self.fs_out_hz();
-        let Some(d) = design else {
-            return [0.0; 2];
-        };
+    ) -> f64 {
         let tone = SlowReading::Tone {
-            freq_hz: 2.0 * rate_dps.abs() / 360.0,
+            freq_hz,
             span_s,
             hann,
         };
-        let v = 0.25 * tone.variance(&|f| d.psd(f), self.flicker_f_lo_hz(), 0.5 * fs_out);
-        [v, v]
+        0.25 * tone.variance(
+            &|f| d.psd(f),
+            self.flicker_f_lo_hz(),
+            0.5 * self.fs_out_hz(),
+        )
     }
 
     /// `sum_k |L(k fs_out)|^2 / |L(0)|^2 g(k fs_out)` over the multiples of the output rate of
@@ -347,7 +348,7 @@ impl Config {
     /// drives' amplitude and phase flicker and the carrier's (`Config::slow_flicker_variance`)
     /// on a Coriolis or rate-table reading; on a rotating psi, which keeps neither phase
     /// flicker to first order, the amplitude flicker at twice the modulation
-    /// (`Config::rotating_amplitude_flicker_variance`).
+    /// (`Config::amplitude_quarter_tone`).
     pub fn noise_phase(&self) -> Option<Vec<NoisePhase>> {
         // With a [pll], the reading's noise and phase at the carrier the lock holds.
         if let Some(held) = self.expected_lock() {
@@ -397,11 +398,9 @@ impl Config {
         // the window's own weight (not its white-noise bandwidth: a Hann window takes 1.06 to
         // 1.12 times the boxcar's of the drive's 1/f phase, not 1.5).
         let hann = self.experiment.window == WindowKind::Hann;
-        // A rotating psi's amplitude flicker: designed once (a sweep may list 1e5 rates).
-        let amplitude_design = match shape {
-            Shape::Rotating => self.flicker_design(self.flicker_psds_at_1hz()[1], fs_out),
-            _ => None,
-        };
+        // The drives' amplitude flicker, for a rotating psi and a rate table's amplitude:
+        // designed once (a sweep may list 1e5 rates).
+        let amplitude_design = self.flicker_design(self.flicker_psds_at_1hz()[1], fs_out);
         let slow_of = |span_s: f64, rate: f64| match shape {
             // The plant rotates at a Coriolis reading's rate (a rate table's swings: at rest).
             Shape::Coriolis => {
@@ -412,12 +411,12 @@ impl Config {
                 span_s,
                 hann,
             }),
-            Shape::Rotating => self.rotating_amplitude_flicker_variance(
-                amplitude_design.as_ref(),
-                span_s,
-                hann,
-                rate,
-            ),
+            Shape::Rotating => {
+                let v = amplitude_design.as_ref().map_or(0.0, |d| {
+                    self.amplitude_quarter_tone(d, 2.0 * rate.abs() / 360.0, span_s, hann)
+                });
+                [v, v]
+            }
         };
         // Once per span (and per rate for a Coriolis reading, whose plant rotates at it, and
         // a rotating one, whose modulation sets what of the amplitude flicker it reads): a
@@ -512,12 +511,11 @@ impl Config {
         // order (at rest, where `slow` weighs the flicker, that transfer is 0). The reading
         // `2 <A (1 + s a(t)) cos^2(w_t t)>` takes the flicker's mean and a quarter of its tone
         // at 2 f_t; the derivative by a step of F2 (the device, once; its solves per rate).
-        let table_amplitude = match (shape, self.noise.as_ref()) {
-            (Shape::RateTable { freq_hz }, Some(n)) if n.drive_amplitude_flicker_per_rthz > 0.0 => {
-                let design = self.flicker_design(self.flicker_psds_at_1hz()[1], fs_out);
+        let table_amplitude = match (shape, amplitude_design.as_ref()) {
+            (Shape::RateTable { freq_hz }, Some(d)) => {
                 let mut c = self.clone();
                 c.drive.f2 = Some(self.f2() * (1.0 + TABLE_F2_STEP));
-                design.map(|d| (d, freq_hz, c.driven_device()))
+                Some((d, freq_hz, c.driven_device()))
             }
             _ => None,
         };
@@ -534,14 +532,8 @@ impl Config {
                 .or_insert_with(|| {
                     let psd = |f: f64| d.psd(f);
                     let (f_lo, f_top) = (self.flicker_f_lo_hz(), 0.5 * fs_out);
-                    let mean = SlowReading::Mean { span_s, hann }.variance(&psd, f_lo, f_top);
-                    let tone = SlowReading::Tone {
-                        freq_hz: 2.0 * freq_hz,
-                        span_s,
-                        hann,
-                    }
-                    .variance(&psd, f_lo, f_top);
-                    mean + 0.25 * tone
+                    SlowReading::Mean { span_s, hann }.variance(&psd, f_lo, f_top)
+                        + self.amplitude_quarter_tone(d, 2.0 * *freq_hz, span_s, hann)
                 });
             let up = stepped.rate_table_response(rate * DEG, *freq_hz).0;
             [0, 1].map(|k| {

@@ -23,6 +23,7 @@ impl Config {
     /// and psi grows with them far beyond it before a window can hold a modulation period.
     pub(crate) fn warn_unresolved_phases(&self, warnings: &mut Vec<String>) {
         let dev = self.driven_device();
+        let mdeg = |t: f64| (t / DEG * 1e3).abs();
         let phase = |r: f64| match self.shape() {
             Shape::Coriolis => Some(dev.coriolis_phase_rad(r * DEG)),
             Shape::RateTable { freq_hz } => Some(dev.rate_table_response(r.abs() * DEG, freq_hz).0),
@@ -40,7 +41,7 @@ impl Config {
         let clears = |r: f64| {
             phase(r).is_none_or(|th| {
                 th.iter()
-                    .any(|t| (t / DEG * 1e3).abs() >= MIN_RESOLVED_PHASE_MDEG || t.is_nan())
+                    .any(|&t| mdeg(t) >= MIN_RESOLVED_PHASE_MDEG || t.is_nan())
             })
         };
         if top.is_none_or(|r| r == 0.0 || clears(r)) {
@@ -49,11 +50,10 @@ impl Config {
         let mut largest: Option<(f64, f64)> = None;
         for &r in self.experiment.rates_dps.iter().filter(|&&r| r != 0.0) {
             let Some(th) = phase(r) else { return };
-            for t in th {
-                let mdeg = (t / DEG * 1e3).abs();
+            for m in th.map(mdeg) {
                 // A NaN (an unbuildable plant) is reported by the other rules.
-                if !mdeg.is_nan() && largest.is_none_or(|(m, _)| mdeg > m) {
-                    largest = Some((mdeg, r));
+                if !m.is_nan() && largest.is_none_or(|(l, _)| m > l) {
+                    largest = Some((m, r));
                 }
             }
         }

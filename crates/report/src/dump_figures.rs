@@ -22,6 +22,8 @@ pub const SPECTRUM_RANGE_DB: f64 = 200.0;
 /// Width of the figures, px; each row of panels is this high.
 const WIDTH_PX: u32 = 1600;
 const ROW_PX: u32 = 430;
+/// Height of the title band above the rows, px.
+const TITLE_PX: u32 = 80;
 
 /// `"dBV"` for volts, else `"dB re 1 <unit>"` (or `"dB"` when dimensionless).
 pub fn db_unit(unit: &str) -> String {
@@ -68,7 +70,7 @@ pub fn dump_figures(set: &DumpSet) -> Result<DumpFigures, ReportError> {
                     "{} panels, {WIDTH_PX} x {height} px, beyond the {} px a figure may take (at most {} panels); nothing was written: inspect fewer channels",
                     panels.len(),
                     gyroemu_plot::MAX_SIDE_PX,
-                    2 * ((gyroemu_plot::MAX_SIDE_PX - 80) / ROW_PX)
+                    2 * ((gyroemu_plot::MAX_SIDE_PX - TITLE_PX) / ROW_PX)
                 ),
             }
             .into());
@@ -79,7 +81,7 @@ pub fn dump_figures(set: &DumpSet) -> Result<DumpFigures, ReportError> {
 
 /// A figure's height for `panels` panels, two to a row.
 fn figure_height(panels: usize) -> usize {
-    80 + ROW_PX as usize * panels.div_ceil(2).max(1)
+    TITLE_PX as usize + ROW_PX as usize * panels.div_ceil(2).max(1)
 }
 
 impl DumpFigures {
